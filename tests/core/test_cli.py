@@ -1,0 +1,113 @@
+"""The ``ursim`` command line: outputs, exit codes and one-line errors for bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from ursim_core.cli import main
+
+
+def two_rooms(path: Path) -> Path:
+    image = np.zeros((80, 170), np.uint8)
+    image[5:75, 5:80] = 255
+    image[5:75, 90:165] = 255
+    image[35:45, 80:90] = 255
+    cv2.imwrite(str(path), image)
+    return path
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "ursim_core.cli", *args], capture_output=True, text=True)
+
+
+def test_segment_writes_labels_overlay_and_regions(tmp_path):
+    source = two_rooms(tmp_path / "rooms.png")
+    out = tmp_path / "out"
+    assert main(["segment", str(source), "--preset", "default", "-o", str(out)]) == 0
+    labels = cv2.imread(str(out / "rooms.labels.png"), cv2.IMREAD_UNCHANGED)
+    assert labels.dtype == np.uint16 and labels.shape == (80, 170)
+    document = json.loads((out / "rooms.regions.json").read_text())
+    ids = sorted(region["id"] for region in document["regions"])
+    assert ids == sorted(int(v) for v in np.unique(labels) if v)
+    assert len(ids) == 2
+    assert document["regions"][0]["neighbours"] == [ids[1]]
+    assert document["segmentation"]["params"]["threshold"] == pytest.approx(0.25)
+    assert len(document["sha256"]) == 64
+    overlay = cv2.imread(str(out / "rooms.overlay.png"))
+    assert overlay.shape == (80, 170, 3)
+
+
+def test_segment_param_override_is_recorded(tmp_path):
+    source = two_rooms(tmp_path / "rooms.png")
+    assert main(["segment", str(source), "--param", "doors=55", "-o", str(tmp_path)]) == 0
+    document = json.loads((tmp_path / "rooms.regions.json").read_text())
+    assert document["segmentation"]["params"]["doors"] == 55
+
+
+@pytest.mark.parametrize(
+    "make, expected",
+    [
+        (lambda d: d / "missing.png", "missing.png"),
+        (lambda d: (d / "text.png").write_text("not an image") or d / "text.png", "text.png"),
+        (lambda d: (d / "empty.png").write_bytes(b"") or d / "empty.png", "empty.png"),
+        (lambda d: cv2.imwrite(str(d / "black.png"), np.zeros((10, 10), np.uint8)) and d / "black.png", "black.png"),
+    ],
+)
+def test_bad_maps_give_one_line_and_exit_1(tmp_path, make, expected):
+    path = make(tmp_path)
+    result = run_cli("segment", str(path), "-o", str(tmp_path / "out"))
+    assert result.returncode == 1
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and expected in lines[0], result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_truncated_png_is_reported(tmp_path):
+    good = two_rooms(tmp_path / "good.png").read_bytes()
+    (tmp_path / "cut.png").write_bytes(good[: len(good) // 2])
+    result = run_cli("segment", str(tmp_path / "cut.png"), "-o", str(tmp_path / "out"))
+    assert result.returncode == 1 and "cut.png" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_pixel_limit_is_reported(tmp_path):
+    source = two_rooms(tmp_path / "rooms.png")
+    result = run_cli("segment", str(source), "--max-pixels", "1000", "-o", str(tmp_path / "out"))
+    assert result.returncode == 1 and "rooms.png" in result.stderr
+
+
+def test_bad_yaml_is_reported(tmp_path):
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: -1\norigin: [0, 0, 0]\n")
+    result = run_cli("segment", str(tmp_path / "map.yaml"), "-o", str(tmp_path / "out"))
+    assert result.returncode == 1 and "map.yaml" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_unknown_preset_and_bad_param(tmp_path):
+    source = two_rooms(tmp_path / "rooms.png")
+    assert run_cli("segment", str(source), "--preset", "nope", "-o", str(tmp_path)).returncode == 1
+    result = run_cli("segment", str(source), "--param", "threshold=-3", "-o", str(tmp_path))
+    assert result.returncode == 1 and "threshold" in result.stderr
+
+
+def test_usage_errors_exit_2():
+    assert run_cli("segment", "--no-such-option").returncode == 2
+    assert run_cli().returncode == 2
+
+
+def test_help_shows_examples():
+    result = run_cli("segment", "--help")
+    assert result.returncode == 0 and "examples:" in result.stdout
+
+
+def test_multi_file_run_keeps_going_after_a_bad_file(tmp_path):
+    good = two_rooms(tmp_path / "good.png")
+    result = run_cli("segment", str(tmp_path / "missing.png"), str(good), "-o", str(tmp_path / "out"))
+    assert result.returncode == 1
+    assert (tmp_path / "out" / "good.labels.png").is_file()
+    assert "missing.png" in result.stderr

@@ -1,0 +1,38 @@
+"""``ursim bench``: speed and memory figures printed as tables (never asserted in tests)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ursim_core.datasets import MISSING_REASON, dataset_root
+
+__all__ = ["run_bench"]
+
+
+def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats: int = 5) -> int:
+    """Run the benchmarks named by ``what`` ('segment', 'scale', 'match' or 'all') and print figures."""
+    root = dataset_root(datasets)
+    if what in ("segment", "all"):
+        from ursim_core.bench_segmentation import bench_segmentation, print_table
+
+        if root is None:
+            print(f"segment: skipped ({MISSING_REASON})")
+        else:
+            print("== segmentation of the largest maps (median of repeats)")
+            print_table(bench_segmentation(root, repeats=repeats))
+    if what in ("scale", "all"):
+        from ursim_core.bench_segmentation import bench_scale, print_table
+
+        print("== segmentation scale (generated buildings)")
+        print_table(bench_scale())
+    if what in ("match", "all"):
+        from ursim_core.bench_matching import bench_kth, bench_scale as bench_match_scale, print_table as print_match
+
+        if root is None:
+            print(f"match: skipped ({MISSING_REASON})")
+        else:
+            print("== matching on the KTH sketches")
+            print_match(bench_kth(root))
+        print("== matching scale (generated graphs)")
+        print_match(bench_match_scale((300, 1000)))
+    return 0

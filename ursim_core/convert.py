@@ -1,0 +1,67 @@
+"""Conversion between the original annotators' ``.dat`` files and the JSON correspondence format."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from ursim_core.errors import ParameterError
+
+__all__ = ["convert"]
+
+_KINDS = {".dat": "dat", ".json": "json"}
+
+
+def _kind(path: Path) -> str:
+    try:
+        return _KINDS[path.suffix.lower()]
+    except KeyError:
+        raise ParameterError("unknown correspondence file type (expected .dat or .json)", path=path) from None
+
+
+def convert(source: Path, target: Path, *, sketch: str | Path | None = None, metric: str | Path | None = None,
+            tolerance: int = 10) -> None:
+    """Convert ``source`` (.dat or .json) to ``target`` (.json or .dat).
+
+    For ``.dat -> .json``, ``sketch`` and ``metric`` name the two maps: they are recorded in the JSON
+    (path, sha256, size) and, when given, both maps are segmented with the 'default' MAORIS preset
+    (the one the original annotators clicked on) so the cliques also carry region ids.
+
+    Examples
+    --------
+    >>> convert(Path("a.dat"), Path("a.txt"))
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: a.txt: unknown correspondence file type (expected .dat or .json)
+    """
+    from ursim_core.correspondences import (
+        MapRef,
+        assign_regions,
+        load_correspondences,
+        load_dat,
+        save_correspondences,
+        save_dat,
+    )
+
+    source_kind, target_kind = _kind(source), _kind(target)
+    corr = load_dat(source) if source_kind == "dat" else load_correspondences(source)
+    if target_kind == "dat":
+        save_dat(corr, target)
+        return
+    if (sketch is None) != (metric is None):
+        raise ParameterError("give both --sketch and --metric, or neither")
+    if sketch is not None and metric is not None:
+        from ursim_core.maps import load_map
+        from ursim_core.segmentation import segment
+
+        maps = {"sketch": load_map(sketch), "metric": load_map(metric)}
+        segs = {side: segment(m, preset="default") for side, m in maps.items()}
+        refs = {
+            side: MapRef(path=Path(m.path).resolve(), sha256=m.sha256, size=tuple(m.shape),
+                         segmentation_method=segs[side].method, segmentation_params=dict(segs[side].params),
+                         labels_path=None, extra={})
+            for side, m in maps.items()
+        }
+        corr = dataclasses.replace(corr, sketch=refs["sketch"], metric=refs["metric"])
+        corr = assign_regions(corr, segs["sketch"].labels, segs["metric"].labels, tolerance=tolerance)
+    save_correspondences(corr, target)

@@ -1,0 +1,284 @@
+"""Levenshtein alignment of two region sequences and its normalised distance.
+
+This is the edit distance the planar matcher uses to align the cyclic neighbour lists of two
+regions (Mielle et al. 2019, Algorithm 1; released code ``edit_distance_cpp``, see
+``original_code.md`` §1.11). Elements are compared through a boolean "same" relation, given as a
+callable or a matrix: in URSIM two regions are "the same" when their signature distance is
+``c <= m``.
+
+Costs: insertion 1, deletion 1, substitution 0 when the elements are the same and 1 otherwise.
+The operation string uses the released code's letters, read from the first elements to the last:
+
+``n``  the two elements are aligned and the same (no change),
+``s``  the two elements are aligned but differ (substitution),
+``d``  an element of ``first`` is skipped (deletion),
+``i``  an element of ``second`` is skipped (insertion).
+
+The backtrace starts at the bottom-right cell and prefers the diagonal when it is ``<=`` both the
+cell above and the cell to the left, then the left cell (``i``), then the cell above (``d``); on
+the first row it moves left, on the first column up.  Ties are therefore broken exactly as the
+released code does, which matters because the aligned pairs become matches.
+
+The normalised distance (Yujian and Bo 2007) reduces to ``d_N = 2 d / (|X| + |Y| + d)`` because
+every element is the same as itself; it lies in [0, 1], is 0 for two empty sequences and 1 when
+exactly one is empty.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "Alignment",
+    "levenshtein",
+    "normalised_distance",
+    "align",
+    "cyclic_align",
+    "aligned_pairs",
+]
+
+SameRelation = Callable[[object, object], bool]
+
+
+@dataclass(frozen=True)
+class Alignment:
+    """Result of aligning two sequences.
+
+    Attributes
+    ----------
+    distance : int
+        Levenshtein distance.
+    normalised : float
+        ``2 d / (|X| + |Y| + d)``, in [0, 1].
+    operations : str
+        Operation string over ``n``, ``s``, ``d``, ``i`` from the first elements to the last.
+    rotation : int
+        Offset of the rotation of the first sequence that was aligned (0 for a plain alignment).
+    reflected : bool
+        True when the first sequence was reversed before rotating.
+    first : tuple
+        The (rotated, possibly reversed) first sequence that ``operations`` refers to.
+    second : tuple
+        The second sequence.
+    """
+
+    distance: int
+    normalised: float
+    operations: str
+    rotation: int = 0
+    reflected: bool = False
+    first: tuple = ()
+    second: tuple = ()
+
+
+def _same_function(same) -> SameRelation:
+    if callable(same):
+        return same
+    matrix = same
+    return lambda a, b: bool(matrix[a][b])
+
+
+def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
+    """Levenshtein distance and the released code's backtrace.
+
+    Parameters
+    ----------
+    first, second : sequence
+        The sequences. When ``same`` is a matrix, their elements index its rows
+        (``first``) and columns (``second``).
+    same : callable or 2-D array-like of bool
+        ``same(a, b)`` or ``same[a][b]``: True when element ``a`` of ``first`` and
+        element ``b`` of ``second`` are equal (substitution cost 0).
+
+    Returns
+    -------
+    distance : int
+    operations : str
+        Letters ``n``, ``s``, ``d``, ``i`` (see the module docstring), first elements first.
+
+    Examples
+    --------
+    >>> levenshtein("kitten", "sitting", lambda a, b: a == b)
+    (3, 'snnnsni')
+    >>> levenshtein([0, 1], [1], [[False], [True]])
+    (1, 'dn')
+    """
+    is_same = _same_function(same)
+    rows, cols = len(first), len(second)
+    table = [[0] * (cols + 1) for _ in range(rows + 1)]
+    for i in range(rows + 1):
+        table[i][0] = i
+    for j in range(cols + 1):
+        table[0][j] = j
+    for i in range(1, rows + 1):
+        element = first[i - 1]
+        above, here = table[i - 1], table[i]
+        for j in range(1, cols + 1):
+            substitution = above[j - 1] + (0 if is_same(element, second[j - 1]) else 1)
+            here[j] = min(substitution, above[j] + 1, here[j - 1] + 1)
+    operations = []
+    i, j = rows, cols
+    while i > 0 or j > 0:
+        if i == 0:
+            operations.append("i")
+            j -= 1
+        elif j == 0:
+            operations.append("d")
+            i -= 1
+        else:
+            diagonal, up, left = table[i - 1][j - 1], table[i - 1][j], table[i][j - 1]
+            if diagonal <= up and diagonal <= left:
+                operations.append("n" if table[i][j] == diagonal else "s")
+                i -= 1
+                j -= 1
+            elif left <= up:
+                operations.append("i")
+                j -= 1
+            else:
+                operations.append("d")
+                i -= 1
+    return table[rows][cols], "".join(reversed(operations))
+
+
+def normalised_distance(distance: int, first_length: int, second_length: int) -> float:
+    """Normalised edit distance ``2 d / (|X| + |Y| + d)`` (0 for two empty sequences).
+
+    Examples
+    --------
+    >>> normalised_distance(3, 6, 7)
+    0.375
+    >>> normalised_distance(0, 0, 0), normalised_distance(2, 2, 0)
+    (0.0, 1.0)
+    """
+    denominator = first_length + second_length + distance
+    if denominator == 0:
+        return 0.0
+    return 2.0 * distance / denominator
+
+
+def align(first: Sequence, second: Sequence, same) -> Alignment:
+    """Align two sequences: Levenshtein distance, normalised distance and operations.
+
+    Examples
+    --------
+    >>> result = align("ab", "abc", lambda a, b: a == b)
+    >>> result.distance, round(result.normalised, 3), result.operations
+    (1, 0.333, 'nni')
+    """
+    distance, operations = levenshtein(first, second, same)
+    return Alignment(
+        distance=distance,
+        normalised=normalised_distance(distance, len(first), len(second)),
+        operations=operations,
+        first=tuple(first),
+        second=tuple(second),
+    )
+
+
+def cyclic_align(
+    first: Sequence,
+    second: Sequence,
+    same,
+    *,
+    rotation_search: str = "min",
+    reflections: bool = False,
+) -> Alignment:
+    """Align a cyclic sequence with another by trying rotations of the first.
+
+    Parameters
+    ----------
+    first : sequence
+        Cyclic sequence that is rotated (the sketch region's neighbours in the matcher).
+    second : sequence
+        Sequence kept as is (the metric region's neighbours).
+    same : callable or 2-D array-like of bool
+        Equality relation, see :func:`levenshtein`.
+    rotation_search : {'min', 'first'}
+        ``'min'`` keeps the rotation with the lowest normalised distance (ties: the
+        smallest offset, non-reflected before reflected). ``'first'`` reproduces the
+        released code, whose integer truncation of the best distance means the
+        rotation at offset 0 is always kept (original_code.md §1.10).
+    reflections : bool
+        Also try the rotations of the reversed first sequence (mirror-image sketches).
+        Ignored by ``rotation_search='first'``.
+
+    Returns
+    -------
+    Alignment
+        With ``rotation`` and ``reflected`` telling which version of ``first`` was used.
+
+    Examples
+    --------
+    >>> same = lambda a, b: a == b
+    >>> cyclic_align("bca", "abc", same).rotation
+    2
+    >>> cyclic_align("bca", "abc", same, rotation_search="first").operations
+    'dnni'
+    >>> cyclic_align("cba", "abc", same, reflections=True).reflected
+    True
+    """
+    if rotation_search not in ("min", "first"):
+        raise ValueError(f"rotation_search must be 'min' or 'first', not {rotation_search!r}")
+    sequence = list(first)
+    if rotation_search == "first" or len(sequence) <= 1:
+        return align(sequence, second, same)
+    candidates = [(False, sequence)]
+    if reflections:
+        candidates.append((True, sequence[::-1]))
+    best = None
+    for reflected, base in candidates:
+        for offset in range(len(base)):
+            rotated = base[offset:] + base[:offset]
+            result = align(rotated, second, same)
+            if best is None or result.normalised < best.normalised:
+                best = Alignment(
+                    distance=result.distance,
+                    normalised=result.normalised,
+                    operations=result.operations,
+                    rotation=offset,
+                    reflected=reflected,
+                    first=result.first,
+                    second=result.second,
+                )
+                if best.distance == 0:
+                    return best
+    return best
+
+
+def aligned_pairs(alignment: Alignment) -> list[tuple]:
+    """Pairs of elements that the operations align (``n`` and ``s`` both count).
+
+    The released code turns every aligned position into a match, whether the two
+    elements were the same (``n``) or substituted (``s``).
+
+    Examples
+    --------
+    >>> aligned_pairs(align("abc", "axc", lambda a, b: a == b))
+    [('a', 'a'), ('b', 'x'), ('c', 'c')]
+    """
+    pairs = []
+    i = j = 0
+    for operation in alignment.operations:
+        if operation in "ns":
+            pairs.append((alignment.first[i], alignment.second[j]))
+            i += 1
+            j += 1
+        elif operation == "d":
+            i += 1
+        else:
+            j += 1
+    return pairs
+
+
+def same_matrix(c_matrix: np.ndarray, m: float) -> list[list[bool]]:
+    """Boolean "same" relation ``c <= m`` as nested lists (fast indexing in the matcher).
+
+    Examples
+    --------
+    >>> same_matrix(np.array([[0.0, 0.3]]), 0.1)
+    [[True, False]]
+    """
+    return (np.asarray(c_matrix) <= m).tolist()

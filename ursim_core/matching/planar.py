@@ -1,0 +1,309 @@
+"""Planar seed-and-expand graph matching (Mielle et al. 2019, Algorithm 1).
+
+The algorithm follows the released code (``original_code.md`` §1.10 and §1.12) step by step:
+
+1. Every seed pair (sketch region, metric region) becomes a one-pair hypothesis first.
+2. Seeds are then taken in order. For a seed ``(s, s')`` the cyclic neighbour lists of ``s`` and
+   ``s'`` are aligned by normalised edit distance over rotations of the sketch list
+   (:func:`~ursim_core.matching.edit_distance.cyclic_align`; ``rotation_search="first"`` reproduces
+   the released integer-truncation bug that always keeps offset 0). Every aligned pair (``n`` *and*
+   ``s`` operations) is queued and marked seen; a seed that equals a queued pair is consumed.
+3. Queued pairs are popped in FIFO order and appended to the hypothesis. For a popped ``(v, v')``
+   the neighbours of ``v`` already matched in the hypothesis to neighbours of ``v'`` are *locks*;
+   consecutive locks (in ``v``'s cyclic order) cut both neighbour lists into arcs (elements
+   strictly between the two locks, walking forward; with one lock, all the other neighbours after
+   it), each pair of arcs is aligned by edit distance, and every aligned pair whose two regions are
+   both unseen is queued (consuming the identical seed if there is one). No lock, no expansion.
+4. A hypothesis' cost is
+   ``(#unmatched in G1 + #unmatched in G2) + (#edges of G1 with an unmatched end + same in G2)
+   + |#edges among matched in G1 - #edges among matched in G2|``.
+   The best hypothesis is the one with the lowest cost; ties go to the earliest one (the
+   one-pair hypotheses in seed order come first, then expansions in seed order).
+
+Neighbour order: the released code sorts a region's neighbours by the angle
+``atan2(n - v) - atan2(first - v)`` in [0, 2 pi) of the region centroids in image coordinates
+(rows down, so the order is clockwise on screen), where ``first`` is the first boost out-edge
+(edge insertion order, which depends on MAORIS internals). Here ``first`` is the neighbour with
+the smallest region id, which is deterministic; only the ``rotation_search="first"`` mode depends
+on that choice. Ties in angle keep region-id order.
+
+Reflections (``reflections=True``, not in the released code) also try the mirrored sketch list
+at the seed; a hypothesis seeded with a mirrored alignment walks every sketch neighbour list
+backwards during expansion, so mirror-drawn sketches expand consistently.
+
+Complexity: seeds are all pairs with ``c <= m`` (up to ``n1 * n2``); each expansion costs
+O(k * d^2) for a hypothesis of k pairs and degree d, so the worst case is O(n1 n2 k d^2).
+Consumed seeds are skipped, which in practice removes most of them on consistent graphs.
+:func:`planar_match` takes the seed list from the caller, which may cap it for large graphs
+(see ``ursim_core.matching.MatchConfig.max_seeds``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import networkx as nx
+
+from .edit_distance import aligned_pairs, align, cyclic_align
+
+__all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
+
+
+@dataclass(frozen=True, eq=False)
+class PlanarGraph:
+    """Index form of a region graph for the matcher.
+
+    Attributes
+    ----------
+    nodes : list
+        Region ids; index ``i`` stands for ``nodes[i]``.
+    neighbours : list of list of int
+        Cyclic neighbour order of each vertex (indices).
+    edges : list of (int, int)
+        Undirected edges as index pairs, each once.
+    """
+
+    nodes: list
+    neighbours: list
+    edges: list
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.nodes)
+
+
+@dataclass(frozen=True)
+class PlanarResult:
+    """Outcome of :func:`planar_match`.
+
+    Attributes
+    ----------
+    pairs : list of (int, int)
+        Best hypothesis as index pairs (sketch index, metric index), in expansion order.
+    cost : float
+        Its cost (see the module docstring); ``inf`` when there was no seed.
+    hypotheses : int
+        Number of hypotheses scored (one-pair ones included).
+    seeds_expanded : int
+        Seeds that started an expansion (the others were consumed by earlier ones).
+    """
+
+    pairs: list
+    cost: float
+    hypotheses: int
+    seeds_expanded: int
+
+
+def cyclic_neighbours(graph: nx.Graph, nodes: Sequence) -> list[list[int]]:
+    """Neighbours of every vertex in angular order around its centroid.
+
+    Parameters
+    ----------
+    graph : networkx.Graph
+        Nodes carry ``centroid`` = (row, col).
+    nodes : sequence
+        Index order of the vertices.
+
+    Returns
+    -------
+    list of list of int
+        For vertex i, indices of its neighbours sorted by the angle relative to the
+        neighbour with the smallest region id (see the module docstring).
+
+    Examples
+    --------
+    >>> g = nx.Graph()
+    >>> g.add_node(0, centroid=(0.0, 0.0)); g.add_node(1, centroid=(0.0, 1.0))
+    >>> g.add_node(2, centroid=(1.0, 0.0)); g.add_node(3, centroid=(-1.0, 0.0))
+    >>> g.add_edges_from([(0, 1), (0, 2), (0, 3)])
+    >>> cyclic_neighbours(g, [0, 1, 2, 3])[0]
+    [1, 2, 3]
+    """
+    index = {node: i for i, node in enumerate(nodes)}
+    orders = []
+    for node in nodes:
+        adjacent = sorted((n for n in graph.neighbors(node) if n != node), key=lambda n: index[n])
+        if len(adjacent) <= 1:
+            orders.append([index[n] for n in adjacent])
+            continue
+        row, col = graph.nodes[node]["centroid"]
+
+        def direction(other):
+            other_row, other_col = graph.nodes[other]["centroid"]
+            return math.atan2(other_row - row, other_col - col)
+
+        reference = direction(adjacent[0])
+        angles = [(direction(n) - reference) % (2.0 * math.pi) for n in adjacent]
+        ordered = sorted(range(len(adjacent)), key=lambda k: angles[k])
+        orders.append([index[adjacent[k]] for k in ordered])
+    return orders
+
+
+def planar_graph(graph: nx.Graph, *, nodes: Sequence | None = None) -> PlanarGraph:
+    """Build the :class:`PlanarGraph` of a region graph (nodes in ascending id order by default).
+
+    Examples
+    --------
+    >>> g = nx.path_graph(3); nx.set_node_attributes(g, {0: (0, 0), 1: (0, 5), 2: (0, 9)}, "centroid")
+    >>> p = planar_graph(g)
+    >>> p.neighbours, p.edges
+    ([[1], [0, 2], [1]], [(0, 1), (1, 2)])
+    """
+    nodes = sorted(graph.nodes) if nodes is None else list(nodes)
+    index = {node: i for i, node in enumerate(nodes)}
+    edges = sorted({(min(index[a], index[b]), max(index[a], index[b])) for a, b in graph.edges() if a != b})
+    return PlanarGraph(nodes=nodes, neighbours=cyclic_neighbours(graph, nodes), edges=edges)
+
+
+def hypothesis_cost(first: PlanarGraph, second: PlanarGraph, pairs: Sequence[tuple[int, int]]) -> int:
+    """Released-code cost of a hypothesis (original_code.md §1.12).
+
+    Examples
+    --------
+    >>> g = planar_graph(nx.relabel_nodes(nx.path_graph(3), {}, copy=True).copy()) if False else None
+    >>> p = PlanarGraph(nodes=[0, 1, 2], neighbours=[[1], [0, 2], [1]], edges=[(0, 1), (1, 2)])
+    >>> hypothesis_cost(p, p, [(0, 0), (1, 1), (2, 2)]), hypothesis_cost(p, p, [(0, 0)])
+    (0, 6)
+    """
+    matched_first = {a for a, _ in pairs}
+    matched_second = {b for _, b in pairs}
+    inner_first = sum(1 for a, b in first.edges if a in matched_first and b in matched_first)
+    inner_second = sum(1 for a, b in second.edges if a in matched_second and b in matched_second)
+    return (
+        (first.n_vertices - len(matched_first)) + (second.n_vertices - len(matched_second))
+        + (len(first.edges) - inner_first) + (len(second.edges) - inner_second)
+        + abs(inner_first - inner_second)
+    )
+
+
+def _arc(order: list[int], start: int, stop: int) -> list[int]:
+    """Elements strictly between positions ``start`` and ``stop`` walking forward (cyclic).
+
+    ``start == stop`` gives every other element, starting after ``start``.
+    """
+    size = len(order)
+    elements = []
+    position = (start + 1) % size
+    while position != stop:
+        elements.append(order[position])
+        position = (position + 1) % size
+    return elements
+
+
+def _expand_locked(first_order, second_order, matched, second_set, same):
+    """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs."""
+    positions_second = {vertex: k for k, vertex in enumerate(second_order)}
+    locks = []  # (position in first_order, position in second_order), in first_order order
+    for k, vertex in enumerate(first_order):
+        partner = matched.get(vertex)
+        if partner is not None and partner in second_set:
+            locks.append((k, positions_second[partner]))
+    if not locks:
+        return []
+    candidates = []
+    for index, (first_position, second_position) in enumerate(locks):
+        next_first, next_second = locks[(index + 1) % len(locks)]
+        first_arc = _arc(first_order, first_position, next_first)
+        second_arc = _arc(second_order, second_position, next_second)
+        if first_arc and second_arc:
+            candidates.extend(aligned_pairs(align(first_arc, second_arc, same)))
+    return candidates
+
+
+def planar_match(
+    first: PlanarGraph,
+    second: PlanarGraph,
+    same: Sequence[Sequence[bool]],
+    *,
+    seeds: Sequence[tuple[int, int]] | None = None,
+    rotation_search: str = "min",
+    reflections: bool = False,
+) -> PlanarResult:
+    """Algorithm 1: seed-and-expand planar matching of two region graphs.
+
+    Parameters
+    ----------
+    first, second : PlanarGraph
+        Sketch and metric graphs (index form, see :func:`planar_graph`).
+    same : 2-D sequence of bool
+        ``same[i][j]`` is True when sketch vertex i and metric vertex j compare equal
+        (``c <= m``).
+    seeds : sequence of (int, int), optional
+        Seed pairs in processing order. Default: every pair with ``same[i][j]``,
+        sketch index outer loop, metric index inner loop (as the released code).
+    rotation_search : {'min', 'first'}
+        See :func:`~ursim_core.matching.edit_distance.cyclic_align`.
+    reflections : bool
+        Also try mirrored neighbour orders at the seed.
+
+    Returns
+    -------
+    PlanarResult
+
+    Examples
+    --------
+    >>> p = PlanarGraph(nodes=[0, 1, 2], neighbours=[[1], [0, 2], [1]], edges=[(0, 1), (1, 2)])
+    >>> same = [[True, False, True], [False, True, False], [True, False, True]]
+    >>> result = planar_match(p, p, same)
+    >>> sorted(result.pairs), result.cost
+    ([(0, 0), (1, 1), (2, 2)], 0)
+    """
+    if seeds is None:
+        seeds = [(i, j) for i in range(first.n_vertices) for j in range(second.n_vertices) if same[i][j]]
+    else:
+        seeds = list(seeds)
+    if not seeds:
+        return PlanarResult(pairs=[], cost=math.inf, hypotheses=0, seeds_expanded=0)
+    n_first, n_second = first.n_vertices, second.n_vertices
+    edges_first, edges_second = len(first.edges), len(second.edges)
+    # Every one-pair hypothesis has the same cost; as they come first, the first seed wins among them.
+    best_pairs = [seeds[0]]
+    best_cost = (n_first - 1) + (n_second - 1) + edges_first + edges_second
+    hypotheses = len(seeds)
+    consumed = set()
+    seeds_expanded = 0
+    first_sets = [set(order) for order in first.neighbours]
+    second_sets = [set(order) for order in second.neighbours]
+    reversed_first = [order[::-1] for order in first.neighbours]
+    for seed in seeds:
+        if seed in consumed:
+            continue
+        consumed.add(seed)
+        seeds_expanded += 1
+        seed_first, seed_second = seed
+        alignment = cyclic_align(first.neighbours[seed_first], second.neighbours[seed_second], same,
+                                 rotation_search=rotation_search, reflections=reflections)
+        first_orders = reversed_first if alignment.reflected else first.neighbours
+        seen_first = {seed_first}
+        seen_second = {seed_second}
+        queue = deque()
+        for pair in aligned_pairs(alignment):
+            queue.append(pair)
+            seen_first.add(pair[0])
+            seen_second.add(pair[1])
+            consumed.add(pair)
+        matched = {seed_first: seed_second}
+        pairs = [seed]
+        while queue:
+            vertex, partner = queue.popleft()
+            pairs.append((vertex, partner))
+            matched[vertex] = partner
+            for a, b in _expand_locked(first_orders[vertex], second.neighbours[partner], matched,
+                                       second_sets[partner], same):
+                if a not in seen_first and b not in seen_second:
+                    queue.append((a, b))
+                    seen_first.add(a)
+                    seen_second.add(b)
+                    consumed.add((a, b))
+        hypotheses += 1
+        inner_first = sum(1 for v in matched for n in first_sets[v] if n in matched) // 2
+        matched_second = set(matched.values())
+        inner_second = sum(1 for v in matched_second for n in second_sets[v] if n in matched_second) // 2
+        cost = ((n_first - len(pairs)) + (n_second - len(pairs)) + (edges_first - inner_first)
+                + (edges_second - inner_second) + abs(inner_first - inner_second))
+        if cost < best_cost:
+            best_cost, best_pairs = cost, pairs
+    return PlanarResult(pairs=best_pairs, cost=best_cost, hypotheses=hypotheses, seeds_expanded=seeds_expanded)

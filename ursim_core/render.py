@@ -1,0 +1,187 @@
+"""Pictures for the command line: segmentation overlays and side-by-side match figures.
+
+All functions return RGB uint8 arrays (rows, cols, 3); :func:`save_png` writes them atomically.
+"""
+
+from __future__ import annotations
+
+import colorsys
+from pathlib import Path
+from typing import Iterable, Sequence
+
+import cv2
+import networkx as nx
+import numpy as np
+
+from ursim_core.atomic import atomic_write_bytes
+from ursim_core.errors import UrsimError
+
+__all__ = ["distinct_colors", "label_colors", "overlay_segmentation", "side_by_side_matches", "save_png"]
+
+_GOLDEN = 0.618033988749895
+
+
+def distinct_colors(n: int, *, saturation: float = 0.65, value: float = 0.95) -> np.ndarray:
+    """``n`` well-separated RGB colours (golden-ratio hue steps), uint8, shape (n, 3).
+
+    The k-th colour never changes when ``n`` grows, so region k keeps its colour.
+
+    Examples
+    --------
+    >>> distinct_colors(3).shape
+    (3, 3)
+    >>> bool((distinct_colors(5)[:3] == distinct_colors(3)).all())
+    True
+    """
+    hues = (np.arange(n) * _GOLDEN) % 1.0
+    return np.array(
+        [[round(255 * c) for c in colorsys.hsv_to_rgb(h, saturation, value)] for h in hues], dtype=np.uint8
+    ).reshape(n, 3)
+
+
+def label_colors(labels: np.ndarray, colors: dict[int, Sequence[int]] | None = None) -> np.ndarray:
+    """Lookup table mapping every label value to an RGB colour (index 0 = black).
+
+    Parameters
+    ----------
+    labels : ndarray of int
+        Label image.
+    colors : dict, optional
+        Fixed colours for some labels; the others get :func:`distinct_colors`.
+    """
+    n = int(labels.max()) + 1 if labels.size else 1
+    table = np.zeros((n, 3), np.uint8)
+    table[1:] = distinct_colors(n - 1)
+    for label, color in (colors or {}).items():
+        if 0 < label < n:
+            table[label] = color
+    return table
+
+
+def _base_image(image: np.ndarray | None, free: np.ndarray | None, shape: tuple[int, int]) -> np.ndarray:
+    if image is not None:
+        grey = np.asarray(image, np.uint8)
+    elif free is not None:
+        grey = np.where(free, 255, 0).astype(np.uint8)
+    else:
+        grey = np.full(shape, 255, np.uint8)
+    return np.repeat(grey[..., None], 3, axis=2)
+
+
+def _put_label(canvas: np.ndarray, text: str, row: float, col: float, scale: float) -> None:
+    font = cv2.FONT_HERSHEY_SIMPLEX
+    thickness = max(1, int(round(scale * 2)))
+    (width, height), _ = cv2.getTextSize(text, font, scale, thickness)
+    origin = (int(col - width / 2), int(row + height / 2))
+    cv2.putText(canvas, text, origin, font, scale, (255, 255, 255), thickness + 2, cv2.LINE_AA)
+    cv2.putText(canvas, text, origin, font, scale, (0, 0, 0), thickness, cv2.LINE_AA)
+
+
+def overlay_segmentation(
+    labels: np.ndarray,
+    graph: nx.Graph,
+    *,
+    image: np.ndarray | None = None,
+    free: np.ndarray | None = None,
+    opacity: float = 0.55,
+    colors: dict[int, Sequence[int]] | None = None,
+    show_ids: bool = True,
+    show_edges: bool = True,
+    marked: Iterable[int] = (),
+) -> np.ndarray:
+    """Draw regions in colour over the map, with region ids and adjacency edges.
+
+    Parameters
+    ----------
+    labels : ndarray of int, shape (rows, cols)
+    graph : networkx.Graph
+        Region graph with node attribute ``interior`` (row, col).
+    image, free : ndarray, optional
+        The map's grey image (preferred) or free mask, drawn underneath.
+    opacity : float
+        Region colour opacity in [0, 1].
+    colors : dict, optional
+        Fixed colours per region (e.g. matched pairs sharing a colour).
+    marked : iterable of int
+        Regions drawn with a thick ring (anchors).
+
+    Examples
+    --------
+    >>> labels = np.zeros((20, 30), np.int32); labels[2:18, 2:14] = 1; labels[2:18, 14:28] = 2
+    >>> from ursim_core.graph import region_graph
+    >>> overlay_segmentation(labels, region_graph(labels)).shape
+    (20, 30, 3)
+    """
+    labels = np.asarray(labels)
+    canvas = _base_image(image, free, labels.shape).astype(np.float32)
+    table = label_colors(labels, colors).astype(np.float32)
+    inside = labels > 0
+    canvas[inside] = (1 - opacity) * canvas[inside] + opacity * table[labels[inside]]
+    canvas = canvas.astype(np.uint8)
+    outline = inside & (cv2.morphologyEx(labels.astype(np.float32), cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8)) > 0)
+    canvas[outline] = (40, 40, 40)
+    scale = max(0.35, min(labels.shape) / 700)
+    if show_edges:
+        for a, b in graph.edges:
+            ra, ca = graph.nodes[a]["interior"]
+            rb, cb = graph.nodes[b]["interior"]
+            cv2.line(canvas, (int(ca), int(ra)), (int(cb), int(rb)), (30, 30, 30), max(1, int(scale * 2)), cv2.LINE_AA)
+    for region in marked:
+        if region in graph:
+            row, col = graph.nodes[region]["interior"]
+            cv2.circle(canvas, (int(col), int(row)), int(14 * scale + 6), (220, 20, 60), max(2, int(scale * 3)), cv2.LINE_AA)
+    if show_ids:
+        for region, (row, col) in graph.nodes(data="interior"):
+            _put_label(canvas, str(region), row, col, scale)
+    return canvas
+
+
+def side_by_side_matches(
+    sketch: tuple[np.ndarray, nx.Graph, np.ndarray | None],
+    metric: tuple[np.ndarray, nx.Graph, np.ndarray | None],
+    pairs: Sequence[tuple[int, int]],
+    *,
+    anchors: Sequence[tuple[int, int]] = (),
+    gap: int = 24,
+) -> np.ndarray:
+    """Both maps side by side, matched regions sharing a colour, connector lines, anchors ringed.
+
+    ``sketch`` and ``metric`` are ``(labels, graph, grey_image_or_None)``. The metric map is
+    scaled to the sketch's height so both read at a similar size.
+    """
+    pair_colors = distinct_colors(max(len(pairs), 1))
+    grey = np.array((205, 205, 205), np.uint8)
+    sketch_colors = {r: grey for r in sketch[1].nodes}
+    metric_colors = {r: grey for r in metric[1].nodes}
+    for index, (s, m) in enumerate(pairs):
+        sketch_colors[s] = pair_colors[index]
+        metric_colors[m] = pair_colors[index]
+    left = overlay_segmentation(sketch[0], sketch[1], image=sketch[2], colors=sketch_colors, show_edges=False,
+                                marked=[a for a, _ in anchors], opacity=0.7)
+    right = overlay_segmentation(metric[0], metric[1], image=metric[2], colors=metric_colors, show_edges=False,
+                                 marked=[b for _, b in anchors], opacity=0.7)
+    scale = left.shape[0] / right.shape[0]
+    right = cv2.resize(right, (max(1, round(right.shape[1] * scale)), left.shape[0]), interpolation=cv2.INTER_NEAREST)
+    canvas = np.full((left.shape[0], left.shape[1] + gap + right.shape[1], 3), 255, np.uint8)
+    canvas[:, : left.shape[1]] = left
+    offset = left.shape[1] + gap
+    canvas[:, offset:] = right
+    for index, (s, m) in enumerate(pairs):
+        if s not in sketch[1] or m not in metric[1]:
+            continue
+        rs, cs = sketch[1].nodes[s]["interior"]
+        rm, cm = metric[1].nodes[m]["interior"]
+        color = tuple(int(v) for v in pair_colors[index])
+        cv2.line(canvas, (int(cs), int(rs)), (int(offset + cm * scale), int(rm * scale)), color, 2, cv2.LINE_AA)
+    return canvas
+
+
+def save_png(path: str | Path, rgb: np.ndarray) -> None:
+    """Write an RGB (or grey) uint8 image as PNG, atomically."""
+    array = np.asarray(rgb)
+    if array.ndim == 3:
+        array = cv2.cvtColor(array, cv2.COLOR_RGB2BGR)
+    ok, encoded = cv2.imencode(".png", array)
+    if not ok:
+        raise UrsimError("could not encode PNG", path=path)
+    atomic_write_bytes(Path(path), encoded.tobytes())

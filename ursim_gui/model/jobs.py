@@ -1,0 +1,140 @@
+"""Long computations (segmentation, matching) packaged for a worker thread.
+
+A job holds its inputs and has one method, ``run(progress, cancelled)``. It never
+touches the session or any widget: ``ursim_gui/workers.py`` runs it in a Qt thread
+and hands the result back to the GUI thread, which calls
+``AnnotationSession.set_segmentation`` or ``apply_match``. Keeping the jobs free of
+Qt means they are tested like plain functions.
+
+The core functions are single calls without progress hooks, so a job reports
+progress and checks for cancellation *between* its steps; a cancel request made
+during the long step takes effect as soon as that step returns, and the result
+is then discarded instead of being applied.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+__all__ = ["JobCancelled", "SegmentJob", "MatchJob", "ProgressCallback", "CancelledCallback"]
+
+#: ``progress(fraction, message)`` with ``fraction`` in [0, 1].
+ProgressCallback = Callable[[float, str], None]
+#: ``cancelled() -> bool``, polled between steps.
+CancelledCallback = Callable[[], bool]
+
+
+class JobCancelled(Exception):
+    """Raised by ``run`` when ``cancelled()`` returned True between two steps."""
+
+
+def _check(cancelled: CancelledCallback, what: str) -> None:
+    if cancelled():
+        raise JobCancelled(f"{what} cancelled")
+
+
+class SegmentJob:
+    """Segment one map into regions.
+
+    Parameters
+    ----------
+    map : ursim_core.maps.Map or ndarray of bool
+        The map (or its free-space mask).
+    preset : str or None
+        Preset name of the method ('sketch', 'robot', ...).
+    params : dict, optional
+        Single-parameter overrides of the preset.
+    method : str, optional
+        A key of ``ursim_core.segmentation.SEGMENTERS``.
+    side : str, optional
+        'sketch' or 'metric': carried along so the code receiving the result knows
+        where it belongs (the job itself does not use it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> free = np.zeros((60, 130), bool)
+    >>> free[5:55, 5:60] = True; free[5:55, 70:125] = True; free[27:33, 60:70] = True
+    >>> seg = SegmentJob(free, "default", None).run(lambda f, m: None, lambda: False)
+    >>> seg.n_regions
+    2
+    """
+
+    def __init__(self, map: Any, preset: str | None, params: dict[str, Any] | None = None, *, method: str = "maoris", side: str | None = None) -> None:
+        self.map = map
+        self.preset = preset
+        self.params = dict(params or {})
+        self.method = method
+        self.side = side
+
+    @property
+    def description(self) -> str:
+        """Human-readable name for a status bar ('Segmenting sketch (preset sketch)')."""
+        what = f"Segmenting {self.side}" if self.side else "Segmenting"
+        return f"{what} (preset {self.preset})" if self.preset else what
+
+    def run(self, progress: ProgressCallback, cancelled: CancelledCallback) -> Any:
+        """Return the ``ursim_core.segmentation.Segmentation``.
+
+        Raises
+        ------
+        JobCancelled
+            When ``cancelled()`` is True before or after the segmentation step.
+        ursim_core.errors.UrsimError
+            For an unknown method, preset or parameter (checked before the long step).
+        """
+        from ursim_core.segmentation import resolve_params, segment
+
+        progress(0.0, "checking parameters")
+        _check(cancelled, "segmentation")
+        # Fail fast on a bad parameter instead of after a long computation.
+        resolve_params(self.method, self.preset, self.params)
+        _check(cancelled, "segmentation")
+        progress(0.05, "segmenting")
+        segmentation = segment(self.map, method=self.method, preset=self.preset, params=self.params)
+        _check(cancelled, "segmentation")
+        progress(1.0, f"{segmentation.n_regions} regions")
+        return segmentation
+
+
+class MatchJob:
+    """Match a sketch segmentation to a metric segmentation.
+
+    Parameters
+    ----------
+    sketch_seg, metric_seg : ursim_core.segmentation.Segmentation
+        The two segmented maps.
+    config : ursim_core.matching.MatchConfig, optional
+        Matching parameters; the core's defaults when None.
+    """
+
+    def __init__(self, sketch_seg: Any, metric_seg: Any, config: Any = None) -> None:
+        self.sketch_seg = sketch_seg
+        self.metric_seg = metric_seg
+        self.config = config
+
+    @property
+    def description(self) -> str:
+        return "Matching sketch to metric map"
+
+    def run(self, progress: ProgressCallback, cancelled: CancelledCallback) -> Any:
+        """Return the ``ursim_core.matching.MatchResult``.
+
+        Raises
+        ------
+        JobCancelled
+            When ``cancelled()`` is True before or after the matching step.
+        """
+        # Imported here: matching pulls in the heavy descriptor code, and the model
+        # package must stay cheap to import (and importable while it is absent).
+        from ursim_core.matching import MatchConfig, match
+
+        progress(0.0, "preparing")
+        _check(cancelled, "matching")
+        config = self.config if self.config is not None else MatchConfig()
+        progress(0.05, "matching")
+        result = match(self.sketch_seg, self.metric_seg, config=config)
+        _check(cancelled, "matching")
+        progress(1.0, f"{len(result.pairs)} pairs")
+        return result
