@@ -206,9 +206,28 @@ def _match_config(args: argparse.Namespace):
     return base.replace(**overrides) if hasattr(base, "replace") else type(base)(**{**base.__dict__, **overrides})
 
 
+def _matcher_record(config, result) -> dict[str, Any]:
+    """What produced the automatic cliques, JSON-safe (kept in the file as an unknown key)."""
+    import dataclasses
+    import math
+
+    def safe(value: Any) -> Any:
+        if isinstance(value, float) and not math.isfinite(value):
+            return None
+        return value
+
+    settings = dataclasses.asdict(config) if dataclasses.is_dataclass(config) else {}
+    return {
+        "config": json.loads(json.dumps(settings, default=str)),
+        "m": safe(float(result.m)) if result.m is not None else None,
+        "cost": safe(float(result.cost)) if result.cost is not None else None,
+        "anchors": [[int(a), int(b)] for a, b in result.anchors],
+        "reason": result.reason or "",
+    }
+
+
 def cmd_match(args: argparse.Namespace) -> int:
-    from ursim_core.atomic import atomic_write_text  # noqa: F401  (fail early if the package is broken)
-    from ursim_core.correspondences import MapRef, from_pairs, save_correspondences
+    from ursim_core.correspondences import Correspondences, MapRef, from_pairs, save_correspondences
     from ursim_core.matching import match
     from ursim_core.render import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image, segment
@@ -237,17 +256,17 @@ def cmd_match(args: argparse.Namespace) -> int:
             extra={},
         )
 
-    corr = from_pairs(
+    cliques = from_pairs(
         result.pairs,
         sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
         metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
         source="auto",
-        scores=[float(c) for c in getattr(result, "pair_costs", [])] or None,
+    )
+    corr = Correspondences(
         sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
         metric=ref(metric_map, metric_seg, "metric.labels.png"),
-        extra={"matcher": {"config": config.to_dict() if hasattr(config, "to_dict") else str(config),
-                           "m": result.m, "cost": result.cost, "anchors": [list(a) for a in result.anchors],
-                           "reason": result.reason}},
+        cliques=cliques,
+        extra={"matcher": _matcher_record(config, result)},
     )
     save_correspondences(corr, out / "correspondences.json")
     figure = side_by_side_matches(

@@ -6,8 +6,6 @@ interaction and layer bookkeeping.
 
 from __future__ import annotations
 
-import sys
-
 import cv2
 import numpy as np
 from PySide6.QtCore import QPointF, QRect, QRectF, Qt
@@ -16,7 +14,7 @@ from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem
 
 from ursim_gui.overlay import region_mask
 
-__all__ = ["ImageItem", "LabelItem", "rgba_to_qimage", "grey_to_qimage", "region_outline_path"]
+__all__ = ["ImageItem", "LabelItem", "grey_to_qimage", "pack_premultiplied", "argb_qimage", "lut_qimage", "mask_qimage", "region_outline_path"]
 
 
 def grey_to_qimage(grey: np.ndarray) -> tuple[QImage, np.ndarray]:
@@ -26,43 +24,41 @@ def grey_to_qimage(grey: np.ndarray) -> tuple[QImage, np.ndarray]:
     return QImage(grey.data, cols, rows, grey.strides[0], QImage.Format.Format_Grayscale8), grey
 
 
-def rgba_to_qimage(rgba: np.ndarray) -> tuple[QImage, np.ndarray]:
-    """A premultiplied QImage over an RGBA ``uint8`` array, without a copy by Qt.
+def pack_premultiplied(table: np.ndarray) -> np.ndarray:
+    """RGBA ``uint8`` rows -> premultiplied ``0xAARRGGBB`` ``uint32`` values.
 
-    The raster engine draws ``ARGB32_Premultiplied`` without conversion, which is
-    byte order B, G, R, A on little-endian machines; the array is converted to that
-    layout here (one vectorised pass) and returned so the caller keeps it alive.
+    That is the pixel value of ``QImage.Format_ARGB32_Premultiplied`` on every
+    endianness, the format the raster engine draws without conversion; doing the
+    premultiplication on a (small) lookup table keeps an overlay at one gather.
     """
-    rgba = np.asarray(rgba, dtype=np.uint8)
-    alpha = rgba[..., 3:4].astype(np.uint16)
-    premultiplied = np.empty_like(rgba)
-    premultiplied[..., :3] = (rgba[..., :3] * alpha + 127) // 255
-    premultiplied[..., 3] = rgba[..., 3]
-    if sys.byteorder == "little":
-        premultiplied[..., :3] = premultiplied[..., 2::-1].copy()
-        fmt = QImage.Format.Format_ARGB32_Premultiplied
-    else:
-        fmt = QImage.Format.Format_RGBA8888_Premultiplied
-    premultiplied = np.ascontiguousarray(premultiplied)
-    rows, cols = premultiplied.shape[:2]
-    return QImage(premultiplied.data, cols, rows, premultiplied.strides[0], fmt), premultiplied
+    table = np.asarray(table, dtype=np.uint32).reshape(-1, 4)
+    alpha = table[:, 3]
+    rgb = (table[:, :3] * alpha[:, None] + 127) // 255
+    return (alpha << 24) | (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
 
 
-def premultiplied_table(table: np.ndarray) -> np.ndarray:
-    """Convert an RGBA lookup table to the byte layout of :func:`rgba_to_qimage`.
+def argb_qimage(pixels: np.ndarray) -> tuple[QImage, np.ndarray]:
+    """A QImage over a ``uint32`` array of premultiplied ``0xAARRGGBB`` pixels (no copy)."""
+    pixels = np.ascontiguousarray(pixels, dtype=np.uint32)
+    rows, cols = pixels.shape
+    return QImage(pixels.data, cols, rows, pixels.strides[0], QImage.Format.Format_ARGB32_Premultiplied), pixels
 
-    Doing the premultiplication on the (small) table instead of the image keeps the
-    overlay at one indexing pass: ``premultiplied_table(t)[labels]`` is ready to draw.
+
+def lut_qimage(labels: np.ndarray, table: np.ndarray) -> tuple[QImage, np.ndarray]:
+    """QImage of a label image coloured by an RGBA lookup table: one ``uint32`` gather.
+
+    Labels beyond the table are drawn transparent.
     """
-    return rgba_to_qimage(table[np.newaxis])[1][0]
+    packed = pack_premultiplied(table)
+    if labels.size and int(labels.max()) >= len(packed):
+        packed = np.concatenate([packed, np.zeros(int(labels.max()) + 1 - len(packed), np.uint32)])
+    return argb_qimage(packed[labels])
 
 
-def table_to_qimage(table_bytes: np.ndarray, labels: np.ndarray) -> tuple[QImage, np.ndarray]:
-    """QImage of ``table_bytes[labels]`` where the table is already premultiplied."""
-    pixels = np.ascontiguousarray(table_bytes[labels])
-    rows, cols = pixels.shape[:2]
-    fmt = QImage.Format.Format_ARGB32_Premultiplied if sys.byteorder == "little" else QImage.Format.Format_RGBA8888_Premultiplied
-    return QImage(pixels.data, cols, rows, pixels.strides[0], fmt), pixels
+def mask_qimage(mask: np.ndarray, rgba: tuple[int, int, int, int]) -> tuple[QImage, np.ndarray]:
+    """QImage that is ``rgba`` where ``mask`` is True and transparent elsewhere."""
+    value = pack_premultiplied(np.array([rgba]))[0]
+    return argb_qimage(np.where(mask, value, np.uint32(0)))
 
 
 class ImageItem(QGraphicsItem):
@@ -77,6 +73,8 @@ class ImageItem(QGraphicsItem):
         self._image = QImage()
         self._keepalive: np.ndarray | None = None
         self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemUsesExtendedStyleOption, True)
+        # Big layers are scaled once per zoom level, not on every hover repaint.
+        self.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
 
     def set_image(self, image: QImage, keepalive: np.ndarray | None = None) -> None:
         """Show ``image``; ``keepalive`` is the numpy buffer the image points into."""
@@ -120,6 +118,7 @@ class LabelItem(QGraphicsItem):
     def __init__(self, text: str, background: QColor, foreground: QColor, offset: tuple[float, float] = (0.0, 0.0)):
         super().__init__()
         self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations, True)
+        self.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
         self._text = text
         self._background = background
         self._foreground = foreground

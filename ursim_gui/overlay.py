@@ -24,7 +24,6 @@ __all__ = [
     "region_colour_table",
     "overlay_rgba",
     "outline_mask",
-    "outline_rgba",
     "region_label_positions",
     "region_mask",
 ]
@@ -126,14 +125,6 @@ def outline_mask(labels: np.ndarray) -> np.ndarray:
     edge[:, 1:] |= horizontal
     edge[:, :-1] |= horizontal
     return edge & (labels > 0)
-
-
-def outline_rgba(labels: np.ndarray, colour: Colour = (30, 30, 40), alpha: int = 220) -> np.ndarray:
-    """RGBA image that is ``colour`` on region outlines and transparent elsewhere."""
-    mask = outline_mask(labels)
-    rgba = np.zeros(mask.shape + (4,), np.uint8)
-    rgba[mask] = (*colour, alpha)
-    return rgba
 
 
 def region_label_positions(graph) -> dict[int, tuple[float, float]]:

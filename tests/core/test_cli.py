@@ -23,6 +23,11 @@ def two_rooms(path: Path) -> Path:
     return path
 
 
+def write(path: Path, data: bytes) -> Path:
+    path.write_bytes(data)
+    return path
+
+
 def run_cli(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "ursim_core.cli", *args], capture_output=True, text=True)
 
@@ -55,8 +60,8 @@ def test_segment_param_override_is_recorded(tmp_path):
     "make, expected",
     [
         (lambda d: d / "missing.png", "missing.png"),
-        (lambda d: (d / "text.png").write_text("not an image") or d / "text.png", "text.png"),
-        (lambda d: (d / "empty.png").write_bytes(b"") or d / "empty.png", "empty.png"),
+        (lambda d: write(d / "text.png", b"not an image"), "text.png"),
+        (lambda d: write(d / "empty.png", b""), "empty.png"),
         (lambda d: cv2.imwrite(str(d / "black.png"), np.zeros((10, 10), np.uint8)) and d / "black.png", "black.png"),
     ],
 )

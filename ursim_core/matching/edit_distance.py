@@ -38,6 +38,8 @@ __all__ = [
     "align",
     "cyclic_align",
     "aligned_pairs",
+    "aligned_index_pairs",
+    "same_matrix",
 ]
 
 SameRelation = Callable[[object, object], bool]
@@ -103,7 +105,7 @@ def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
     --------
     >>> levenshtein("kitten", "sitting", lambda a, b: a == b)
     (3, 'snnnsni')
-    >>> levenshtein([0, 1], [1], [[False], [True]])
+    >>> levenshtein([0, 1], [0], [[False], [True]])
     (1, 'dn')
     """
     is_same = _same_function(same)
@@ -216,7 +218,7 @@ def cyclic_align(
     >>> cyclic_align("bca", "abc", same).rotation
     2
     >>> cyclic_align("bca", "abc", same, rotation_search="first").operations
-    'dnni'
+    'innd'
     >>> cyclic_align("cba", "abc", same, reflections=True).reflected
     True
     """
@@ -270,6 +272,54 @@ def aligned_pairs(alignment: Alignment) -> list[tuple]:
             i += 1
         else:
             j += 1
+    return pairs
+
+
+def aligned_index_pairs(first: Sequence[int], second: Sequence[int], same: Sequence[Sequence[bool]]) -> list[tuple[int, int]]:
+    """Pairs aligned by :func:`levenshtein` for integer sequences and a "same" matrix.
+
+    Same result as ``aligned_pairs(align(first, second, same))`` (same costs, same
+    backtrace ties), specialised for the matcher's inner loop: no operation string,
+    no callable, and a shortcut for one-element sequences.
+
+    Examples
+    --------
+    >>> aligned_index_pairs([0, 1], [1, 0], [[False, True], [True, False]])
+    [(0, 1), (1, 0)]
+    """
+    rows, cols = len(first), len(second)
+    if rows == 0 or cols == 0:
+        return []
+    if rows == 1 and cols == 1:
+        return [(first[0], second[0])]
+    table = [list(range(cols + 1))]
+    for i in range(1, rows + 1):
+        same_row = same[first[i - 1]]
+        above = table[i - 1]
+        here = [i]
+        left = i
+        for j in range(1, cols + 1):
+            value = above[j - 1] + (0 if same_row[second[j - 1]] else 1)
+            if above[j] + 1 < value:
+                value = above[j] + 1
+            if left + 1 < value:
+                value = left + 1
+            here.append(value)
+            left = value
+        table.append(here)
+    pairs = []
+    i, j = rows, cols
+    while i > 0 and j > 0:
+        diagonal, up, left = table[i - 1][j - 1], table[i - 1][j], table[i][j - 1]
+        if diagonal <= up and diagonal <= left:
+            i -= 1
+            j -= 1
+            pairs.append((first[i], second[j]))
+        elif left <= up:
+            j -= 1
+        else:
+            i -= 1
+    pairs.reverse()
     return pairs
 
 

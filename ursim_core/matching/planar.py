@@ -43,11 +43,11 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import networkx as nx
 
-from .edit_distance import aligned_pairs, align, cyclic_align
+from .edit_distance import aligned_index_pairs, aligned_pairs, cyclic_align
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -89,12 +89,15 @@ class PlanarResult:
         Number of hypotheses scored (one-pair ones included).
     seeds_expanded : int
         Seeds that started an expansion (the others were consumed by earlier ones).
+    alternatives : list of (cost, pairs)
+        Every expanded hypothesis in creation order, when ``keep_alternatives=True``.
     """
 
     pairs: list
     cost: float
     hypotheses: int
     seeds_expanded: int
+    alternatives: list = field(default_factory=list)
 
 
 def cyclic_neighbours(graph: nx.Graph, nodes: Sequence) -> list[list[int]]:
@@ -163,10 +166,9 @@ def hypothesis_cost(first: PlanarGraph, second: PlanarGraph, pairs: Sequence[tup
 
     Examples
     --------
-    >>> g = planar_graph(nx.relabel_nodes(nx.path_graph(3), {}, copy=True).copy()) if False else None
     >>> p = PlanarGraph(nodes=[0, 1, 2], neighbours=[[1], [0, 2], [1]], edges=[(0, 1), (1, 2)])
     >>> hypothesis_cost(p, p, [(0, 0), (1, 1), (2, 2)]), hypothesis_cost(p, p, [(0, 0)])
-    (0, 6)
+    (0, 8)
     """
     matched_first = {a for a, _ in pairs}
     matched_second = {b for _, b in pairs}
@@ -193,23 +195,29 @@ def _arc(order: list[int], start: int, stop: int) -> list[int]:
     return elements
 
 
-def _expand_locked(first_order, second_order, matched, second_set, same):
+def _expand_locked(first_order, second_order, matched, second_set, same, cache):
     """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs."""
-    positions_second = {vertex: k for k, vertex in enumerate(second_order)}
     locks = []  # (position in first_order, position in second_order), in first_order order
     for k, vertex in enumerate(first_order):
         partner = matched.get(vertex)
         if partner is not None and partner in second_set:
-            locks.append((k, positions_second[partner]))
+            locks.append((k, partner))
     if not locks:
         return []
+    positions_second = {vertex: k for k, vertex in enumerate(second_order)}
+    locks = [(k, positions_second[partner]) for k, partner in locks]
     candidates = []
     for index, (first_position, second_position) in enumerate(locks):
         next_first, next_second = locks[(index + 1) % len(locks)]
         first_arc = _arc(first_order, first_position, next_first)
         second_arc = _arc(second_order, second_position, next_second)
         if first_arc and second_arc:
-            candidates.extend(aligned_pairs(align(first_arc, second_arc, same)))
+            # Expansions from different seeds meet the same arcs again: align each pair of arcs once.
+            key = (tuple(first_arc), tuple(second_arc))
+            aligned = cache.get(key)
+            if aligned is None:
+                aligned = cache[key] = aligned_index_pairs(first_arc, second_arc, same)
+            candidates.extend(aligned)
     return candidates
 
 
@@ -221,6 +229,7 @@ def planar_match(
     seeds: Sequence[tuple[int, int]] | None = None,
     rotation_search: str = "min",
     reflections: bool = False,
+    keep_alternatives: bool = False,
 ) -> PlanarResult:
     """Algorithm 1: seed-and-expand planar matching of two region graphs.
 
@@ -238,6 +247,9 @@ def planar_match(
         See :func:`~ursim_core.matching.edit_distance.cyclic_align`.
     reflections : bool
         Also try mirrored neighbour orders at the seed.
+    keep_alternatives : bool
+        Also return every expanded hypothesis (for inspection and for rules that
+        re-rank them).
 
     Returns
     -------
@@ -268,6 +280,8 @@ def planar_match(
     first_sets = [set(order) for order in first.neighbours]
     second_sets = [set(order) for order in second.neighbours]
     reversed_first = [order[::-1] for order in first.neighbours]
+    arc_cache: dict = {}
+    alternatives: list = []
     for seed in seeds:
         if seed in consumed:
             continue
@@ -292,7 +306,7 @@ def planar_match(
             pairs.append((vertex, partner))
             matched[vertex] = partner
             for a, b in _expand_locked(first_orders[vertex], second.neighbours[partner], matched,
-                                       second_sets[partner], same):
+                                       second_sets[partner], same, arc_cache):
                 if a not in seen_first and b not in seen_second:
                     queue.append((a, b))
                     seen_first.add(a)
@@ -304,6 +318,9 @@ def planar_match(
         inner_second = sum(1 for v in matched_second for n in second_sets[v] if n in matched_second) // 2
         cost = ((n_first - len(pairs)) + (n_second - len(pairs)) + (edges_first - inner_first)
                 + (edges_second - inner_second) + abs(inner_first - inner_second))
+        if keep_alternatives:
+            alternatives.append((cost, pairs))
         if cost < best_cost:
             best_cost, best_pairs = cost, pairs
-    return PlanarResult(pairs=best_pairs, cost=best_cost, hypotheses=hypotheses, seeds_expanded=seeds_expanded)
+    return PlanarResult(pairs=best_pairs, cost=best_cost, hypotheses=hypotheses, seeds_expanded=seeds_expanded,
+                        alternatives=alternatives)

@@ -1,0 +1,90 @@
+"""Edit distance, normalisation and backtrace against hand-worked cases."""
+
+from __future__ import annotations
+
+import pytest
+
+from ursim_core.matching.edit_distance import (
+    align,
+    aligned_pairs,
+    cyclic_align,
+    levenshtein,
+    normalised_distance,
+)
+
+
+def equal(a, b):
+    return a == b
+
+
+@pytest.mark.parametrize(
+    "first, second, distance, operations",
+    [
+        ("kitten", "sitting", 3, "snnnsni"),
+        ("abc", "abc", 0, "nnn"),
+        ("", "", 0, ""),
+        ("", "ab", 2, "ii"),
+        ("ab", "", 2, "dd"),
+        ("a", "b", 1, "s"),  # the diagonal is preferred over "di" / "id"
+        ("ab", "ba", 2, "ss"),  # every cell ties: substitutions, not a shifted "ind"
+        ("abc", "c", 2, "ddn"),
+        ("ac", "abc", 1, "nin"),
+    ],
+)
+def test_levenshtein_and_backtrace(first, second, distance, operations):
+    assert levenshtein(first, second, equal) == (distance, operations)
+
+
+def test_same_relation_as_matrix():
+    # Rows index the first sequence's elements, columns the second's.
+    same = [[True, False], [False, False]]
+    assert levenshtein([0, 1], [0, 1], same) == (1, "ns")
+
+
+@pytest.mark.parametrize(
+    "distance, n_first, n_second, expected",
+    [(3, 6, 7, 6 / 16), (0, 0, 0, 0.0), (2, 2, 0, 1.0), (2, 2, 2, 4 / 6), (0, 3, 3, 0.0)],
+)
+def test_normalised_distance(distance, n_first, n_second, expected):
+    assert normalised_distance(distance, n_first, n_second) == pytest.approx(expected)
+
+
+def test_normalised_distance_stays_in_unit_interval():
+    for first in ("", "a", "ab", "abc", "xyz"):
+        for second in ("", "a", "ba", "cab", "zz"):
+            value = align(first, second, equal).normalised
+            assert 0.0 <= value <= 1.0
+            assert (value == 0.0) == (first == second)
+
+
+def test_aligned_pairs_include_substitutions():
+    result = align("abcd", "axd", equal)
+    # Hand backtrace: (4,3) n; (3,2) diagonal 1 <= up 1, value 2 -> s (c with x); (2,1) up 0 < diagonal -> d.
+    assert result.operations == "ndsn"
+    assert aligned_pairs(result) == [("a", "a"), ("c", "x"), ("d", "d")]
+
+
+def test_cyclic_minimum_rotation_versus_released_first_rotation():
+    best = cyclic_align("bca", "abc", equal)
+    assert (best.rotation, best.distance, best.operations) == (2, 0, "nnn")
+    released = cyclic_align("bca", "abc", equal, rotation_search="first")
+    assert (released.rotation, released.distance, released.operations) == (0, 2, "innd")
+    assert released.normalised == pytest.approx(0.5)
+
+
+def test_cyclic_ties_keep_the_smallest_offset():
+    result = cyclic_align("aa", "ab", equal)
+    assert result.rotation == 0 and result.operations == "ns"
+
+
+def test_reflections_are_tried_only_when_asked():
+    plain = cyclic_align("abcd", "dcba", equal)
+    assert not plain.reflected and plain.distance > 0
+    mirrored = cyclic_align("abcd", "dcba", equal, reflections=True)
+    assert mirrored.reflected and mirrored.distance == 0
+    assert aligned_pairs(mirrored) == [(x, x) for x in "dcba"]
+
+
+def test_unknown_rotation_search_is_rejected():
+    with pytest.raises(ValueError):
+        cyclic_align("ab", "ab", equal, rotation_search="all")

@@ -1,0 +1,381 @@
+"""The experiment runner: summaries on hand-made rows, the runner on a synthetic dataset, the real data."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from ursim_core.errors import ParameterError
+from ursim_core.evaluation import (
+    DEFAULT_M_GRID,
+    POOLED,
+    EvaluationResult,
+    RunRow,
+    m_label,
+    mean_f1_by_m,
+    run_evaluation,
+    summarise,
+    summarise_human,
+)
+
+
+def _row(name, m, f1, *, annotator="malcolm", matcher="planar", variant="T4", precision=None, recall=None, auto_m=0.05):
+    label = "auto" if m == "auto" else m_label(m)
+    value = auto_m if m == "auto" else float(m)
+    return RunRow(
+        map=name, annotator=annotator, matcher=matcher, variant=variant, m_label=label, m_value=value,
+        tp=0, fp=0, fn=0, precision=f1 if precision is None else precision, recall=f1 if recall is None else recall,
+        f1=f1, seeds=0, n_sketch_regions=3, n_metric_regions=3, time_s=0.0,
+    )
+
+
+# --------------------------------------------------------------------------- summaries
+
+
+# F1 per map (rows) and m (columns 0, 0.1, 0.2), with the automatic m's F1.
+TABLE = {
+    "00": ((0.0, 0.5, 0.5), 0.5),
+    "01": ((0.2, 0.2, 0.9), 0.2),
+    "02": ((0.0, 0.8, 0.4), 0.8),
+}
+
+
+def _table_rows(annotator="malcolm", table=TABLE, **kwargs):
+    rows = []
+    for name, (per_m, auto_f1) in table.items():
+        rows += [_row(name, m, f1, annotator=annotator, **kwargs) for m, f1 in zip((0.0, 0.1, 0.2), per_m)]
+        rows.append(_row(name, "auto", auto_f1, annotator=annotator, **kwargs))
+    return rows
+
+
+def _by_choice(summaries, annotator="malcolm"):
+    return {s.choice: s for s in summaries if s.annotator == annotator}
+
+
+def test_oracle_takes_the_best_m_of_each_map_and_the_smallest_m_on_ties():
+    oracle = _by_choice(summarise(_table_rows()))["oracle"]
+    assert oracle.maps == ("00", "01", "02")
+    assert oracle.f1 == (0.5, 0.9, 0.8)
+    assert oracle.m_values == (0.1, 0.2, 0.1)  # map 00 ties at 0.1 and 0.2: the smaller wins
+    assert oracle.median == pytest.approx(0.8)
+    assert oracle.mean == pytest.approx(2.2 / 3)
+    assert oracle.sd == pytest.approx(np.std([0.5, 0.9, 0.8], ddof=1))
+
+
+def test_fixed_m_is_the_single_m_with_the_best_mean():
+    # Means over maps: m=0: 0.067, m=0.1: 0.5, m=0.2: 0.6.
+    fixed = _by_choice(summarise(_table_rows()))["fixed"]
+    assert fixed.fixed_m == "0.2"
+    assert fixed.f1 == (0.5, 0.9, 0.4)
+    assert fixed.mean == pytest.approx(0.6)
+    assert fixed.median == pytest.approx(0.5)
+
+
+def test_fixed_m_ties_pick_the_smallest_m():
+    table = {"00": ((0.3, 0.6, 0.6), 0.0), "01": ((0.3, 0.6, 0.6), 0.0)}
+    assert _by_choice(summarise(_table_rows(table=table)))["fixed"].fixed_m == "0.1"
+
+
+def test_auto_uses_the_auto_rows_and_their_m():
+    auto = _by_choice(summarise(_table_rows()))["auto"]
+    assert auto.f1 == (0.5, 0.2, 0.8)
+    assert auto.m_values == (0.05, 0.05, 0.05)
+    assert auto.mean == pytest.approx(0.5)
+
+
+def test_precision_and_recall_follow_the_chosen_rows():
+    rows = [_row("00", 0.0, 0.0, precision=0.0, recall=0.0), _row("00", 0.1, 0.8, precision=1.0, recall=2 / 3)]
+    oracle = _by_choice(summarise(rows))["oracle"]
+    assert oracle.mean_precision == 1.0 and oracle.mean_recall == pytest.approx(2 / 3)
+
+
+def test_annotators_are_summarised_apart_and_pooled():
+    vasiliki_table = {name: (tuple(1.0 - f for f in per_m), 1.0 - auto) for name, (per_m, auto) in TABLE.items()}
+    rows = _table_rows("malcolm") + _table_rows("vasiliki", table=vasiliki_table)
+    summaries = summarise(rows)
+    assert list(dict.fromkeys(s.annotator for s in summaries)) == ["malcolm", "vasiliki", POOLED]
+    vasiliki_oracle = _by_choice(summaries, "vasiliki")["oracle"]
+    assert vasiliki_oracle.f1 == (1.0, 0.8, 1.0)
+    pooled = _by_choice(summaries, POOLED)
+    assert pooled["oracle"].n == 6
+    assert pooled["oracle"].maps[:2] == ("00/malcolm", "01/malcolm")
+    # Pooled means per m: 0: 0.5, 0.1: 0.5, 0.2: 0.5 -> tie, smallest m.
+    assert pooled["fixed"].fixed_m == "0"
+    assert summarise(rows, pool=False)[-1].annotator == "vasiliki"
+
+
+def test_methods_are_ordered_like_the_paper_table_and_human_rows_ignored():
+    rows = (
+        _table_rows(matcher="vf2", variant="T1")
+        + _table_rows(matcher="planar", variant="T4")
+        + _table_rows(matcher="planar", variant="baseline")
+        + [RunRow("00", "malcolm", "human", "vasiliki", "-", math.nan, 1, 0, 0, 1.0, 1.0, 1.0, 0, 3, 3, 0.0)]
+    )
+    order = list(dict.fromkeys((s.matcher, s.variant) for s in summarise(rows)))
+    assert order == [("planar", "baseline"), ("planar", "T4"), ("vf2", "T1")]
+
+
+def test_m_grid_restricts_the_oracle_and_the_fixed_choice():
+    summaries = summarise(_table_rows(), m_grid=(0.0, 0.1))
+    assert _by_choice(summaries)["oracle"].f1 == (0.5, 0.2, 0.8)
+    assert _by_choice(summaries)["fixed"].fixed_m == "0.1"
+
+
+def test_single_map_has_no_sd():
+    oracle = _by_choice(summarise([_row("00", 0.1, 0.4)]))["oracle"]
+    assert oracle.mean == 0.4 and oracle.median == 0.4 and math.isnan(oracle.sd)
+
+
+def test_human_summaries_per_direction():
+    rows = [
+        RunRow(name, reference, "human", scored, "-", math.nan, 1, 0, 0, 1.0, 1.0, f1, 0, 3, 3, 0.0)
+        for name, reference, scored, f1 in (("00", "a", "b", 1.0), ("01", "a", "b", 0.6), ("00", "b", "a", 0.5))
+    ]
+    summaries = {(s.annotator, s.variant): s for s in summarise_human(rows)}
+    assert summaries[("a", "b")].mean == pytest.approx(0.8)
+    assert summaries[("b", "a")].f1 == (0.5,)
+
+
+def test_mean_f1_by_m_leaves_auto_out():
+    result = mean_f1_by_m(_table_rows())
+    assert list(result) == [("malcolm", "planar", "T4")]
+    assert [(label, round(mean, 4), n) for _, label, mean, n in result[("malcolm", "planar", "T4")]] == [
+        ("0", round(0.2 / 3, 4), 3),
+        ("0.1", 0.5, 3),
+        ("0.2", 0.6, 3),
+    ]
+
+
+def test_m_labels_and_default_grid():
+    assert [m_label(m) for m in DEFAULT_M_GRID[:4]] == ["0", "0.025", "0.05", "0.075"]
+    assert len(DEFAULT_M_GRID) == 20 and m_label(DEFAULT_M_GRID[-1]) == "0.475"
+
+
+def test_result_summary_lookup():
+    result = EvaluationResult(rows=tuple(_table_rows()))
+    assert result.summary("malcolm", "planar", "T4", "fixed").fixed_m == "0.2"
+    assert result.summary("malcolm", "hungarian", "T4", "fixed") is None
+    assert result.annotators == ("malcolm",)
+
+
+# --------------------------------------------------------------------------- the runner, synthetic data
+
+# Three rooms of different sizes in a row joined by doors; (row, col) centres of the rooms.
+ROOM_CENTRES = ((35, 30), (35, 85), (25, 150))
+
+
+def _plan(scale: float) -> np.ndarray:
+    def s(value):
+        return int(round(value * scale))
+
+    free = np.zeros((s(70), s(190)), bool)
+    free[s(5):s(65), s(5):s(55)] = True
+    free[s(15):s(55), s(65):s(105)] = True
+    free[s(5):s(45), s(115):s(185)] = True
+    free[s(30):s(38), s(55):s(65)] = True
+    free[s(20):s(28), s(105):s(115)] = True
+    return np.where(free, 255, 0).astype(np.uint8)
+
+
+def _dat_text(sketch_scale: float, model_scale: float, rooms: int) -> str:
+    lines = ["# sketch.png model_simple.png"]
+    for index, (row, col) in enumerate(ROOM_CENTRES[:rooms]):
+        lines += [
+            f"# {index}match set", "# map1", f"{round(row * sketch_scale)} {round(col * sketch_scale)}",
+            "# map2", f"{round(row * model_scale)} {round(col * model_scale)}", "",
+        ]
+    # The published files end with an empty match set; the legacy fnfix scorer counts it.
+    lines += [f"# {rooms}match set", "# map1", "# map2", ""]
+    return "\n".join(lines)
+
+
+MODEL_SCALE = 1.5
+SKETCH_SCALES = {"copy": MODEL_SCALE, "small": 1.0}
+
+
+@pytest.fixture(scope="module")
+def synthetic_dataset(tmp_path_factory) -> Path:
+    root = tmp_path_factory.mktemp("synthetic_kth")
+    (root / "sketches").mkdir()
+    (root / "model").mkdir()
+    Image.fromarray(_plan(MODEL_SCALE)).save(root / "model" / "model_simple.png")
+    for name, scale in SKETCH_SCALES.items():
+        Image.fromarray(_plan(scale)).save(root / "sketches" / f"{name}.png")
+        # malcolm annotated the three rooms, vasiliki only the first two.
+        for annotator, rooms in (("malcolm", 3), ("vasiliki", 2)):
+            folder = root / "gt_correspondences" / annotator
+            folder.mkdir(parents=True, exist_ok=True)
+            (folder / f"gt_{name}_model_simple.dat").write_text(_dat_text(scale, MODEL_SCALE, rooms))
+    return root
+
+
+GRID = (0.0, 0.1, 0.2)
+
+
+@pytest.fixture(scope="module")
+def synthetic_result(synthetic_dataset) -> EvaluationResult:
+    return run_evaluation(
+        synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "baseline"], m_grid=GRID,
+        preset="robot", workers=1,
+    )
+
+
+def test_runner_produces_one_row_per_map_annotator_matcher_variant_and_m(synthetic_result):
+    rows = synthetic_result.rows
+    assert len(rows) == 2 * 2 * 2 * 2 * (len(GRID) + 1)
+    keys = {(r.map, r.annotator, r.matcher, r.variant, r.m_label) for r in rows}
+    assert len(keys) == len(rows)
+    assert {r.m_label for r in rows} == {"0", "0.1", "0.2", "auto"}
+    for row in rows:
+        assert 0.0 <= row.f1 <= 1.0 and row.scoring == "correct"
+        assert row.n_sketch_regions == 3 and row.n_metric_regions == 3
+        assert row.model == "model_simple" and row.time_s >= 0
+        if row.m_label != "auto":
+            assert row.m_value == float(row.m_label)
+        if row.tp:
+            assert row.f1 == pytest.approx(2 * row.precision * row.recall / (row.precision + row.recall))
+
+
+def test_runner_matches_an_identical_map_perfectly(synthetic_result):
+    # The "copy" sketch is the model itself: the oracle m must recover every room.
+    oracle = synthetic_result.summary("malcolm", "planar", "T4", "oracle")
+    assert dict(zip(oracle.maps, oracle.f1))["copy"] == 1.0
+    copy_rows = [r for r in synthetic_result.rows if r.map == "copy" and r.annotator == "malcolm" and r.matcher == "planar"
+                 and r.variant == "T4" and r.f1 == 1.0]
+    assert all((r.tp, r.fp, r.fn) == (3, 0, 0) for r in copy_rows)
+
+
+def test_human_vs_human_has_the_known_answer(synthetic_result):
+    # vasiliki's two cliques are two of malcolm's three: scored against malcolm, P = 1, R = 2/3;
+    # malcolm's against vasiliki's, P = 2/3, R = 1. F1 = 0.8 both ways, on both maps.
+    human = {(r.map, r.annotator, r.variant): r for r in synthetic_result.human_rows}
+    assert set(human) == {(m, a, b) for m in SKETCH_SCALES for a, b in (("malcolm", "vasiliki"), ("vasiliki", "malcolm"))}
+    for (name, reference, scored), row in human.items():
+        assert row.f1 == pytest.approx(0.8)
+        if reference == "malcolm":
+            assert (row.tp, row.fp, row.fn) == (2, 0, 1)
+        else:
+            assert (row.tp, row.fp, row.fn) == (2, 1, 0)
+    assert all(s.mean == pytest.approx(0.8) for s in synthetic_result.human_summaries)
+
+
+def test_runner_settings_and_timings(synthetic_result, synthetic_dataset):
+    settings = synthetic_result.settings
+    assert settings["matchers"] == ["planar", "hungarian"] and settings["variants"] == ["T4", "baseline"]
+    assert settings["m_grid"] == list(GRID) and settings["scoring"] == "correct"
+    assert settings["presets_used"] == ["robot"]
+    assert settings["dataset"] == str(synthetic_dataset)
+    assert synthetic_result.timings["maps"] == 3
+    assert synthetic_result.notes == ()
+
+
+def test_legacy_scoring_modes(synthetic_dataset):
+    as_built = run_evaluation(synthetic_dataset, matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot",
+                              workers=1, legacy_scoring=True, human=False, auto_m=False)
+    assert {r.scoring for r in as_built.rows} == {"as-built"} and {r.fn for r in as_built.rows} == {0}
+    assert as_built.human_rows == ()
+    fnfix = run_evaluation(synthetic_dataset, matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot",
+                           workers=1, legacy_scoring="fnfix", auto_m=False)
+    # The trailing empty match set can never be hit: at least one FN everywhere.
+    assert all(r.fn >= 1 for r in fnfix.rows)
+    assert {r.m_label for r in fnfix.rows} == {"0.1"}
+
+
+def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_path):
+    calls = []
+    cache: dict = {}
+    options = dict(matchers=["hungarian"], variants=["T1", "T2"], m_grid=(0.1,), preset="robot", workers=1,
+                   segmentation_cache=cache, cache_dir=tmp_path / "segcache")
+    first = run_evaluation(synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options)
+    total = 3 + 2 * 2 + 1  # maps segmented + (experiment x variant) tasks + human vs human
+    assert [c[0] for c in calls] == list(range(1, total + 1)) and {c[1] for c in calls} == {total}
+    assert any(text.startswith("segment") for _, _, text in calls) and calls[-1][2] == "human vs human"
+    assert first.timings["maps_from_cache"] == 0 and len(cache) == 3
+    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 3
+
+    in_memory = run_evaluation(synthetic_dataset, **options)
+    assert in_memory.timings["maps_from_cache"] == 3
+    on_disk = run_evaluation(synthetic_dataset, **{**options, "segmentation_cache": None})
+    assert on_disk.timings["maps_from_cache"] == 3
+    assert [r.f1 for r in on_disk.rows] == [r.f1 for r in first.rows]
+
+
+def test_two_worker_processes_give_the_same_rows(synthetic_dataset, synthetic_result):
+    parallel = run_evaluation(synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "baseline"],
+                              m_grid=GRID, preset="robot", workers=2)
+    strip = lambda rows: [(r.map, r.annotator, r.matcher, r.variant, r.m_label, r.tp, r.fp, r.fn, r.f1) for r in rows]
+    assert strip(parallel.rows) == strip(synthetic_result.rows)
+
+
+def test_map_selection_and_experiment_list(synthetic_dataset):
+    from ursim_core.dataset_layout import discover
+
+    only_copy = run_evaluation(synthetic_dataset, matchers=["hungarian"], variants=["T1"], m_grid=(0.1,),
+                               preset="robot", workers=1, maps=["copy"], auto_m=False)
+    assert {r.map for r in only_copy.rows} == {"copy"}
+    experiments = [e for e in discover(synthetic_dataset) if e.name == "small"]
+    given = run_evaluation(experiments, matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot",
+                           workers=1, auto_m=False)
+    assert {r.map for r in given.rows} == {"small"}
+
+
+@pytest.mark.parametrize(
+    "options, field",
+    [
+        ({"matchers": ["simplex"]}, "matchers"),
+        ({"variants": ["T9"]}, "variants"),
+        ({"variants": []}, "variants"),
+        ({"m_grid": (0.1, -0.1)}, "m_grid"),
+        ({"m_grid": ()}, "m_grid"),
+        ({"m_grid": (0.1, 0.1)}, "m_grid"),
+        ({"maps": ["nope"]}, "maps"),
+        ({"config_overrides": {"m": 0.2}}, "config_overrides"),
+        ({"legacy_scoring": "sometimes"}, "legacy"),
+    ],
+)
+def test_bad_options_are_parameter_errors(synthetic_dataset, options, field):
+    with pytest.raises(ParameterError) as raised:
+        run_evaluation(synthetic_dataset, workers=1, **options)
+    assert raised.value.field == field
+
+
+def test_unknown_config_field_is_reported(synthetic_dataset):
+    with pytest.raises(TypeError, match="no_such_option"):
+        run_evaluation(synthetic_dataset, workers=1, config_overrides={"no_such_option": 1})
+
+
+# --------------------------------------------------------------------------- real data
+
+
+@pytest.mark.dataset
+def test_three_kth_sketches_end_to_end():
+    from ursim_core.datasets import MISSING_REASON, dataset_root
+
+    root = dataset_root()
+    if root is None:
+        pytest.skip(MISSING_REASON)
+    result = run_evaluation(
+        root / "ursim_kth_sketches", matchers=["planar", "hungarian"], variants=["T4", "baseline"],
+        maps=["01", "03", "11"], workers=1,
+    )
+    assert {r.map for r in result.rows} == {"01", "03", "11"}
+    assert len(result.rows) == 3 * 2 * 2 * 2 * (len(DEFAULT_M_GRID) + 1)
+    for annotator in ("malcolm", "vasiliki"):
+        oracle = result.summary(annotator, "planar", "T4", "oracle")
+        fixed = result.summary(annotator, "planar", "T4", "fixed")
+        auto = result.summary(annotator, "planar", "T4", "auto")
+        assert oracle.n == fixed.n == auto.n == 3
+        # The oracle is the best m of the grid per map, and the automatic m picks from that grid.
+        assert all(o >= f - 1e-12 for o, f in zip(oracle.f1, fixed.f1))
+        assert all(o >= a - 1e-12 for o, a in zip(oracle.f1, auto.f1))
+        assert set(auto.m_values) <= set(DEFAULT_M_GRID)
+        # URSIM finds some correct correspondences on these sketches.
+        assert oracle.mean > 0.2
+    human = {(s.annotator, s.variant): s for s in result.human_summaries}
+    assert set(human) == {("malcolm", "vasiliki"), ("vasiliki", "malcolm")}
+    # Two annotators of the same maps agree far more than any matcher does.
+    assert all(s.mean > 0.5 for s in human.values())

@@ -1,0 +1,103 @@
+"""ursim_gui.overlay and ursim_gui.view_state: Qt-free, tested without widgets."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from conftest import three_room_labels
+from ursim_core.correspondences import Clique, Correspondences
+from ursim_core.graph import region_graph
+from ursim_gui.overlay import (
+    NEUTRAL_REGION,
+    clique_colour,
+    outline_mask,
+    overlay_rgba,
+    palette_colour,
+    region_colour_table,
+    region_label_positions,
+    region_mask,
+)
+from ursim_gui.view_state import clique_marks, missed_reference, partner_regions, side_colour_table
+
+
+def test_colour_table_makes_background_transparent_and_regions_distinct():
+    table = region_colour_table(20, alpha=200)
+    assert table.shape == (21, 4) and table.dtype == np.uint8
+    assert tuple(table[0]) == (0, 0, 0, 0)
+    assert (table[1:, 3] == 200).all()
+    assert len({tuple(row[:3]) for row in table[1:]}) == 20
+    assert palette_colour(7) == tuple(table[7, :3])
+
+
+def test_overlay_is_one_lookup_per_pixel():
+    labels = three_room_labels()
+    table = region_colour_table(3, {2: (1, 2, 3)}, default=(9, 9, 9), alpha=255)
+    rgba = overlay_rgba(labels, table)
+    assert rgba.shape == labels.shape + (4,)
+    assert tuple(rgba[10, 60]) == (1, 2, 3, 255)
+    assert tuple(rgba[10, 10]) == (9, 9, 9, 255)
+    assert tuple(rgba[0, 0]) == (0, 0, 0, 0)
+
+
+def test_overlay_tolerates_labels_beyond_the_table():
+    labels = np.array([[0, 1], [5, 2]], np.int32)
+    rgba = overlay_rgba(labels, region_colour_table(2))
+    assert tuple(rgba[1, 0]) == (0, 0, 0, 0)
+
+
+def test_outline_marks_only_region_borders():
+    labels = np.zeros((6, 6), np.int32)
+    labels[1:5, 1:3] = 1
+    labels[1:5, 3:5] = 2
+    mask = outline_mask(labels)
+    assert mask[2, 2] and mask[2, 3]          # the shared border
+    assert mask[1, 1]                         # border with the wall
+    assert not mask[0, 0]                     # walls stay clean
+    labels_big = np.ones((6, 6), np.int32)
+    labels_big[2:4, 2:4] = 2
+    assert not outline_mask(labels_big)[0, 0]
+
+
+def test_label_positions_use_interior_points_and_masks_are_cropped():
+    labels = three_room_labels()
+    graph = region_graph(labels)
+    positions = region_label_positions(graph)
+    assert set(positions) == {1, 2, 3}
+    for region, (row, col) in positions.items():
+        assert labels[int(row), int(col)] == region
+    mask, (row0, col0) = region_mask(labels, 2, graph.nodes[2]["bbox"])
+    assert (row0, col0) == (5, 52)
+    assert mask.sum() == (labels == 2).sum()
+
+
+def _corr():
+    return Correspondences(
+        cliques=(
+            Clique(id=1, sketch_regions=(1,), metric_regions=(3,), source="auto"),
+            Clique(id=2, sketch_regions=(2,), metric_regions=(2,), status="rejected"),
+        )
+    )
+
+
+def test_side_colours_follow_cliques_and_match_across_views():
+    labels = three_room_labels()
+    corr = _corr()
+    sketch = side_colour_table(corr, "sketch", labels)
+    metric = side_colour_table(corr, "metric", labels)
+    assert tuple(sketch[1, :3]) == clique_colour(1) == tuple(metric[3, :3])
+    assert tuple(sketch[2, :3]) == NEUTRAL_REGION        # rejected clique is not coloured
+    assert tuple(metric[1, :3]) == NEUTRAL_REGION
+    plain = side_colour_table(Correspondences(), "sketch", labels)
+    assert tuple(plain[1, :3]) == palette_colour(1)
+
+
+def test_partners_marks_and_misses():
+    corr = _corr()
+    assert partner_regions(corr, "sketch", [1]) == {3}
+    assert partner_regions(corr, "metric", [3]) == {1}
+    assert partner_regions(corr, "sketch", [3]) == set()
+    reference = [(frozenset({1}), frozenset({3})), (frozenset({3}), frozenset({1}))]
+    assert clique_marks(corr, reference) == {1: "TP"}
+    assert clique_marks(corr, [(frozenset({1}), frozenset({2}))]) == {1: "FP"}
+    assert clique_marks(corr, None) == {}
+    assert missed_reference(corr, reference) == [(frozenset({3}), frozenset({1}))]

@@ -1,0 +1,149 @@
+"""GUI timings: ``python -m ursim_gui.bench_gui`` (runs offscreen unless a platform is set).
+
+Measures, on synthetic maps:
+
+1. open + overlay: a 4000x4000 map with its segmentation shown (image, overlay LUT,
+   outlines, graph, ids) and one frame painted; budget 1 s.
+2. hover: highlighting a region's partners in the other view and painting the frame, on
+   a KTH-size map (1870x924); budget 16 ms.
+3. edit redraw: recolouring a side after a correspondence change and painting; 16 ms.
+4. UI blocking during segmentation and matching in the worker: the longest gap between
+   ticks of a 10 ms timer in the GUI thread; budget 100 ms.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+
+import numpy as np
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+__all__ = ["room_grid_labels", "main"]
+
+
+def room_grid_labels(rows: int, cols: int, room: int) -> np.ndarray:
+    """Label image of square rooms of side ``room`` with 3 px walls and doors between them."""
+    labels = np.zeros((rows, cols), np.int32)
+    region = 0
+    for r0 in range(0, rows - room + 1, room):
+        for c0 in range(0, cols - room + 1, room):
+            region += 1
+            labels[r0 + 3 : r0 + room, c0 + 3 : c0 + room] = region
+            labels[r0 + room // 2 - 4 : r0 + room // 2 + 4, c0 : c0 + 3] = region if c0 else 0
+    return labels
+
+
+def _ms(seconds: float) -> str:
+    return f"{seconds * 1000:8.1f} ms"
+
+
+def _paint(view) -> None:
+    view.viewport().repaint()
+
+
+def bench_open(view, size: int) -> float:
+    from ursim_core.graph import region_graph
+    from ursim_gui.overlay import region_colour_table
+
+    labels = room_grid_labels(size, size, 100)
+    graph = region_graph(labels)
+    grey = np.where(labels > 0, 255, 0).astype(np.uint8)
+    start = time.perf_counter()
+    view.set_image(grey)
+    view.set_segmentation(labels, graph)
+    view.set_region_colours(region_colour_table(int(labels.max()), alpha=255))
+    view.set_ids_visible(True)
+    _paint(view)
+    return time.perf_counter() - start
+
+
+def bench_hover_and_edit(views, correspondences_for) -> tuple[list[float], list[float]]:
+    from ursim_core.graph import region_graph
+    from ursim_gui.view_state import partner_regions, side_colour_table
+
+    labels = room_grid_labels(924, 1870, 90)
+    graph = region_graph(labels)
+    grey = np.where(labels > 0, 255, 0).astype(np.uint8)
+    for view in views:
+        view.set_image(grey)
+        view.set_segmentation(labels, graph)
+    corr = correspondences_for(int(labels.max()))
+    sketch, metric = views
+    hover = []
+    for region in range(1, int(labels.max()) + 1, 3):
+        start = time.perf_counter()
+        metric.set_highlight(partner_regions(corr, "sketch", [region]))
+        _paint(metric)
+        hover.append(time.perf_counter() - start)
+    edit = []
+    for _ in range(10):
+        start = time.perf_counter()
+        metric.set_region_colours(side_colour_table(corr, "metric", labels))
+        _paint(metric)
+        edit.append(time.perf_counter() - start)
+    return hover, edit
+
+
+def bench_blocking(app, job) -> tuple[float, float]:
+    """Run ``job`` in the worker; return (longest GUI-thread gap, job wall time)."""
+    from PySide6.QtCore import QTimer
+
+    from ursim_gui.workers import JobRunner
+
+    runner = JobRunner()
+    ticks: list[float] = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(10)
+    start = time.perf_counter()
+    runner.start(job)
+    while runner.busy:
+        app.processEvents()
+        time.sleep(0.001)
+    timer.stop()
+    gaps = [b - a for a, b in zip(ticks, ticks[1:])] or [0.0]
+    return max(gaps), time.perf_counter() - start
+
+
+def _correspondences(n: int):
+    from ursim_core.correspondences import Clique, Correspondences
+
+    return Correspondences(cliques=tuple(Clique(id=i, sketch_regions=(i,), metric_regions=(n + 1 - i,)) for i in range(1, n + 1)))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m ursim_gui.bench_gui", description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=4000, help="side of the big map (default 4000)")
+    args = parser.parse_args(argv)
+    from PySide6.QtWidgets import QApplication
+
+    from ursim_core.maps import map_from_array
+    from ursim_core.segmentation import segment
+    from ursim_gui.map_view import MapView
+    from ursim_gui.model.jobs import MatchJob, SegmentJob
+
+    app = QApplication.instance() or QApplication([])
+    views = [MapView("sketch"), MapView("metric")]
+    for view in views:
+        view.resize(900, 700)
+        view.show()
+    app.processEvents()
+    print(f"open + overlay {args.size}x{args.size} map  : {_ms(bench_open(views[0], args.size))}   (budget 1000 ms)")
+    hover, edit = bench_hover_and_edit(views, _correspondences)
+    print(f"hover highlight 1870x924, mean / max : {_ms(statistics.mean(hover))} / {_ms(max(hover))}   (budget 16 ms, {len(hover)} regions)")
+    print(f"edit redraw 1870x924, mean / max     : {_ms(statistics.mean(edit))} / {_ms(max(edit))}   (budget 16 ms)")
+    free = room_grid_labels(924, 1870, 150) > 0
+    gap, wall = bench_blocking(app, SegmentJob(map_from_array(np.where(free, 255, 0).astype(np.uint8)), "robot", side="metric"))
+    print(f"segmentation in worker: longest UI gap {_ms(gap)} over {wall:.2f} s   (budget 100 ms)")
+    seg = segment(free, preset="robot")
+    gap, wall = bench_blocking(app, MatchJob(seg, seg))
+    print(f"matching in worker    : longest UI gap {_ms(gap)} over {wall:.2f} s   (budget 100 ms)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,166 @@
+"""File commands of the main window: open, save, import/export, reference, recovery, autosave.
+
+Each command asks for a path (unless given one), calls the session, and turns a failure
+into an error dialog plus a log entry. The session decides what is saved and whether the
+document is dirty; a failed save leaves it dirty, so the title keeps its ``*``.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+from PySide6.QtCore import QObject, QTimer
+from PySide6.QtWidgets import QFileDialog
+
+from ursim_core.errors import UrsimError
+from ursim_gui import dialogs
+from ursim_gui.model.autosave import Autosaver, find_recoverable, recover
+
+__all__ = ["DocumentController", "MAP_FILTER", "JSON_FILTER", "DAT_FILTER"]
+
+_log = logging.getLogger(__name__)
+MAP_FILTER = "Maps (*.png *.jpg *.jpeg *.pgm *.tif *.tiff *.bmp *.yaml *.yml);;All files (*)"
+JSON_FILTER = "Correspondences (*.json)"
+DAT_FILTER = "Legacy correspondences (*.dat)"
+REFERENCE_FILTER = "References (*.json *.dat)"
+_FAILURES = (UrsimError, OSError, ValueError)
+
+
+class DocumentController(QObject):
+    """File commands over one session, with dialogs parented to ``window``."""
+
+    def __init__(self, session, window, data_dir: Path):
+        super().__init__(window)
+        self.session = session
+        self.window = window
+        self.autosave_dir = Path(data_dir) / "autosave"
+        self.autosave_dir.mkdir(parents=True, exist_ok=True)
+        self.autosaver = Autosaver(session, self.autosave_dir)
+        self.autosave_timer = QTimer(self)
+        self.autosave_timer.setInterval(1000)
+        self.autosave_timer.timeout.connect(self.flush_autosave)
+        self.autosave_timer.start()
+        session.dirty_changed.connect(lambda _dirty: self.update_title())
+        session.path_changed.connect(lambda _path: self.update_title())
+        session.error.connect(lambda message: dialogs.show_error(window, "Error", message))
+        self.update_title()
+
+    # ---- title and autosave --------------------------------------------------------------
+    def update_title(self) -> None:
+        """Window title from the session: file name, ``*`` while there are unsaved changes."""
+        self.window.setWindowTitle(self.session.window_title())
+
+    def flush_autosave(self) -> None:
+        try:
+            self.autosaver.flush_if_due(time.monotonic())
+        except OSError as error:
+            # Autosave must never interrupt the user; log it and try again later.
+            _log.warning("autosave failed: %s", error)
+
+    # ---- opening -------------------------------------------------------------------------
+    def _ask_open(self, title: str, filters: str) -> Path | None:
+        path, _ = QFileDialog.getOpenFileName(self.window, title, "", filters)
+        return Path(path) if path else None
+
+    def open_map(self, side: str, path: Path | None = None) -> bool:
+        """Open a map image or ROS YAML as ``side``'s map."""
+        path = path or self._ask_open(f"Open {side} map", MAP_FILTER)
+        return path is not None and self._try(f"Cannot open the {side} map", self.session.load_map, side, path)
+
+    def open_correspondences(self, path: Path | None = None) -> bool:
+        """Open a correspondence JSON (and its maps), after offering to save changes."""
+        if not self.confirm_discard("opening another file"):
+            return False
+        path = path or self._ask_open("Open correspondences", JSON_FILTER)
+        return path is not None and self._try("Cannot open the correspondences", self.session.open, path)
+
+    def open_dropped(self, side: str, paths: list[Path]) -> None:
+        """Files dropped on a view: a .json opens correspondences, anything else a map."""
+        for path in paths:
+            if path.suffix.lower() == ".json":
+                self.open_correspondences(path)
+            else:
+                self.open_map(side, path)
+
+    def load_reference(self, path: Path | None = None) -> bool:
+        path = path or self._ask_open("Load reference", REFERENCE_FILTER)
+        return path is not None and self._try("Cannot load the reference", self.session.load_reference, path)
+
+    def import_dat(self, path: Path | None = None) -> bool:
+        path = path or self._ask_open("Import .dat", DAT_FILTER)
+        return path is not None and self._try("Cannot import the .dat file", self.session.import_dat, path)
+
+    # ---- saving --------------------------------------------------------------------------
+    def save(self) -> bool:
+        """Save to the current file, or ask for one. True when the file was written."""
+        if self.session.path is None:
+            return self.save_as()
+        return self._save_to(None)
+
+    def save_as(self, path: Path | None = None) -> bool:
+        if path is None:
+            chosen, _ = QFileDialog.getSaveFileName(self.window, "Save correspondences", "correspondences.json", JSON_FILTER)
+            if not chosen:
+                return False
+            path = Path(chosen)
+        return self._save_to(path)
+
+    def _save_to(self, path: Path | None) -> bool:
+        if not self._try("Save failed", self.session.save, path):
+            return False
+        self.autosaver.discard()
+        self.window.statusBar().showMessage(f"Saved {self.session.path}", 4000)
+        return True
+
+    def export_dat(self, path: Path | None = None) -> bool:
+        if path is None:
+            chosen, _ = QFileDialog.getSaveFileName(self.window, "Export .dat", "correspondences.dat", DAT_FILTER)
+            if not chosen:
+                return False
+            path = Path(chosen)
+        return self._try("Export failed", self.session.export_dat, path)
+
+    def confirm_discard(self, what: str) -> bool:
+        """Before ``what`` replaces the document: True when it may go ahead."""
+        if not self.session.dirty:
+            return True
+        answer = dialogs.ask_unsaved_changes(self.window, what)
+        if answer == "save":
+            return self.save()
+        return answer == "discard"
+
+    def discard_changes(self) -> None:
+        """Forget the autosave without saving (scripted runs that must not prompt)."""
+        self.autosaver.discard()
+
+    def close_document(self) -> None:
+        """The window closes normally: stop autosaving and remove the copy."""
+        self.autosave_timer.stop()
+        self.autosaver.close()
+
+    # ---- recovery --------------------------------------------------------------------------
+    def offer_recovery(self) -> bool:
+        """If autosave files from an earlier run exist, offer them. True when one was restored."""
+        paths = find_recoverable(self.autosave_dir)
+        if not paths:
+            return False
+        chosen = dialogs.ask_recover(self.window, paths)
+        if chosen is None:
+            return False
+        try:
+            self.session.restore(recover(chosen))
+        except _FAILURES as error:
+            dialogs.show_error(self.window, "Recovery failed", str(error))
+            return False
+        chosen.unlink(missing_ok=True)
+        return True
+
+    def _try(self, title: str, operation, *args) -> bool:
+        try:
+            operation(*args)
+        except _FAILURES as error:
+            dialogs.show_error(self.window, title, str(error))
+            return False
+        return True

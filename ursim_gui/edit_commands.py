@@ -1,0 +1,73 @@
+"""Edit menu commands (link, unlink, delete, accept, reject, undo, redo, clear selection).
+
+Each command reads the session's selection and calls one session method, so every key
+press is exactly one undoable step; action enabled states follow the session.
+"""
+
+from __future__ import annotations
+
+__all__ = ["EditCommands"]
+
+
+class EditCommands:
+    """Connects the edit actions to ``session`` and keeps their enabled state current."""
+
+    def __init__(self, session, actions: dict):
+        self.session = session
+        self.actions = actions
+        actions["link"].triggered.connect(self.link)
+        actions["unlink"].triggered.connect(self.unlink)
+        actions["delete_clique"].triggered.connect(self.delete_clique)
+        actions["accept"].triggered.connect(lambda: self.set_status("accepted"))
+        actions["reject"].triggered.connect(lambda: self.set_status("rejected"))
+        actions["undo"].triggered.connect(self.undo)
+        actions["redo"].triggered.connect(self.redo)
+        actions["clear_selection"].triggered.connect(session.clear_selection)
+        session.history_changed.connect(self.update_actions)
+        session.selection_changed.connect(self.update_actions)
+        session.correspondences_changed.connect(self.update_actions)
+        self.update_actions()
+
+    def _selected(self, side: str) -> list[int]:
+        return sorted(self.session.selection.get(side, ()))
+
+    def link(self) -> None:
+        """New clique of the selected regions, or add them to the selected clique."""
+        sketch, metric = self._selected("sketch"), self._selected("metric")
+        if sketch or metric:
+            self.session.link(sketch, metric, into=self.session.selected_clique)
+
+    def unlink(self) -> None:
+        """Remove each selected region from its cliques."""
+        for side in ("sketch", "metric"):
+            for region in self._selected(side):
+                self.session.unlink(side, region)
+
+    def delete_clique(self) -> None:
+        if self.session.selected_clique is not None:
+            self.session.delete_clique(self.session.selected_clique)
+
+    def set_status(self, status: str) -> None:
+        if self.session.selected_clique is not None:
+            self.session.set_status(self.session.selected_clique, status)
+
+    def undo(self) -> None:
+        if self.session.can_undo:
+            self.session.undo()
+
+    def redo(self) -> None:
+        if self.session.can_redo:
+            self.session.redo()
+
+    def update_actions(self, *_args) -> None:
+        session, actions = self.session, self.actions
+        has_clique = session.selected_clique is not None
+        has_regions = any(session.selection.get(side) for side in ("sketch", "metric"))
+        actions["undo"].setEnabled(session.can_undo)
+        actions["redo"].setEnabled(session.can_redo)
+        actions["undo"].setText(f"&Undo {session.undo_text}" if session.can_undo else "&Undo")
+        actions["redo"].setText(f"&Redo {session.redo_text}" if session.can_redo else "&Redo")
+        actions["link"].setEnabled(has_regions)
+        actions["unlink"].setEnabled(has_regions)
+        for key in ("delete_clique", "accept", "reject"):
+            actions[key].setEnabled(has_clique)

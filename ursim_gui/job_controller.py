@@ -1,0 +1,148 @@
+"""Runs segmentation and matching jobs off the GUI thread and hands results to the session.
+
+Jobs are queued (segment sketch, segment metric, match) and run one at a time by a
+:class:`~ursim_gui.workers.JobRunner`; the status bar shows progress and a Cancel button
+that drops the whole queue. Results are applied in the GUI thread through the session's
+own methods (``set_segmentation``, ``apply_match``).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import deque
+
+from PySide6.QtCore import QObject, Signal
+
+from ursim_gui.dialogs import show_error
+from ursim_gui.model.jobs import MatchJob, SegmentJob
+from ursim_gui.workers import JobRunner
+
+__all__ = ["JobController", "MatchRequest"]
+
+_log = logging.getLogger(__name__)
+
+
+class JobController(QObject):
+    """Queue of jobs for one session.
+
+    Signals
+    -------
+    busy_changed(bool) : a job started, or the queue emptied
+    """
+
+    busy_changed = Signal(bool)
+
+    def __init__(self, session, status_bar, parent_widget=None):
+        super().__init__(parent_widget)
+        self._session = session
+        self._status = status_bar
+        self._parent = parent_widget
+        self.runner = JobRunner(self)
+        self._queue: deque = deque()
+        self.runner.progress.connect(status_bar.show_progress)
+        self.runner.finished.connect(self._finished)
+        self.runner.failed.connect(self._failed)
+        self.runner.cancelled.connect(self._cancelled)
+        status_bar.cancel_button.clicked.connect(self.cancel)
+
+    @property
+    def busy(self) -> bool:
+        return self.runner.busy or bool(self._queue)
+
+    # ---- requests --------------------------------------------------------------------
+    def segment(self, side: str, preset: str, params: dict | None = None) -> None:
+        """Queue the segmentation of one side's map with a preset and overrides."""
+        map_ = self._session.map(side)
+        if map_ is None:
+            show_error(self._parent, "Cannot segment", f"Open a {side} map first.")
+            return
+        self._enqueue(SegmentJob(map_, preset, params, side=side))
+
+    def match(self, config=None) -> None:
+        """Queue a match of the two segmentations (taken when the job starts)."""
+        self._enqueue(MatchRequest(config))
+
+    def cancel(self) -> None:
+        """Cancel the running job and drop the queued ones."""
+        self._queue.clear()
+        self.runner.cancel()
+        self._status.cancel_button.setEnabled(False)
+        self._status.showMessage("Cancelling…")
+
+    def run_now(self, job) -> object:
+        """Run a job in the calling thread and apply its result (scripted use: --screenshot)."""
+        job = self._resolve(job)
+        if job is None:
+            return None
+        result = job.run(lambda fraction, message="": None, lambda: False)
+        self._apply(job, result)
+        return result
+
+    def wait(self, msecs: int = 120_000) -> None:
+        """Process events until the queue is empty (tests, scripted runs)."""
+        from PySide6.QtCore import QDeadlineTimer, QEventLoop
+        from PySide6.QtWidgets import QApplication
+
+        deadline = QDeadlineTimer(msecs)
+        while self.busy and not deadline.hasExpired():
+            QApplication.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 20)
+
+    # ---- queue ------------------------------------------------------------------------
+    def _enqueue(self, job) -> None:
+        self._queue.append(job)
+        self._start_next()
+
+    def _start_next(self) -> None:
+        while not self.runner.busy and self._queue:
+            job = self._resolve(self._queue.popleft())
+            if job is None:
+                continue
+            self._status.show_job(True)
+            self._status.showMessage(job.description + "…")
+            self.runner.start(job)
+            self.busy_changed.emit(True)
+        if not self.busy:
+            self._status.show_job(False)
+            self.busy_changed.emit(False)
+
+    def _resolve(self, job):
+        if not isinstance(job, MatchRequest):
+            return job
+        sketch, metric = self._session.segmentation("sketch"), self._session.segmentation("metric")
+        if sketch is None or metric is None:
+            show_error(self._parent, "Cannot match", "Segment both maps (or load their label images) first.")
+            self._queue.clear()
+            return None
+        return MatchJob(sketch, metric, job.config)
+
+    def _apply(self, job, result) -> None:
+        if isinstance(job, SegmentJob):
+            self._session.set_segmentation(job.side, result)
+            self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
+        else:
+            self._session.apply_match(result)
+            self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)
+
+    def _finished(self, job, result) -> None:
+        try:
+            self._apply(job, result)
+        finally:
+            self._start_next()
+
+    def _failed(self, job, message: str) -> None:
+        self._queue.clear()
+        self._start_next()
+        show_error(self._parent, "Job failed", f"{job.description} failed:\n{message}")
+
+    def _cancelled(self, job) -> None:
+        _log.info("%s cancelled", job.description)
+        self._queue.clear()
+        self._start_next()
+        self._status.showMessage(f"{job.description} cancelled", 5000)
+
+
+class MatchRequest:
+    """A match request whose inputs are read when it starts (after queued segmentations)."""
+
+    def __init__(self, config):
+        self.config = config

@@ -1,0 +1,239 @@
+"""Main window: composition of the views, panels, menus and controllers. No annotation logic.
+
+Layout: the sketch and metric views side by side in a splitter (with the connector
+overlay over both), the segmentation and matching panels docked on the right, the
+correspondence table, anchors and evaluation docked below.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
+
+from ursim_gui.connectors import ConnectorOverlay
+from ursim_gui.document_controller import DocumentController
+from ursim_gui.edit_commands import EditCommands
+from ursim_gui.job_controller import JobController
+from ursim_gui.map_view import MapView
+from ursim_gui.model.session import AnnotationSession
+from ursim_gui.panels.anchors_list import AnchorsList
+from ursim_gui.panels.correspondence_table import CorrespondenceTable
+from ursim_gui.panels.evaluation_panel import EvaluationPanel
+from ursim_gui.panels.matching_panel import MatchingPanel
+from ursim_gui.panels.segmentation_panel import SegmentationPanel
+from ursim_gui.session_binding import SIDES, ViewBinding
+from ursim_gui.shortcuts import SHORTCUTS, ShortcutSheet, make_action
+from ursim_gui.status_bar import CursorStatusBar
+from ursim_gui.window_tools import WindowTools
+
+__all__ = ["MainWindow"]
+
+_log = logging.getLogger(__name__)
+_TOOLBAR = ("open_sketch", "open_metric", "open_correspondences", "save", None, "undo", "redo", None, "link", "unlink", "accept", "reject", None, "fit", "link_zoom", "connectors")
+_DISPLAY = ("outlines", "region_ids", "graph")
+
+
+class MainWindow(QMainWindow):
+    """The app window over one :class:`AnnotationSession`.
+
+    Parameters
+    ----------
+    data_dir : Path
+        User data folder (autosave files live in ``data_dir / 'autosave'``).
+    session : AnnotationSession, optional
+        The session to show (a new one by default).
+    """
+
+    def __init__(self, data_dir: Path, session: AnnotationSession | None = None):
+        super().__init__()
+        self.setObjectName("main_window")
+        self.session = session if session is not None else AnnotationSession()
+        self.actions = {spec.id: make_action(spec, self) for spec in SHORTCUTS}
+        for action in self.actions.values():
+            self.addAction(action)  # shortcuts work wherever the focus is in the window
+        self.views = {side: MapView(side) for side in SIDES}
+        self._build_centre()
+        self.status = CursorStatusBar(self)
+        self.setStatusBar(self.status)
+        self.documents = DocumentController(self.session, self, data_dir)
+        self.jobs = JobController(self.session, self.status, self)
+        self.binding = ViewBinding(self.session, self.views, self.connectors)
+        self.edits = EditCommands(self.session, self.actions)
+        self.segmentation_panel = SegmentationPanel({key: self.actions[key] for key in _DISPLAY})
+        self.matching_panel = MatchingPanel()
+        self.table = CorrespondenceTable(self.session)
+        self.anchors = AnchorsList(self.session)
+        self.evaluation = EvaluationPanel(self.session)
+        self._build_docks()
+        self._build_menus()
+        self._connect()
+        self.actions["outlines"].setChecked(True)
+        self.actions["connectors"].setChecked(False)
+        self.resize(1600, 980)
+
+    # ---- layout ------------------------------------------------------------------------------
+    def _build_centre(self) -> None:
+        host = QWidget()
+        self.splitter = QSplitter(Qt.Orientation.Horizontal)
+        self.splitter.setChildrenCollapsible(False)
+        self.view_titles = {}
+        for side, view in self.views.items():
+            pane = QWidget()
+            layout = QVBoxLayout(pane)
+            layout.setContentsMargins(2, 2, 2, 2)
+            title = QLabel(side.capitalize())
+            title.setObjectName(f"{side}_title")
+            title.setStyleSheet("font-weight: 600; padding: 2px 4px;")
+            layout.addWidget(title)
+            layout.addWidget(view, 1)
+            self.view_titles[side] = title
+            self.splitter.addWidget(pane)
+        layout = QVBoxLayout(host)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.splitter)
+        self.connectors = ConnectorOverlay(host, self.views["sketch"], self.views["metric"])
+        self.setCentralWidget(host)
+
+    def _dock(self, title: str, widget: QWidget, area, name: str, scroll: bool = False) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(name)
+        if scroll:
+            holder = QScrollArea()
+            holder.setWidgetResizable(True)
+            holder.setWidget(widget)
+            widget = holder
+        dock.setWidget(widget)
+        self.addDockWidget(area, dock)
+        return dock
+
+    def _build_docks(self) -> None:
+        right, bottom = Qt.DockWidgetArea.RightDockWidgetArea, Qt.DockWidgetArea.BottomDockWidgetArea
+        self.docks = {
+            "segmentation": self._dock("Segmentation", self.segmentation_panel, right, "dock_segmentation", scroll=True),
+            "matching": self._dock("Matching", self.matching_panel, right, "dock_matching"),
+            "table": self._dock("Correspondences", self.table, bottom, "dock_table"),
+            "evaluation": self._dock("Evaluation", self.evaluation, bottom, "dock_evaluation"),
+            "anchors": self._dock("Anchors", self.anchors, bottom, "dock_anchors"),
+        }
+        self.tabifyDockWidget(self.docks["evaluation"], self.docks["anchors"])
+        self.docks["evaluation"].raise_()
+        self.resizeDocks([self.docks["table"]], [230], Qt.Orientation.Vertical)
+        self.resizeDocks([self.docks["segmentation"]], [300], Qt.Orientation.Horizontal)
+        self.resizeDocks([self.docks["table"], self.docks["evaluation"]], [900, 400], Qt.Orientation.Horizontal)
+
+    def _build_menus(self) -> None:
+        groups: dict[str, list[str]] = {}
+        for spec in SHORTCUTS:
+            groups.setdefault(spec.group, []).append(spec.id)
+        for group, ids in groups.items():
+            menu = self.menuBar().addMenu(f"&{group}")
+            for action_id in ids:
+                if action_id in ("quit", "link", "fit", "link_zoom", "shortcuts"):
+                    menu.addSeparator()
+                menu.addAction(self.actions[action_id])
+            if group == "View":
+                menu.addSeparator()
+                for dock in self.docks.values():
+                    menu.addAction(dock.toggleViewAction())
+        toolbar = self.addToolBar("Main")
+        toolbar.setObjectName("main_toolbar")
+        toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        for action_id in _TOOLBAR:
+            toolbar.addSeparator() if action_id is None else toolbar.addAction(self.actions[action_id])
+
+    # ---- wiring --------------------------------------------------------------------------------
+    def _connect(self) -> None:
+        a, docs = self.actions, self.documents
+        a["open_sketch"].triggered.connect(lambda: docs.open_map("sketch"))
+        a["open_metric"].triggered.connect(lambda: docs.open_map("metric"))
+        a["open_correspondences"].triggered.connect(lambda: docs.open_correspondences())
+        a["save"].triggered.connect(docs.save)
+        a["save_as"].triggered.connect(lambda: docs.save_as())
+        a["import_dat"].triggered.connect(lambda: docs.import_dat())
+        a["export_dat"].triggered.connect(lambda: docs.export_dat())
+        a["export_figure"].triggered.connect(lambda: self.tools.export_figure())
+        a["new_sketch"].triggered.connect(lambda: self.tools.new_sketch())
+        a["quit"].triggered.connect(self.close)
+        a["shortcuts"].triggered.connect(self.show_shortcuts)
+        a["fit"].triggered.connect(self.fit_views)
+        a["zoom_in"].triggered.connect(lambda: self._zoom_all(1.25))
+        a["zoom_out"].triggered.connect(lambda: self._zoom_all(0.8))
+        a["connectors"].toggled.connect(self.connectors.setVisible)
+        a["outlines"].toggled.connect(lambda on: [v.set_outlines_visible(on) for v in self.views.values()])
+        a["region_ids"].toggled.connect(lambda on: [v.set_ids_visible(on) for v in self.views.values()])
+        a["graph"].toggled.connect(lambda on: [v.set_graph_visible(on) for v in self.views.values()])
+        self.segmentation_panel.opacity_changed.connect(lambda value: [v.set_overlay_opacity(value) for v in self.views.values()])
+        for side, view in self.views.items():
+            view.files_dropped.connect(lambda paths, side=side: docs.open_dropped(side, paths))
+            view.cursor_moved.connect(lambda row, col, side=side: self.tools.show_cursor(side, row, col))
+            view.zoom_changed.connect(lambda factor, side=side: self._zoom_changed(side, factor))
+            box = self.segmentation_panel.boxes[side]
+            box.segment_requested.connect(lambda s, preset, params: self.jobs.segment(s, preset, params))
+            box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
+        self.matching_panel.match_requested.connect(self.jobs.match)
+        self.evaluation.load_requested.connect(lambda: docs.load_reference())
+        self.jobs.busy_changed.connect(lambda _busy: self._update_ready())
+        self.session.segmentation_changed.connect(lambda _side: self._update_ready())
+        self.session.segmentation_changed.connect(self._show_summary)
+        self.session.map_changed.connect(self._show_map_title)
+        self.session.correspondences_changed.connect(lambda *_: self.matching_panel.show_result(self.session.last_match))
+        self.tools = WindowTools(self)
+        self._update_ready()
+
+    def _zoom_changed(self, side: str, factor: float) -> None:
+        self.status.show_zoom(factor)
+        if self.actions["link_zoom"].isChecked():
+            other = self.views[SIDES[1 - SIDES.index(side)]]
+            other.set_zoom(factor)  # set_zoom is a no-op at an equal factor, so no ping-pong
+
+    def _zoom_all(self, step: float) -> None:
+        for view in self.views.values():
+            view.set_zoom(view.zoom_factor() * step)
+
+    def fit_views(self) -> None:
+        for view in self.views.values():
+            view.fit_to_window()
+
+    def _update_ready(self) -> None:
+        segmented = all(self.session.segmentation(side) is not None for side in SIDES)
+        self.matching_panel.set_ready(segmented and not self.jobs.busy)
+        for side, box in self.segmentation_panel.boxes.items():
+            box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
+
+    def _show_summary(self, side: str) -> None:
+        segmentation = self.session.segmentation(side)
+        text = "no segmentation" if segmentation is None else f"{segmentation.n_regions} regions ({segmentation.method})"
+        self.segmentation_panel.boxes[side].set_summary(text)
+
+    def _show_map_title(self, side: str) -> None:
+        map_ = self.session.map(side)
+        text = side.capitalize() if map_ is None else f"{side.capitalize()}: {map_.name}  ({map_.shape[0]}×{map_.shape[1]} px)"
+        self.view_titles[side].setText(text)
+        self._update_ready()
+
+    def show_shortcuts(self) -> ShortcutSheet:
+        sheet = ShortcutSheet(self)
+        sheet.open()
+        return sheet
+
+    # ---- inputs and closing ----------------------------------------------------------------------
+    def open_inputs(self, sketch=None, metric=None, correspondences=None, *, example: bool = False, wait: bool = False) -> bool:
+        """Open maps and/or correspondences given on the command line (see ``WindowTools``)."""
+        return self.tools.open_inputs(sketch, metric, correspondences, example=example, wait=wait)
+
+    def discard_and_close(self) -> None:
+        """Close without asking about unsaved changes (scripted runs)."""
+        self._discard_on_close = True
+        self.close()
+
+    def closeEvent(self, event) -> None:
+        if not getattr(self, "_discard_on_close", False) and not self.documents.confirm_discard("closing"):
+            event.ignore()
+            return
+        self.jobs.cancel()
+        self.jobs.runner.wait(10_000)
+        self.documents.close_document()
+        event.accept()

@@ -1,0 +1,275 @@
+"""Autosave and crash recovery of the correspondences being edited.
+
+While a document has unsaved changes, :class:`Autosaver` keeps a copy in
+``<folder>/<id>.autosave.json``: a normal correspondence file (atomic write) with one
+extra top-level key, ``"autosave_of"``, the absolute path of the document it belongs to
+(null for an untitled one), so that recovery can reopen the right maps and offer to save
+to the right file. The copy disappears when the document becomes clean (saved, or
+undone back to the saved state) and when the window closes normally; a copy found at
+start-up therefore means the last run ended in a crash.
+
+Writes are debounced: an edit marks the copy stale (:meth:`Autosaver.mark_dirty`), and
+the view's timer calls :meth:`Autosaver.flush_if_due` with the current time. Time is
+always passed in (``time.monotonic()`` in the app), so tests control it exactly.
+
+The folder is, by priority: the constructor argument, ``$URSIM_AUTOSAVE_DIR``,
+``$URSIM_GUI_DATA_DIR/autosave`` (the app's data folder), then the platform's user data
+folder (``~/.local/share/ursim-studio/autosave`` on Linux).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import os
+import sys
+import time
+import uuid
+from collections.abc import Callable
+from pathlib import Path
+
+from ursim_core.correspondences import Correspondences, load_correspondences, save_correspondences
+from ursim_gui.model.session import AUTOSAVE_ORIGIN_KEY, AnnotationSession
+
+__all__ = [
+    "AUTOSAVE_SUFFIX",
+    "AUTOSAVE_DIR_ENV",
+    "Autosaver",
+    "default_autosave_folder",
+    "find_recoverable",
+    "recover",
+    "recover_with_origin",
+    "discard",
+]
+
+AUTOSAVE_SUFFIX = ".autosave.json"
+AUTOSAVE_DIR_ENV = "URSIM_AUTOSAVE_DIR"
+_APP_DATA_ENV = "URSIM_GUI_DATA_DIR"
+_APP_FOLDER = "ursim-studio"
+
+
+def default_autosave_folder() -> Path:
+    """Where autosave files go when no folder is given (see the module docstring).
+
+    Examples
+    --------
+    >>> default_autosave_folder().name
+    'autosave'
+    """
+    override = os.environ.get(AUTOSAVE_DIR_ENV)
+    if override:
+        return Path(override)
+    app_data = os.environ.get(_APP_DATA_ENV)
+    if app_data:
+        return Path(app_data) / "autosave"
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Application Support"
+    else:
+        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    return base / _APP_FOLDER / "autosave"
+
+
+def find_recoverable(folder: str | os.PathLike | None = None) -> list[Path]:
+    """Autosave files in ``folder`` (default: :func:`default_autosave_folder`), newest first.
+
+    A missing folder simply has none.
+    """
+    folder = default_autosave_folder() if folder is None else Path(folder)
+    if not folder.is_dir():
+        return []
+    found = [path for path in folder.glob(f"*{AUTOSAVE_SUFFIX}") if path.is_file()]
+
+    def modified(path: Path) -> float:
+        try:
+            return path.stat().st_mtime
+        except OSError:
+            return 0.0
+
+    return sorted(found, key=lambda path: (-modified(path), path.name))
+
+
+def recover(path: str | os.PathLike) -> Correspondences:
+    """Read an autosave file.
+
+    The value still carries ``extra["autosave_of"]`` (the document it belongs to);
+    :meth:`AnnotationSession.restore` uses and removes it. Use
+    :func:`recover_with_origin` to get the clean value and the path separately.
+
+    Raises
+    ------
+    ursim_core.errors.FormatError
+        The file is unreadable or not a correspondence file.
+    """
+    return load_correspondences(path)
+
+
+def recover_with_origin(path: str | os.PathLike) -> tuple[Correspondences, Path | None]:
+    """Read an autosave file: (correspondences without the autosave key, original document or None)."""
+    corr = load_correspondences(path)
+    extra = dict(corr.extra)
+    origin = extra.pop(AUTOSAVE_ORIGIN_KEY, None)
+    origin_path = Path(origin) if isinstance(origin, str) and origin else None
+    return dataclasses.replace(corr, extra=extra), origin_path
+
+
+def discard(path: str | os.PathLike) -> None:
+    """Delete an autosave file (no error when it is already gone)."""
+    Path(path).unlink(missing_ok=True)
+
+
+class Autosaver:
+    """Keeps an autosave copy of a session's unsaved correspondences.
+
+    Parameters
+    ----------
+    session : AnnotationSession
+        Watched through its ``correspondences_changed``, ``dirty_changed`` and
+        ``path_changed`` signals.
+    folder : str or Path, optional
+        Where the copy goes (created on first write); see :func:`default_autosave_folder`.
+    delay_s : float, keyword-only
+        Quiet time after the last edit before the copy is written.
+    max_delay_s : float, keyword-only
+        Longest time an edit may stay unsaved while edits keep coming (a continuous
+        stream of edits must not postpone the copy forever).
+    clock : callable, keyword-only
+        ``() -> float`` seconds, the time base of edits marked through the signals; must
+        be the one the caller passes to :meth:`flush_if_due` (``time.monotonic`` by
+        default, as the app's timer).
+
+    Notes
+    -----
+    The file name is stable per document: a hash of the document's path, or a random id
+    for an untitled document, so a crash leaves one file per open document.
+    """
+
+    def __init__(
+        self,
+        session: AnnotationSession,
+        folder: str | os.PathLike | None = None,
+        *,
+        delay_s: float = 2.0,
+        max_delay_s: float = 30.0,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.session = session
+        self.folder = default_autosave_folder() if folder is None else Path(folder)
+        self.delay_s = float(delay_s)
+        self.max_delay_s = max(float(max_delay_s), self.delay_s)
+        self._clock = clock
+        self._untitled_id = uuid.uuid4().hex[:16]
+        self._first_pending: float | None = None
+        self._last_pending: float | None = None
+        self._written: Path | None = None
+        self._closed = False
+        session.correspondences_changed.connect(self._on_correspondences_changed)
+        session.dirty_changed.connect(self._on_dirty_changed)
+        session.path_changed.connect(self._on_path_changed)
+
+    # ------------------------------------------------------------------ state
+    @property
+    def path(self) -> Path:
+        """The file this session's copy is (or would be) written to."""
+        document = self.session.path
+        if document is None:
+            name = f"untitled-{self._untitled_id}"
+        else:
+            digest = hashlib.sha256(str(document).encode("utf-8")).hexdigest()[:16]
+            name = f"{document.stem}-{digest}"
+        return self.folder / f"{name}{AUTOSAVE_SUFFIX}"
+
+    @property
+    def pending(self) -> bool:
+        """True when edits happened since the last write."""
+        return self._last_pending is not None
+
+    @property
+    def written_path(self) -> Path | None:
+        """The copy currently on disk, if any."""
+        return self._written
+
+    # ------------------------------------------------------------------ debouncing
+    def mark_dirty(self, now: float) -> None:
+        """Record an edit at time ``now`` (seconds); the copy is due ``delay_s`` later."""
+        if self._first_pending is None:
+            self._first_pending = now
+        self._last_pending = now
+
+    def due(self, now: float) -> bool:
+        """True when a pending copy should be written at time ``now``."""
+        if self._last_pending is None:
+            return False
+        return now - self._last_pending >= self.delay_s or now - self._first_pending >= self.max_delay_s
+
+    def flush_if_due(self, now: float) -> bool:
+        """Write the copy if it is due; True when a write (or a removal) happened.
+
+        Raises
+        ------
+        OSError
+            The write failed. The edit stays pending and is retried after another
+            ``delay_s``; the caller logs the failure (autosave must not interrupt the user).
+        """
+        if self._closed or not self.due(now):
+            return False
+        try:
+            self.flush()
+        except OSError:
+            # Back off instead of failing again on every timer tick.
+            self._first_pending = self._last_pending = now
+            raise
+        return True
+
+    def flush(self) -> None:
+        """Write the copy now if the session is dirty, else remove any copy."""
+        self._first_pending = self._last_pending = None
+        if not self.session.dirty:
+            self.discard()
+            return
+        corr = self.session.correspondences
+        document = self.session.path
+        extra = {**corr.extra, AUTOSAVE_ORIGIN_KEY: None if document is None else str(document)}
+        target = self.path
+        self.folder.mkdir(parents=True, exist_ok=True)
+        # ``now`` keeps the document's own timestamps: the copy must be the value in the
+        # session, not a re-stamped one.
+        save_correspondences(dataclasses.replace(corr, extra=extra), target, now=corr.modified)
+        if self._written is not None and self._written != target:
+            discard(self._written)
+        self._written = target
+
+    def discard(self) -> None:
+        """Remove this session's copy (after a successful save or a deliberate discard)."""
+        for path in {self._written, self.path} - {None}:
+            discard(path)
+        self._written = None
+        self._first_pending = self._last_pending = None
+
+    def close(self) -> None:
+        """Clean shutdown: remove the copy and stop watching the session."""
+        if self._closed:
+            return
+        self.discard()
+        self._closed = True
+        self.session.correspondences_changed.disconnect(self._on_correspondences_changed)
+        self.session.dirty_changed.disconnect(self._on_dirty_changed)
+        self.session.path_changed.disconnect(self._on_path_changed)
+
+    # ------------------------------------------------------------------ session signals
+    def _on_correspondences_changed(self) -> None:
+        self.mark_dirty(self._clock())
+
+    def _on_dirty_changed(self, dirty: bool) -> None:
+        if not dirty:
+            # Saved, or undone back to the saved state: nothing left to recover.
+            self.discard()
+
+    def _on_path_changed(self, _path) -> None:
+        # The copy's name follows the document; a copy under the old name is obsolete.
+        if self._written is not None and self._written != self.path:
+            discard(self._written)
+            self._written = None
+            if self.session.dirty:
+                self.mark_dirty(self._clock())

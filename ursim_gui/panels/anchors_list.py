@@ -1,0 +1,39 @@
+"""Anchors of the last match: a list of (sketch region, metric region); click selects both."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QLabel, QListWidget, QListWidgetItem, QVBoxLayout, QWidget
+
+__all__ = ["AnchorsList"]
+
+
+class AnchorsList(QWidget):
+    """Lists ``session.anchors``; clicking an entry selects its two regions in the session."""
+
+    def __init__(self, session, parent=None):
+        super().__init__(parent)
+        self._session = session
+        self.list = QListWidget()
+        self.list.setObjectName("anchors_list")
+        self.hint = QLabel("Unique regions matched first; drawn with a dashed outline.")
+        self.hint.setWordWrap(True)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.hint)
+        layout.addWidget(self.list)
+        self.list.itemClicked.connect(self._select)
+        session.correspondences_changed.connect(self.refresh)
+        self.refresh()
+
+    def refresh(self, *_args) -> None:
+        self.list.clear()
+        for sketch, metric in self._session.anchors:
+            item = QListWidgetItem(f"sketch {sketch}  ↔  metric {metric}")
+            item.setData(Qt.ItemDataRole.UserRole, (int(sketch), int(metric)))
+            self.list.addItem(item)
+
+    def _select(self, item: QListWidgetItem) -> None:
+        sketch, metric = item.data(Qt.ItemDataRole.UserRole)
+        self._session.select("sketch", [sketch])
+        self._session.select("metric", [metric])

@@ -1,0 +1,152 @@
+"""Correspondence table: a QAbstractTableModel adapter over the session and its view.
+
+Rows are the session's cliques in file order. The adapter reads the session on every
+change signal (it keeps no copy of the annotations); selecting a row selects the clique
+in the session, and a selection made elsewhere (a click in a map) selects the row.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QAbstractTableModel, QItemSelectionModel, QModelIndex, Qt
+from PySide6.QtGui import QColor
+from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView, QVBoxLayout, QWidget
+
+
+__all__ = ["CorrespondenceTableModel", "CorrespondenceTable", "COLUMNS"]
+
+COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval")
+_MARK_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
+_STATUS_COLOURS = {"accepted": QColor(30, 120, 60), "rejected": QColor(170, 40, 40), "pending": QColor(120, 120, 120)}
+
+
+def _regions_text(regions) -> str:
+    return ", ".join(str(r) for r in regions) or "–"
+
+
+class CorrespondenceTableModel(QAbstractTableModel):
+    """Read-only table of the session's cliques."""
+
+    def __init__(self, session, parent=None):
+        super().__init__(parent)
+        self._session = session
+        self._cliques = tuple(session.correspondences.cliques)
+        session.correspondences_changed.connect(self.refresh)
+        session.reference_changed.connect(self.refresh)
+
+    def refresh(self, *_args) -> None:
+        """Re-read the cliques and evaluation marks from the session."""
+        self.beginResetModel()
+        self._cliques = tuple(self._session.correspondences.cliques)
+        self.endResetModel()
+
+    def rowCount(self, parent=QModelIndex()) -> int:
+        return 0 if parent.isValid() else len(self._cliques)
+
+    def columnCount(self, parent=QModelIndex()) -> int:
+        return 0 if parent.isValid() else len(COLUMNS)
+
+    def headerData(self, section: int, orientation, role=Qt.ItemDataRole.DisplayRole):
+        if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.DisplayRole:
+            return COLUMNS[section]
+        return None
+
+    def data(self, index: QModelIndex, role=Qt.ItemDataRole.DisplayRole):
+        if not index.isValid():
+            return None
+        clique = self._cliques[index.row()]
+        column = index.column()
+        if role == Qt.ItemDataRole.DisplayRole:
+            return self._text(clique, column)
+        if role == Qt.ItemDataRole.DecorationRole and column == 0:
+            return QColor(*self._session.color_of_clique(clique.id))
+        if role == Qt.ItemDataRole.ForegroundRole:
+            if column == 6:
+                return _MARK_COLOURS.get(self._mark(clique.id))
+            if column == 5:
+                return _STATUS_COLOURS.get(clique.effective_status)
+        if role == Qt.ItemDataRole.UserRole:
+            return clique.id
+        if role == Qt.ItemDataRole.ToolTipRole and clique.note:
+            return clique.note
+        return None
+
+    def _text(self, clique, column: int) -> str:
+        if column == 0:
+            return str(clique.id)
+        if column == 1:
+            return _regions_text(clique.sketch_regions)
+        if column == 2:
+            return _regions_text(clique.metric_regions)
+        if column == 3:
+            return clique.source
+        if column == 4:
+            return "" if clique.score is None else f"{clique.score:.3g}"
+        if column == 5:
+            return clique.effective_status
+        return self._mark(clique.id)
+
+    def _mark(self, clique_id: int) -> str:
+        status = self._session.clique_status(clique_id)
+        return status.upper() if status else ""
+
+    def clique_id(self, row: int) -> int:
+        return self._cliques[row].id
+
+    def row_of(self, clique_id: int | None) -> int:
+        """Row of a clique id, -1 when absent."""
+        for row, clique in enumerate(self._cliques):
+            if clique.id == clique_id:
+                return row
+        return -1
+
+
+class CorrespondenceTable(QWidget):
+    """The table view, kept in sync with the session's selected clique both ways."""
+
+    def __init__(self, session, parent=None):
+        super().__init__(parent)
+        self._session = session
+        self.model = CorrespondenceTableModel(session, self)
+        self.view = QTableView()
+        self.view.setObjectName("correspondence_table")
+        self.view.setModel(self.model)
+        self.view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.view.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.view.verticalHeader().setVisible(False)
+        self.view.verticalHeader().setDefaultSectionSize(22)
+        self.view.setAlternatingRowColors(True)
+        header = self.view.horizontalHeader()
+        header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        header.setStretchLastSection(True)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.view)
+        self._syncing = False
+        self.view.selectionModel().selectionChanged.connect(self._row_selected)
+        self.model.modelReset.connect(self.show_session_selection)
+        session.selection_changed.connect(self.show_session_selection)
+
+    def _row_selected(self, *_args) -> None:
+        if self._syncing:
+            return
+        rows = self.view.selectionModel().selectedRows()
+        clique_id = self.model.clique_id(rows[0].row()) if rows else None
+        if clique_id != self._session.selected_clique:
+            self._session.select_clique(clique_id)
+
+    def show_session_selection(self, *_args) -> None:
+        """Select the row of the session's selected clique (none when there is none)."""
+        row = self.model.row_of(self._session.selected_clique)
+        self._syncing = True
+        try:
+            selection = self.view.selectionModel()
+            if row < 0:
+                selection.clearSelection()
+            else:
+                index = self.model.index(row, 0)
+                flags = QItemSelectionModel.SelectionFlag.ClearAndSelect | QItemSelectionModel.SelectionFlag.Rows
+                selection.select(index, flags)
+                self.view.scrollTo(index)
+        finally:
+            self._syncing = False

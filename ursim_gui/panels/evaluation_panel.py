@@ -1,0 +1,86 @@
+"""Evaluation panel: load a reference (.json or .dat), live precision / recall / F1, misses.
+
+The score is the session's (recomputed by the model on every change); the panel only
+shows it. Loading the file is the main window's job (it owns dialogs and errors).
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import QFormLayout, QGroupBox, QHBoxLayout, QLabel, QListWidget, QPushButton, QVBoxLayout, QWidget
+
+__all__ = ["EvaluationPanel", "format_regions"]
+
+
+def format_regions(regions) -> str:
+    """``{3, 1}`` -> ``'1, 3'``."""
+    return ", ".join(str(r) for r in sorted(regions))
+
+
+class EvaluationPanel(QWidget):
+    """Shows the session's evaluation against its reference.
+
+    Signals
+    -------
+    load_requested() : the user wants to pick a reference file
+    """
+
+    load_requested = Signal()
+
+    def __init__(self, session, parent=None):
+        super().__init__(parent)
+        self._session = session
+        box = QGroupBox("Evaluation against a reference")
+        self.load_button = QPushButton("Load reference…")
+        self.load_button.setObjectName("eval_load")
+        self.clear_button = QPushButton("Clear")
+        self.clear_button.setObjectName("eval_clear")
+        buttons = QHBoxLayout()
+        buttons.addWidget(self.load_button)
+        buttons.addWidget(self.clear_button)
+        self.source = QLabel("no reference loaded")
+        self.source.setWordWrap(True)
+        self.values = {name: QLabel("–") for name in ("precision", "recall", "f1", "counts")}
+        for name, label in self.values.items():
+            label.setObjectName(f"eval_{name}")
+        form = QFormLayout()
+        form.addRow("Precision", self.values["precision"])
+        form.addRow("Recall", self.values["recall"])
+        form.addRow("F1", self.values["f1"])
+        form.addRow("TP / FP / FN", self.values["counts"])
+        self.missed = QListWidget()
+        self.missed.setObjectName("eval_missed")
+        inner = QVBoxLayout(box)
+        inner.addLayout(buttons)
+        inner.addWidget(self.source)
+        inner.addLayout(form)
+        inner.addWidget(QLabel("Missed reference cliques (sketch ↔ metric)"))
+        inner.addWidget(self.missed, 1)
+        layout = QVBoxLayout(self)
+        layout.addWidget(box)
+        self.load_button.clicked.connect(self.load_requested)
+        self.clear_button.clicked.connect(lambda: self._session.clear_reference())
+        session.reference_changed.connect(self.refresh)
+        session.correspondences_changed.connect(self.refresh)
+        self.refresh()
+
+    def refresh(self, *_args) -> None:
+        """Re-read the score, the reference and the misses from the session."""
+        reference = self._session.reference
+        score = self._session.evaluation
+        self.clear_button.setEnabled(reference is not None)
+        if reference is None or score is None:
+            self.source.setText("no reference loaded")
+            for label in self.values.values():
+                label.setText("–")
+            self.missed.clear()
+            return
+        self.source.setText(f"{len(reference)} reference cliques")
+        self.values["precision"].setText(f"{score.precision:.3f}")
+        self.values["recall"].setText(f"{score.recall:.3f}")
+        self.values["f1"].setText(f"{score.f1:.3f}")
+        self.values["counts"].setText(f"{score.tp} / {score.fp} / {score.fn}")
+        self.missed.clear()
+        for index in self._session.missed_reference():
+            sketch, metric = reference[index]
+            self.missed.addItem(f"{format_regions(sketch)}  ↔  {format_regions(metric)}")

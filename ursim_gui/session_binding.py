@@ -1,0 +1,123 @@
+"""Binds the session to the two map views: model signals -> drawing, view input -> model calls.
+
+The binding holds no annotation state. It re-reads the session when it signals a change
+and draws with the pure helpers of :mod:`ursim_gui.view_state`; clicks become
+``session.select`` calls. Hover is purely visual: it only re-draws the cheap highlight
+layer of the other view.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtGui import QColor
+
+from ursim_gui.view_state import eval_badges, first_regions, side_colour_table
+
+__all__ = ["ViewBinding", "SIDES"]
+
+SIDES = ("sketch", "metric")
+_BADGE_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
+
+
+class ViewBinding:
+    """Keeps ``views[side]`` and the connector overlay in step with ``session``.
+
+    Parameters
+    ----------
+    session : AnnotationSession
+    views : dict of side -> MapView
+    connectors : ConnectorOverlay
+    """
+
+    def __init__(self, session, views: dict, connectors):
+        self.session = session
+        self.views = views
+        self.connectors = connectors
+        session.map_changed.connect(self._map_changed)
+        session.segmentation_changed.connect(self._segmentation_changed)
+        session.correspondences_changed.connect(self._correspondences_changed)
+        session.selection_changed.connect(self._selection_changed)
+        session.reference_changed.connect(self._badges_changed)
+        for side, view in views.items():
+            view.region_hovered.connect(lambda region, side=side: self.hover(side, region))
+            view.region_clicked.connect(lambda region, additive, side=side: self.click(side, region, additive))
+        for side in SIDES:
+            self._map_changed(side)
+
+    # ---- view input -> model -------------------------------------------------------------
+    def click(self, side: str, region: int, additive: bool) -> None:
+        """A click on ``region`` (0 = background).
+
+        Ctrl-click adds the region to the selection (keeping the selected clique, so L
+        adds to it). A plain click on a matched region selects its clique (both sides
+        and the table row); on an unmatched one it selects the region on its side,
+        keeping the other side's selection, so click-click-L links a pair. A plain
+        click on the background clears the selection.
+        """
+        if region <= 0:
+            if not additive:
+                self.session.clear_selection()
+            return
+        if additive:
+            self.session.select(side, [region], add=True)
+            return
+        cliques = self.session.clique_of(side, region)
+        if cliques:
+            self.session.select_clique(cliques[0])
+        else:
+            self.session.select(side, [region])
+
+    def hover(self, side: str, region: int) -> None:
+        """Highlight the partners of ``region`` in the other view (nothing for 0)."""
+        other = SIDES[1 - SIDES.index(side)]
+        self.views[other].set_highlight(self.session.partners(side, region) if region > 0 else ())
+
+    # ---- model -> views ------------------------------------------------------------------------
+    def _map_changed(self, side: str) -> None:
+        map_ = self.session.map(side)
+        view = self.views[side]
+        if map_ is None:
+            view.set_image(None)
+            return
+        grey = map_.image if map_.image is not None else np.where(map_.free, 255, 0).astype(np.uint8)
+        view.set_image(grey)
+        self._segmentation_changed(side)
+
+    def _segmentation_changed(self, side: str) -> None:
+        segmentation = self.session.segmentation(side)
+        view = self.views[side]
+        if segmentation is None:
+            view.set_segmentation(None, None)
+        else:
+            view.set_segmentation(segmentation.labels, segmentation.graph)
+        self._paint(side)
+
+    def _correspondences_changed(self, *_args) -> None:
+        for side in SIDES:
+            self._paint(side)
+
+    def _selection_changed(self, *_args) -> None:
+        selection = self.session.selection
+        for side in SIDES:
+            self.views[side].set_selection(selection.get(side, ()))
+
+    def _badges_changed(self, *_args) -> None:
+        for side in SIDES:
+            badges = eval_badges(self.session.correspondences, side, self.session.clique_status)
+            self.views[side].set_badges({region: (mark, _BADGE_COLOURS[mark]) for region, mark in badges.items()})
+
+    def _paint(self, side: str) -> None:
+        """Recolour one side, re-mark its anchors and selection, refresh links and badges."""
+        segmentation = self.session.segmentation(side)
+        view = self.views[side]
+        if segmentation is not None:
+            table = side_colour_table(self.session.correspondences, side, segmentation.labels, self.session.color_of_clique)
+            view.set_region_colours(table)
+            index = SIDES.index(side)
+            view.set_anchors({pair[index] for pair in self.session.anchors})
+            view.set_selection(self.session.selection.get(side, ()))
+        self._badges_changed()
+        self.connectors.set_links(
+            (sketch, metric, self.session.color_of_clique(clique_id))
+            for clique_id, sketch, metric in first_regions(self.session.correspondences)
+        )

@@ -1,0 +1,110 @@
+"""Every keyboard shortcut and mouse gesture of the app, and the F1 sheet that lists them.
+
+:data:`SHORTCUTS` is the single source of truth: the main window creates its actions
+from it and the sheet displays it, so the sheet cannot drift from the real bindings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import QDialog, QDialogButtonBox, QHeaderView, QTableWidget, QTableWidgetItem, QVBoxLayout
+
+__all__ = ["ActionSpec", "SHORTCUTS", "MOUSE_GESTURES", "make_action", "ShortcutSheet"]
+
+
+@dataclass(frozen=True)
+class ActionSpec:
+    """One user command: id, menu text, key sequences (first is shown) and what it does."""
+
+    id: str
+    text: str
+    keys: tuple[str, ...]
+    description: str
+    group: str
+    checkable: bool = False
+
+
+SHORTCUTS: tuple[ActionSpec, ...] = (
+    ActionSpec("new_sketch", "&New sketch…", ("Ctrl+N",), "Draw a sketch on a blank canvas", "File"),
+    ActionSpec("open_sketch", "Open &sketch…", (), "Open the sketch map (image or ROS YAML)", "File"),
+    ActionSpec("open_metric", "Open &metric map…", (), "Open the metric map (image or ROS YAML)", "File"),
+    ActionSpec("open_correspondences", "&Open correspondences…", ("Ctrl+O",), "Open a correspondence JSON and its maps", "File"),
+    ActionSpec("save", "&Save", ("Ctrl+S",), "Save the correspondences", "File"),
+    ActionSpec("save_as", "Save &as…", ("Ctrl+Shift+S",), "Save the correspondences to a new file", "File"),
+    ActionSpec("import_dat", "&Import .dat…", (), "Replace the correspondences by a legacy .dat file", "File"),
+    ActionSpec("export_dat", "&Export .dat…", (), "Write the correspondences as a legacy .dat file", "File"),
+    ActionSpec("export_figure", "Export &figure…", ("Ctrl+E",), "PNG of both maps with the matches and a legend", "File"),
+    ActionSpec("quit", "&Quit", ("Ctrl+Q",), "Close the window (asks to save changes)", "File"),
+    ActionSpec("undo", "&Undo", ("Ctrl+Z",), "Undo the last edit", "Edit"),
+    ActionSpec("redo", "&Redo", ("Ctrl+Shift+Z", "Ctrl+Y"), "Redo the last undone edit", "Edit"),
+    ActionSpec("link", "&Link selected regions", ("L",), "New clique of the selected regions (or add them to the selected clique)", "Edit"),
+    ActionSpec("unlink", "U&nlink region", ("U",), "Remove the selected region(s) from their cliques", "Edit"),
+    ActionSpec("delete_clique", "&Delete clique", ("Delete",), "Delete the selected clique", "Edit"),
+    ActionSpec("accept", "&Accept clique", ("A",), "Mark the selected clique accepted", "Edit"),
+    ActionSpec("reject", "Re&ject clique", ("R",), "Mark the selected clique rejected", "Edit"),
+    ActionSpec("clear_selection", "Clear selection", ("Esc",), "Deselect all regions", "Edit"),
+    ActionSpec("fit", "&Fit to window", ("F",), "Fit both maps to their views", "View"),
+    ActionSpec("zoom_in", "Zoom &in", ("Ctrl++", "Ctrl+="), "Zoom both views in", "View"),
+    ActionSpec("zoom_out", "Zoom &out", ("Ctrl+-",), "Zoom both views out", "View"),
+    ActionSpec("link_zoom", "&Linked zoom", ("Ctrl+K",), "Zoom both views together", "View", checkable=True),
+    ActionSpec("connectors", "&Connector lines", ("C",), "Draw lines between matched regions", "View", checkable=True),
+    ActionSpec("outlines", "Region &outlines", ("O",), "Show region outlines", "View", checkable=True),
+    ActionSpec("region_ids", "Region &ids", ("I",), "Show region ids", "View", checkable=True),
+    ActionSpec("graph", "Adjacency &graph", ("G",), "Show the region adjacency graph", "View", checkable=True),
+    ActionSpec("shortcuts", "&Keyboard shortcuts", ("F1",), "This sheet", "Help"),
+)
+
+MOUSE_GESTURES: tuple[tuple[str, str], ...] = (
+    ("Click", "Select a region (and its clique)"),
+    ("Ctrl+Click", "Add a region to the selection"),
+    ("Wheel", "Zoom around the cursor"),
+    ("Drag / middle drag", "Pan"),
+    ("Hover", "Highlight the partner regions in the other view"),
+    ("Drop a file", "Open it as this view's map"),
+)
+
+
+def make_action(spec: ActionSpec, parent) -> QAction:
+    """A QAction for ``spec`` with its shortcuts, tooltip and object name (``action_<id>``)."""
+    action = QAction(spec.text, parent)
+    action.setObjectName(f"action_{spec.id}")
+    action.setShortcuts([QKeySequence(key) for key in spec.keys])
+    action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
+    action.setCheckable(spec.checkable)
+    keys = f" ({spec.keys[0]})" if spec.keys else ""
+    action.setToolTip(f"{spec.description}{keys}")
+    action.setStatusTip(spec.description)
+    return action
+
+
+class ShortcutSheet(QDialog):
+    """The F1 dialog: one row per shortcut and mouse gesture, grouped by menu."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setWindowTitle("Keyboard shortcuts")
+        self.setObjectName("shortcut_sheet")
+        rows = [(s.group, " or ".join(QKeySequence(k).toString(QKeySequence.SequenceFormat.NativeText) for k in s.keys), s.description) for s in SHORTCUTS if s.keys]
+        rows += [("Mouse", gesture, what) for gesture, what in MOUSE_GESTURES]
+        self.table = QTableWidget(len(rows), 3, self)
+        self.table.setHorizontalHeaderLabels(["Group", "Keys", "Action"])
+        for row, values in enumerate(rows):
+            for column, value in enumerate(values):
+                self.table.setItem(row, column, QTableWidgetItem(value))
+        self.table.verticalHeader().setVisible(False)
+        self.table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.table.horizontalHeader().setStretchLastSection(True)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close, self)
+        buttons.rejected.connect(self.reject)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.table)
+        layout.addWidget(buttons)
+        self.resize(620, 640)
+
+    def key_texts(self) -> list[str]:
+        """The Keys column (for tests and accessibility checks)."""
+        return [self.table.item(row, 1).text() for row in range(self.table.rowCount())]

@@ -1,0 +1,58 @@
+"""Qt-free helpers that turn session state into what the views draw.
+
+Pure functions of values the session exposes; they derive nothing that is stored, and
+every rule about cliques (partners, TP/FP marks, misses) stays in the session.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ursim_gui.overlay import NEUTRAL_REGION, Colour, region_colour_table
+
+__all__ = ["side_colour_table", "first_regions", "eval_badges"]
+
+
+def side_colour_table(
+    correspondences, side: str, labels: np.ndarray, colour_of: Callable[[int], Colour], *, alpha: int = 255
+) -> np.ndarray:
+    """Colour lookup table of one side's label image.
+
+    Without cliques every region gets its own palette colour (segmentation view). With
+    cliques, a region of a clique takes the clique's colour (``colour_of(id)``, the same
+    in both views) and the other regions are neutral grey so the matches stand out;
+    rejected cliques stay grey.
+    """
+    max_label = int(labels.max()) if labels.size else 0
+    if not correspondences.cliques:
+        return region_colour_table(max_label, alpha=alpha)
+    colours: dict[int, Colour] = {}
+    for clique in correspondences.cliques:
+        if clique.effective_status == "rejected":
+            continue
+        for region in getattr(clique, f"{side}_regions"):
+            colours.setdefault(region, colour_of(clique.id))  # the first clique wins
+    return region_colour_table(max_label, colours, default=NEUTRAL_REGION, alpha=alpha)
+
+
+def first_regions(correspondences) -> list[tuple[int, int, int]]:
+    """(clique id, first sketch region, first metric region) of cliques with both sides and
+    not rejected: where connector lines go."""
+    return [
+        (clique.id, clique.sketch_regions[0], clique.metric_regions[0])
+        for clique in correspondences.cliques
+        if clique.sketch_regions and clique.metric_regions and clique.effective_status != "rejected"
+    ]
+
+
+def eval_badges(correspondences, side: str, status_of: Callable[[int], str | None]) -> dict[int, str]:
+    """'TP' / 'FP' tag per region of ``side``: on each marked clique's first region."""
+    badges: dict[int, str] = {}
+    for clique in correspondences.cliques:
+        mark = status_of(clique.id)
+        regions = getattr(clique, f"{side}_regions")
+        if mark and regions:
+            badges.setdefault(regions[0], mark.upper())
+    return badges

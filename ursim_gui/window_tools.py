@@ -1,0 +1,156 @@
+"""Main-window commands that open a tool or dialog: new sketch, label image, figure, inputs.
+
+Split from :mod:`ursim_gui.main_window` so that module stays pure composition.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from PySide6.QtWidgets import QDialog, QFileDialog
+
+from ursim_core.errors import UrsimError
+from ursim_gui import dialogs
+from ursim_gui.figure_export import export_figure
+from ursim_gui.sketch_canvas import SketchSizeDialog, SketchWindow
+
+__all__ = ["WindowTools", "example_inputs"]
+
+_log = logging.getLogger(__name__)
+_DEFAULT_PRESETS = {"sketch": "sketch", "metric": "robot"}
+
+
+def example_inputs() -> tuple[Path, Path, Path | None] | None:
+    """(sketch, metric, reference) of the bundled example, or None when it is missing."""
+    from ursim_gui.app import EXAMPLE_DIR
+
+    sketch, metric = EXAMPLE_DIR / "sketch.png", EXAMPLE_DIR / "metric.png"
+    if not (sketch.is_file() and metric.is_file()):
+        return None
+    reference = EXAMPLE_DIR / "ground_truth.json"
+    return sketch, metric, reference if reference.is_file() else None
+
+
+class WindowTools:
+    """Commands of ``window`` (a :class:`~ursim_gui.main_window.MainWindow`)."""
+
+    def __init__(self, window):
+        self.window = window
+        self.session = window.session
+        self.sketch_windows: list[SketchWindow] = []
+
+    # ---- sketching ---------------------------------------------------------------------
+    def new_sketch(self, size: tuple[int, int] | None = None) -> SketchWindow | None:
+        """Open a drawing window; asks for the size unless ``size`` (rows, cols) is given."""
+        if size is None:
+            dialog = SketchSizeDialog(self.window)
+            if dialog.exec() != QDialog.DialogCode.Accepted:
+                return None
+            size = dialog.size_rc()
+        sketch = SketchWindow(*size, parent=self.window)
+        sketch.use_as_sketch.connect(self.use_as_sketch)
+        self.sketch_windows.append(sketch)
+        sketch.show()
+        return sketch
+
+    def use_as_sketch(self, image) -> None:
+        from ursim_core.maps import map_from_array
+
+        try:
+            self.session.set_map("sketch", map_from_array(image))
+        except (UrsimError, ValueError) as error:
+            dialogs.show_error(self.window, "Cannot use the sketch", str(error))
+
+    # ---- segmentation input --------------------------------------------------------------------
+    def load_label_image(self, side: str, path: Path | None = None) -> bool:
+        """Use a label image (0 = no region) as ``side``'s segmentation instead of segmenting."""
+        from ursim_core.segmentation import load_label_image
+
+        map_ = self.session.map(side)
+        if map_ is None:
+            dialogs.show_error(self.window, "No map", f"Open the {side} map before its label image.")
+            return False
+        if path is None:
+            chosen, _ = QFileDialog.getOpenFileName(self.window, f"Load {side} label image", "", "Label images (*.png *.tif *.tiff)")
+            if not chosen:
+                return False
+            path = Path(chosen)
+        try:
+            self.session.set_segmentation(side, load_label_image(path, shape=map_.shape))
+        except (UrsimError, OSError) as error:
+            dialogs.show_error(self.window, "Cannot load the label image", str(error))
+            return False
+        return True
+
+    # ---- figure and status --------------------------------------------------------------------
+    def export_figure(self, path: Path | None = None) -> bool:
+        if path is None:
+            chosen, _ = QFileDialog.getSaveFileName(self.window, "Export figure", "figure.png", "PNG image (*.png)")
+            if not chosen:
+                return False
+            path = Path(chosen)
+        views = self.window.views
+        try:
+            export_figure(path, views["sketch"], views["metric"], self.session, connectors=self.window.actions["connectors"].isChecked())
+        except OSError as error:
+            dialogs.show_error(self.window, "Export failed", str(error))
+            return False
+        self.window.statusBar().showMessage(f"Figure written to {path}", 4000)
+        return True
+
+    def show_cursor(self, side: str, row: int, col: int) -> None:
+        map_ = self.session.map(side)
+        world = None
+        if row >= 0 and map_ is not None and map_.resolution is not None and map_.origin is not None:
+            from ursim_core.maps import pixel_to_world
+
+            x, y = pixel_to_world(map_, row, col)
+            world = (float(x), float(y))
+        region = self.window.views[side].region_at(row, col) if row >= 0 else 0
+        self.window.status.show_cursor(side, row, col, world, region)
+
+    # ---- command-line inputs ------------------------------------------------------------------------
+    def open_inputs(self, sketch=None, metric=None, correspondences=None, *, example: bool = False, wait: bool = False) -> bool:
+        """Open what the command line named; with ``example``, the bundled pair.
+
+        Two maps are segmented with the default presets and matched (in the worker, or
+        in this thread with ``wait``). With the example, its ground truth is loaded as
+        the reference so the evaluation is live. Returns False when something failed.
+        """
+        docs, reference = self.window.documents, None
+        if example:
+            found = example_inputs()
+            if found is None:
+                _log.warning("the bundled example (resources/example) is missing; starting empty")
+                return True
+            sketch, metric, reference = found
+        ok = True
+        if correspondences is not None:
+            ok = docs.open_correspondences(Path(correspondences))
+        if sketch is not None and metric is not None:
+            ok = docs.open_map("sketch", Path(sketch)) and docs.open_map("metric", Path(metric)) and ok
+            if ok:
+                self.segment_and_match(wait=wait)
+        if reference is not None and ok:
+            ok = docs.load_reference(reference)
+        return ok
+
+    def segment_and_match(self, *, wait: bool = False) -> None:
+        """Segment both maps with their panel settings, then match."""
+        jobs, panel = self.window.jobs, self.window.segmentation_panel
+        for side in ("sketch", "metric"):
+            box = panel.boxes[side]
+            if wait:
+                from ursim_gui.model.jobs import SegmentJob
+
+                jobs.run_now(SegmentJob(self.session.map(side), box.preset.currentText(), box.overrides(), side=side))
+            else:
+                jobs.segment(side, box.preset.currentText(), box.overrides())
+        config = self.window.matching_panel.config()
+        if wait:
+            from ursim_gui.job_controller import MatchRequest
+
+            jobs.run_now(MatchRequest(config))
+        else:
+            jobs.match(config)
