@@ -287,13 +287,24 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from ursim_core.evaluation import format_tables, run_evaluation, write_report
 
     progress = ProgressBar(1, label="evaluate")
+
+    def report_progress(done: int, total: int, text: str = "") -> None:
+        progress.total, progress.enabled = max(total, 1), total > 1
+        progress(done, total, text)
+
+    legacy: bool | str = {"none": False, "as-built": True, "fnfix": "fnfix"}[args.legacy_scoring]
     result = run_evaluation(
         Path(args.dataset),
         matchers=args.matchers,
         variants=args.variants,
-        legacy_scoring=args.legacy_scoring,
+        preset=args.preset,
+        metric_preset=args.metric_preset,
+        legacy_scoring=legacy,
+        released=args.released,
+        maps=args.maps,
         workers=args.workers,
-        progress=lambda done, total, text="": (setattr(progress, "total", total), setattr(progress, "enabled", True), progress(done, total, text)),
+        cache_dir=args.cache,
+        progress=report_progress,
     )
     print(format_tables(result))
     if args.output:
@@ -358,10 +369,17 @@ def build_parser() -> argparse.ArgumentParser:
     ev = sub("evaluate", "Run the paper's experiments on a dataset folder and write a report.", cmd_evaluate)
     ev.add_argument("dataset", metavar="DATASET")
     ev.add_argument("-o", "--output", metavar="REPORT", help="report folder (CSV, plots, summary.md)")
-    ev.add_argument("--matchers", nargs="+", default=["planar", "hungarian", "vf2"])
-    ev.add_argument("--variants", nargs="+", default=["baseline", "T1", "T2", "T3", "T4"])
-    ev.add_argument("--legacy-scoring", action="store_true",
-                    help="reproduce the released scorer (false negatives dropped), to explain the paper's figures")
+    ev.add_argument("--matchers", nargs="+", default=["planar", "hungarian", "vf2"], choices=["planar", "hungarian", "vf2"])
+    ev.add_argument("--variants", nargs="+", default=["baseline", "T1", "T2", "T3", "T4"], choices=["baseline", "T1", "T2", "T3", "T4"])
+    ev.add_argument("--legacy-scoring", nargs="?", const="as-built", default="none", choices=["none", "as-built", "fnfix"],
+                    help="reproduce the released scorer: 'as-built' (default when given: false negatives dropped, "
+                         "explains the paper's figures) or 'fnfix' (its flag initialised)")
+    ev.add_argument("--released", action="store_true",
+                    help="every released-code option on (segmentation, binarisation, statistics, weights, rotations)")
+    ev.add_argument("--preset", help="segmentation preset of the sketches / input maps (default sketch, robot for robot maps)")
+    ev.add_argument("--metric-preset", help="segmentation preset of the model map (default robot)")
+    ev.add_argument("--maps", nargs="+", metavar="NAME", help="only these maps (e.g. 00 03 17)")
+    ev.add_argument("--cache", metavar="DIR", help="cache segmentations in DIR between runs")
     ev.add_argument("--workers", type=int, default=2, help="processes (default 2)")
 
     conv = sub("convert", "Convert correspondences between the original .dat files and JSON.", cmd_convert)

@@ -42,6 +42,7 @@ import hashlib
 import io
 import json
 import math
+import os
 import statistics
 import time
 from collections.abc import Callable, Iterable, MutableMapping, Sequence
@@ -497,6 +498,7 @@ def run_evaluation(
     ...     print(result.summary("malcolm", "planar", "T4", "oracle").mean)
     """
     from ursim_core.matching import MatchConfig
+    from ursim_core.segmentation import resolve_params
 
     started = time.perf_counter()
     matchers = _checked_choice(matchers, MATCHERS, "matchers")
@@ -505,7 +507,7 @@ def run_evaluation(
     legacy_mode = _scoring_mode(legacy_scoring)
     workers = max(1, int(workers))
 
-    if isinstance(dataset_dir, (str, Path)):
+    if isinstance(dataset_dir, (str, os.PathLike)):
         dataset = Path(dataset_dir)
         experiments = discover(dataset)
     else:
@@ -525,9 +527,12 @@ def run_evaluation(
 
     base_config = MatchConfig.released() if released else MatchConfig()
     overrides = dict(config_overrides or {})
-    for reserved in ("variant", "matcher", "m"):
-        if reserved in overrides:
-            raise ParameterError(f"'{reserved}' is set by the runner; use the matchers/variants/m_grid options", field="config_overrides")
+    known = {f.name for f in dataclasses.fields(MatchConfig)}
+    for name in overrides:
+        if name in ("variant", "matcher", "m", "m_grid"):
+            raise ParameterError(f"'{name}' is set by the runner; use the matchers/variants/m_grid options", field="config_overrides")
+        if name not in known:
+            raise ParameterError(f"unknown matching option '{name}' (known: {', '.join(sorted(known))})", field="config_overrides")
     base_config = dataclasses.replace(base_config, m_grid=tuple(m_grid), **overrides)
 
     load_options = {
@@ -536,16 +541,20 @@ def run_evaluation(
     }
     # Per experiment (same order): the (input map, model map) segmentation jobs.
     input_jobs: list[tuple[_SegmentationJob, _SegmentationJob]] = []
+    digests: dict[Path, str] = {}
     for experiment in experiments:
         input_preset = preset or ("ursim-released" if released else ("sketch" if experiment.layout == "kth" else "robot"))
         model_preset = metric_preset or ("ursim-released" if released else "robot")
         input_jobs.append(
             (
-                _SegmentationJob(experiment.sketch, input_preset, load_options),
-                _SegmentationJob(experiment.metric, model_preset, load_options),
+                _SegmentationJob.of(experiment.sketch, input_preset, load_options, digests),
+                _SegmentationJob.of(experiment.metric, model_preset, load_options, digests),
             )
         )
     distinct_jobs = list(dict.fromkeys(job for pair in input_jobs for job in pair))
+    for preset_name in sorted({job.preset for job in distinct_jobs}):
+        # An unknown preset is reported now, not by a worker process after other maps ran.
+        resolve_params("maoris", preset_name)
 
     n_tasks = len(experiments) * len(matchers) * len(variants)
     total_steps = len(distinct_jobs) + n_tasks + (1 if human else 0)
@@ -560,7 +569,7 @@ def run_evaluation(
     tasks = [
         _MatchTask(
             name=experiment.name,
-            model=experiment.metric.stem,
+            model=_model_label(experiment),
             sketch_key=jobs[0].key,
             metric_key=jobs[1].key,
             matcher=matcher,
@@ -617,6 +626,18 @@ def run_evaluation(
         timings=timings,
         notes=tuple(notes),
     )
+
+
+def _model_label(experiment: Experiment) -> str:
+    """The model map as a path inside the dataset without suffix (``model/model_simple``,
+    ``GT/Malcolm/model_simple``): unique where the file names are not."""
+    metric = Path(experiment.metric)
+    if experiment.dataset is not None:
+        try:
+            return metric.relative_to(experiment.dataset).with_suffix("").as_posix()
+        except ValueError:
+            pass
+    return metric.stem
 
 
 def _checked_choice(values: Sequence[str], allowed: Sequence[str], name: str) -> list[str]:
@@ -685,19 +706,33 @@ class _Progress:
 
 @dataclass(frozen=True)
 class _SegmentationJob:
-    path: Path
+    """One map to segment. Equal jobs (same file content, preset and loading) share a result,
+    so a model stored under two names (Halmstad: GT/Malcolm/model_simple.png = E5_08.png) and a
+    map used by several experiments are segmented once."""
+
+    path: Path = field(compare=False)
+    digest: str
     preset: str
-    load: dict = field(hash=False, compare=False)
+    load_key: str
+
+    @classmethod
+    def of(cls, path: Path, preset: str, load: dict, digests: dict[Path, str]) -> "_SegmentationJob":
+        path = Path(path)
+        if path not in digests:
+            try:
+                digests[path] = hashlib.sha256(path.read_bytes()).hexdigest()
+            except OSError:
+                # load_map reports the real problem, naming the file, when the map is loaded.
+                digests[path] = f"unreadable:{path.resolve()}"
+        return cls(path=path, digest=digests[path], preset=preset, load_key=json.dumps(load, sort_keys=True))
 
     @property
     def key(self) -> str:
-        return f"{Path(self.path).resolve()}|{self.preset}|{json.dumps(self.load, sort_keys=True)}"
+        return f"{self.digest}|{self.preset}|{self.load_key}"
 
-    def __hash__(self) -> int:
-        return hash(self.key)
-
-    def __eq__(self, other) -> bool:
-        return isinstance(other, _SegmentationJob) and self.key == other.key
+    @property
+    def load(self) -> dict:
+        return json.loads(self.load_key)
 
 
 def _segment_job(job: _SegmentationJob):
@@ -705,26 +740,19 @@ def _segment_job(job: _SegmentationJob):
     from ursim_core.maps import load_map
     from ursim_core.segmentation import segment
 
-    started = time.perf_counter()
-    loaded = load_map(job.path, **job.load)
-    segmentation = segment(loaded, preset=job.preset)
-    return segmentation, loaded.sha256, time.perf_counter() - started
+    return segment(load_map(job.path, **job.load), preset=job.preset)
 
 
-def _file_digest(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-def _disk_cache_path(cache_dir: Path, job: _SegmentationJob, digest: str) -> Path:
+def _disk_cache_path(cache_dir: Path, job: _SegmentationJob) -> Path:
     from ursim_core.segmentation import resolve_params
 
     # The resolved parameters (not only the preset name) go in the key, so a changed preset
     # definition invalidates the cache.
     identity = json.dumps(
-        {"sha256": digest, "params": resolve_params("maoris", job.preset), "load": job.load, "version": 1},
+        {"sha256": job.digest, "params": resolve_params("maoris", job.preset), "load": job.load, "version": 1},
         sort_keys=True,
     )
-    return cache_dir / f"{Path(job.path).stem}-{hashlib.sha256(identity.encode()).hexdigest()[:24]}.npz"
+    return cache_dir / f"{job.path.stem}-{hashlib.sha256(identity.encode()).hexdigest()[:24]}.npz"
 
 
 def _read_disk_cache(path: Path, job: _SegmentationJob):
@@ -735,7 +763,7 @@ def _read_disk_cache(path: Path, job: _SegmentationJob):
         with np.load(path) as stored:
             labels = stored["labels"].astype(np.int32)
     except (OSError, KeyError, ValueError):
-        # A damaged or foreign cache file is only a cache miss.
+        # A missing, damaged or foreign cache file is only a cache miss.
         return None
     return Segmentation(labels=labels, graph=region_graph(labels), method="maoris", params=resolve_params("maoris", job.preset))
 
@@ -754,41 +782,33 @@ def _write_disk_cache(path: Path, segmentation) -> None:
 
 
 def _segment_all(jobs, workers: int, reporter: _Progress, memory_cache, cache_dir):
-    """Segmentations by job key; biggest maps first so both workers finish together."""
+    """Segmentations by job key, from the caches or computed biggest map first."""
     segmentations: dict[str, Any] = {}
     cache_folder = None if cache_dir is None else Path(cache_dir)
-    digests = {}
     to_run = []
     for job in jobs:
-        digest = _file_digest(job.path) if (memory_cache is not None or cache_folder is not None) else ""
-        digests[job.key] = digest
-        memory_key = (job.key, digest)
-        if memory_cache is not None and memory_key in memory_cache:
-            segmentations[job.key] = memory_cache[memory_key]
-            reporter.step(f"segment {Path(job.path).name} (cached)")
-            continue
-        if cache_folder is not None:
-            found = _read_disk_cache(_disk_cache_path(cache_folder, job, digest), job)
-            if found is not None:
-                segmentations[job.key] = found
-                if memory_cache is not None:
-                    memory_cache[memory_key] = found
-                reporter.step(f"segment {Path(job.path).name} (cached)")
-                continue
-        to_run.append(job)
+        found = None
+        if memory_cache is not None:
+            found = memory_cache.get(job.key)
+        if found is None and cache_folder is not None:
+            found = _read_disk_cache(_disk_cache_path(cache_folder, job), job)
+            if found is not None and memory_cache is not None:
+                memory_cache[job.key] = found
+        if found is None:
+            to_run.append(job)
+        else:
+            segmentations[job.key] = found
+            reporter.step(f"segment {job.path.name} (cached)")
     cached = len(jobs) - len(to_run)
+    # Biggest maps first so the workers finish together.
     to_run.sort(key=lambda job: -_pixel_count(job.path))
-
-    def finished(job, segmentation):
+    for job, segmentation in _completed(_segment_job, to_run, workers=workers):
         segmentations[job.key] = segmentation
         if memory_cache is not None:
-            memory_cache[(job.key, digests[job.key])] = segmentation
+            memory_cache[job.key] = segmentation
         if cache_folder is not None:
-            _write_disk_cache(_disk_cache_path(cache_folder, job, digests[job.key]), segmentation)
-        reporter.step(f"segment {Path(job.path).name}: {segmentation.n_regions} regions")
-
-    for job, (segmentation, _digest, _seconds) in _completed(_segment_job, to_run, workers=workers):
-        finished(job, segmentation)
+            _write_disk_cache(_disk_cache_path(cache_folder, job), segmentation)
+        reporter.step(f"segment {job.path.name}: {segmentation.n_regions} regions")
     return segmentations, cached
 
 
@@ -796,8 +816,8 @@ def _completed(function, items, *, workers: int, initializer=None, initargs=()):
     """Yield ``(item, function(item))`` as each finishes, on ``workers`` processes.
 
     With one worker (or one item) everything runs here, in order, with no process start-up
-    cost; ``initializer`` only concerns worker processes. On an error or an interruption the pending items are cancelled before it propagates,
-    so a failure does not wait for the rest of the work.
+    cost; ``initializer`` only concerns worker processes. On an error or an interruption the
+    pending items are cancelled before it propagates, so a failure does not wait for the rest.
     """
     if workers <= 1 or len(items) < 2:
         for item in items:
@@ -988,7 +1008,7 @@ def _human_rows(experiments, input_jobs, segmentations, references, legacy_mode)
                         n_sketch_regions=sketch_seg.n_regions,
                         n_metric_regions=metric_seg.n_regions,
                         time_s=0.0,
-                        model=experiment.metric.stem,
+                        model=_model_label(experiment),
                         n_pairs=len(score.pairs),
                         scoring=score.mode,
                     )

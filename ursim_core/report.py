@@ -456,7 +456,8 @@ def _published_markdown(result) -> list[str]:
 
 def _png(figure) -> bytes:
     buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
+    # The layout is already tight (tight_layout); bbox_inches="tight" would draw everything twice.
+    figure.savefig(buffer, format="png", dpi=100)
     import matplotlib.pyplot as plt
 
     plt.close(figure)
@@ -522,8 +523,8 @@ def plot_f1_vs_m(result) -> bytes:
 
     handles.append(Line2D([], [], color="grey", linestyle="--"))
     labels.append("automatic m (mean)")
-    figure.legend(handles, labels, loc="upper center", ncol=len(labels), frameon=False, bbox_to_anchor=(0.5, 1.02))
-    figure.tight_layout(rect=(0, 0, 1, 0.96))
+    figure.legend(handles, labels, loc="upper center", ncol=len(labels), frameon=False, bbox_to_anchor=(0.5, 1.0))
+    figure.tight_layout(rect=(0, 0, 1, 1 - 0.35 / figure.get_figheight()))
     return _png(figure)
 
 
@@ -587,8 +588,8 @@ def plot_boxplots(result) -> bytes:
         axis.set_title(f"F1 per map, {_CHOICE_TITLES[choice]}", fontsize=10)
         axis.grid(axis="y", alpha=0.3)
     figure.legend(*axes[0][0].get_legend_handles_labels(), loc="upper center", ncol=len(annotators), frameon=False,
-                  fontsize=9, bbox_to_anchor=(0.5, 1.01))
-    figure.tight_layout(rect=(0, 0, 1, 0.97))
+                  fontsize=9, bbox_to_anchor=(0.5, 1.0))
+    figure.tight_layout(rect=(0, 0, 1, 1 - 0.3 / figure.get_figheight()))
     return _png(figure)
 
 

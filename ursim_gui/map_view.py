@@ -177,7 +177,7 @@ class MapView(QGraphicsView):
 
     def set_anchors(self, regions) -> None:
         """Mark the anchor regions of the last match with a dashed outline."""
-        self._set_marks("anchors", {r: (QColor(0, 0, 0, 0), QColor(150, 20, 150), Qt.PenStyle.DashLine) for r in regions})
+        self._set_marks("anchors", {r: (QColor(0, 0, 0, 0), QColor(120, 0, 140), Qt.PenStyle.DashLine) for r in regions})
 
     def marked_regions(self, kind: str) -> set[int]:
         """Regions currently drawn as ``kind`` ('highlight', 'selection' or 'anchors')."""

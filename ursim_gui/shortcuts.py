@@ -71,6 +71,9 @@ def make_action(spec: ActionSpec, parent) -> QAction:
     """A QAction for ``spec`` with its shortcuts, tooltip and object name (``action_<id>``)."""
     action = QAction(spec.text, parent)
     action.setObjectName(f"action_{spec.id}")
+    # Toolbar label fixed once: menu texts such as "Undo Link sketch 3 to metric 5"
+    # change with the history and would make the toolbar jump.
+    action.setIconText(spec.text.replace("&", "").replace("…", "").split(" selected")[0])
     action.setShortcuts([QKeySequence(key) for key in spec.keys])
     action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
     action.setCheckable(spec.checkable)

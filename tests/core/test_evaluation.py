@@ -233,7 +233,7 @@ def test_runner_produces_one_row_per_map_annotator_matcher_variant_and_m(synthet
     for row in rows:
         assert 0.0 <= row.f1 <= 1.0 and row.scoring == "correct"
         assert row.n_sketch_regions == 3 and row.n_metric_regions == 3
-        assert row.model == "model_simple" and row.time_s >= 0
+        assert row.model == "model/model_simple" and row.time_s >= 0
         if row.m_label != "auto":
             assert row.m_value == float(row.m_label)
         if row.tp:
@@ -269,7 +269,8 @@ def test_runner_settings_and_timings(synthetic_result, synthetic_dataset):
     assert settings["m_grid"] == list(GRID) and settings["scoring"] == "correct"
     assert settings["presets_used"] == ["robot"]
     assert settings["dataset"] == str(synthetic_dataset)
-    assert synthetic_result.timings["maps"] == 3
+    # sketches/copy.png has the model's bytes: with the same preset it is segmented once.
+    assert synthetic_result.timings["maps"] == 2
     assert synthetic_result.notes == ()
 
 
@@ -291,16 +292,16 @@ def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_p
     options = dict(matchers=["hungarian"], variants=["T1", "T2"], m_grid=(0.1,), preset="robot", workers=1,
                    segmentation_cache=cache, cache_dir=tmp_path / "segcache")
     first = run_evaluation(synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options)
-    total = 3 + 2 * 2 + 1  # maps segmented + (experiment x variant) tasks + human vs human
+    total = 2 + 2 * 2 + 1  # distinct maps + (experiment x variant) tasks + human vs human
     assert [c[0] for c in calls] == list(range(1, total + 1)) and {c[1] for c in calls} == {total}
     assert any(text.startswith("segment") for _, _, text in calls) and calls[-1][2] == "human vs human"
-    assert first.timings["maps_from_cache"] == 0 and len(cache) == 3
-    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 3
+    assert first.timings["maps_from_cache"] == 0 and len(cache) == 2
+    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 2
 
     in_memory = run_evaluation(synthetic_dataset, **options)
-    assert in_memory.timings["maps_from_cache"] == 3
+    assert in_memory.timings["maps_from_cache"] == 2
     on_disk = run_evaluation(synthetic_dataset, **{**options, "segmentation_cache": None})
-    assert on_disk.timings["maps_from_cache"] == 3
+    assert on_disk.timings["maps_from_cache"] == 2
     assert [r.f1 for r in on_disk.rows] == [r.f1 for r in first.rows]
 
 
@@ -334,6 +335,7 @@ def test_map_selection_and_experiment_list(synthetic_dataset):
         ({"m_grid": (0.1, 0.1)}, "m_grid"),
         ({"maps": ["nope"]}, "maps"),
         ({"config_overrides": {"m": 0.2}}, "config_overrides"),
+        ({"config_overrides": {"no_such_option": 1}}, "config_overrides"),
         ({"legacy_scoring": "sometimes"}, "legacy"),
     ],
 )
@@ -343,9 +345,21 @@ def test_bad_options_are_parameter_errors(synthetic_dataset, options, field):
     assert raised.value.field == field
 
 
-def test_unknown_config_field_is_reported(synthetic_dataset):
-    with pytest.raises(TypeError, match="no_such_option"):
-        run_evaluation(synthetic_dataset, workers=1, config_overrides={"no_such_option": 1})
+def test_unknown_preset_is_reported_before_any_work(synthetic_dataset):
+    calls = []
+    with pytest.raises(ParameterError, match="no_such_preset"):
+        run_evaluation(synthetic_dataset, workers=1, preset="no_such_preset", progress=lambda *a: calls.append(a))
+    assert calls == []
+
+
+def test_config_overrides_reach_the_matcher(synthetic_dataset):
+    options = dict(matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot", workers=1, auto_m=False,
+                   human=False)
+    plain = run_evaluation(synthetic_dataset, **options)
+    assert any(row.seeds > 1 for row in plain.rows)
+    capped = run_evaluation(synthetic_dataset, config_overrides={"max_seeds": 1}, **options)
+    assert all(row.seeds <= 1 for row in capped.rows)
+    assert capped.settings["config"]["max_seeds"] == 1
 
 
 # --------------------------------------------------------------------------- real data
@@ -379,3 +393,29 @@ def test_three_kth_sketches_end_to_end():
     assert set(human) == {("malcolm", "vasiliki"), ("vasiliki", "malcolm")}
     # Two annotators of the same maps agree far more than any matcher does.
     assert all(s.mean > 0.5 for s in human.values())
+
+
+def test_disk_cache_misses_when_a_map_changes(synthetic_dataset, tmp_path):
+    import shutil
+
+    dataset = tmp_path / "dataset"
+    shutil.copytree(synthetic_dataset, dataset)
+    options = dict(matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot", workers=1,
+                   cache_dir=tmp_path / "segcache", auto_m=False, human=False)
+    run_evaluation(dataset, **options)
+    Image.fromarray(_plan(1.2)).save(dataset / "sketches" / "small.png")
+    again = run_evaluation(dataset, **options)
+    assert again.timings["maps"] == 2 and again.timings["maps_from_cache"] == 1
+
+
+def test_an_exception_in_progress_stops_the_worker_pool(synthetic_dataset):
+    class Cancelled(Exception):
+        pass
+
+    def cancel_when_matching(done, total, text):
+        if text.startswith("match"):
+            raise Cancelled(text)
+
+    with pytest.raises(Cancelled):
+        run_evaluation(synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "T1"], m_grid=GRID,
+                       preset="robot", workers=2, progress=cancel_when_matching)

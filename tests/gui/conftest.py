@@ -53,3 +53,66 @@ def grey3(labels3) -> np.ndarray:
 def _user_data_dir(tmp_path, monkeypatch):
     """Keep logs and autosaves of every test in its own temporary folder."""
     monkeypatch.setenv("URSIM_GUI_DATA_DIR", str(tmp_path / "userdata"))
+
+
+def scaled(labels: np.ndarray, factor: int) -> np.ndarray:
+    return np.kron(labels, np.ones((factor, factor), labels.dtype))
+
+
+@pytest.fixture
+def map_files(tmp_path, labels3):
+    """Sketch (60x150) and metric (120x300) PNG maps of three rooms, and their label images.
+
+    Regions are numbered alike on both sides, so the right match is 1-1, 2-2, 3-3.
+    """
+    import cv2
+
+    files = {}
+    for side, labels in (("sketch", labels3), ("metric", scaled(labels3, 2))):
+        image = np.where(labels > 0, 255, 0).astype(np.uint8)
+        files[side] = tmp_path / f"{side}.png"
+        cv2.imwrite(str(files[side]), image)
+        files[f"{side}_labels"] = tmp_path / f"{side}_labels.png"
+        cv2.imwrite(str(files[f"{side}_labels"]), labels.astype(np.uint16))
+    return files
+
+
+@pytest.fixture(autouse=True)
+def _never_block_on_questions(monkeypatch):
+    """Modal questions would hang a test; tests that check them patch their own answer."""
+    from ursim_gui import dialogs
+
+    monkeypatch.setattr(dialogs, "ask_unsaved_changes", lambda parent, what: "discard")
+    monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: None)
+
+
+@pytest.fixture
+def window(qtbot, tmp_path, map_files):
+    """Main window with both maps open and segmented from their label images (no MAORIS)."""
+    from ursim_core.segmentation import load_label_image
+    from ursim_gui.main_window import MainWindow
+
+    win = MainWindow(data_dir=tmp_path / "userdata")
+    qtbot.addWidget(win)
+    win.resize(1400, 900)
+    win.show()
+    qtbot.waitExposed(win)
+    for side in ("sketch", "metric"):
+        win.session.load_map(side, map_files[side])
+        labels = load_label_image(map_files[f"{side}_labels"], shape=win.session.map(side).shape)
+        win.session.set_segmentation(side, labels)
+    yield win
+    win.jobs.cancel()
+    win.jobs.runner.wait(10_000)
+
+
+def region_point(view, region: int):
+    """Viewport position of a region's interior point (to click or hover it)."""
+    return view.mapFromScene(view.region_scene_point(region))
+
+
+def error_boxes(parent):
+    """Visible error dialogs of a window."""
+    from PySide6.QtWidgets import QMessageBox
+
+    return [box for box in parent.findChildren(QMessageBox, "error_box") if box.isVisible()]

@@ -5,9 +5,11 @@ For sweeping m, :func:`prepare` computes everything that does not depend on m on
 anchors, weights, signatures, the ``c`` matrix, neighbour orders) and :func:`match_prepared` runs
 one matcher at one m.
 
-Configuration (:class:`MatchConfig`): the paper's method is the default and every departure of the
-released C++ code is a named option, so both can be measured; :meth:`MatchConfig.released` turns
-every released-code option on. See ``ursim_core.descriptors`` (signatures),
+Configuration (:class:`MatchConfig`): every departure of the released C++ code and every extension
+beyond the paper is a named option, so each can be measured. :meth:`MatchConfig.paper` is the
+paper's method as published, :meth:`MatchConfig.released` turns every released-code option on, and
+the default ``MatchConfig()`` is the paper's method plus the two extensions that the KTH evidence
+supports (position-aware comparison, signature-aware hypothesis score) and the automatic m. See ``ursim_core.descriptors`` (signatures),
 ``ursim_core.matching.planar`` (Algorithm 1), ``ursim_core.matching.baselines`` (Hungarian, VF2)
 and ``ursim_core.matching.auto_m`` (the automatic choice of m, the default, with the evidence for
 it).
@@ -42,6 +44,7 @@ __all__ = [
     "match",
     "seed_pairs",
     "seed_cap",
+    "pair_cost_matrix",
 ]
 
 #: The released driver's sweep: 0, 0.025, ..., 0.475 (20 values).
@@ -91,6 +94,16 @@ class MatchConfig:
     vf2_timeout : float
         Wall-clock budget of the VF2 baseline, seconds.
     signature_method : {'auto', 'eigh', 'expm'}
+    position_weight : float
+        beta in ``c = (c_signature + beta * d_position) / (1 + beta)`` (0 = paper); see
+        :mod:`ursim_core.descriptors`. Assumes the sketch keeps the map's orientation.
+    hypothesis_score : {'signature', 'substitutions', 'structure'}
+        Planar hypothesis score: 'structure' = the released code's structural cost;
+        'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
+        paper's "replace: 1"); 'signature' = plus ``score_weight * sum of c`` over the
+        matched pairs. Also used to score Hungarian and VF2 results.
+    score_weight : float
+        Weight of the pair term of the hypothesis score.
     """
 
     variant: str = "T4"
@@ -105,10 +118,13 @@ class MatchConfig:
     reflections: bool = False
     size_weight_floor: float = SIZE_WEIGHT_FLOOR
     m_grid: tuple = M_GRID
-    auto_rule: str = "cost"
+    auto_rule: str = "score"
     max_seeds: Any = "auto"
     vf2_timeout: float = 2.0
     signature_method: str = "auto"
+    position_weight: float = 0.5
+    hypothesis_score: str = "signature"
+    score_weight: float = 4.0
 
     def __post_init__(self):
         choices = {
@@ -119,6 +135,7 @@ class MatchConfig:
             "disparity": ("paper", "released"),
             "rotation_search": ("min", "first"),
             "signature_method": ("auto", "eigh", "expm"),
+            "hypothesis_score": ("signature", "substitutions", "structure"),
         }
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
@@ -129,6 +146,10 @@ class MatchConfig:
         if self.max_seeds not in ("auto", None) and (not isinstance(self.max_seeds, int) or self.max_seeds < 1):
             raise ParameterError(f"must be 'auto', None or a positive integer, not {self.max_seeds!r}",
                                  field="max_seeds")
+        for name in ("position_weight", "score_weight", "uniqueness_k", "size_weight_floor", "vf2_timeout"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ParameterError(f"must be a non-negative number, not {value!r}", field=name)
         if not self.times:
             raise ParameterError("needs at least one time", field="times")
         if not self.m_grid:
@@ -153,7 +174,28 @@ class MatchConfig:
         'uniqueness'
         """
         values = dict(variant="T4", matcher="planar", m=0.125, standardise="model", weights="uniqueness",
-                      disparity="released", rotation_search="first", reflections=False)
+                      disparity="released", rotation_search="first", reflections=False, position_weight=0.0,
+                      hypothesis_score="structure", score_weight=0.0)
+        values.update(overrides)
+        return cls(**values)
+
+    @classmethod
+    def paper(cls, **overrides) -> "MatchConfig":
+        """The method as the paper describes it.
+
+        Own-map standardisation, standardised sizes as weights, mean-|dz| disparity,
+        minimum-distance rotation, no position term, hypothesis score = structural cost
+        plus 1 per substituted pair (the paper's edit costs), m = 0.15 (the paper's best
+        fixed m, Section 6.4).
+
+        Examples
+        --------
+        >>> MatchConfig.paper().position_weight, MatchConfig.paper().hypothesis_score
+        (0.0, 'substitutions')
+        """
+        values = dict(variant="T4", matcher="planar", m=0.15, standardise="own", weights=None,
+                      disparity="paper", rotation_search="min", reflections=False, position_weight=0.0,
+                      hypothesis_score="substitutions", score_weight=1.0)
         values.update(overrides)
         return cls(**values)
 
@@ -278,7 +320,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig()) -> Prep
             sketch_graph, metric_graph, variant=config.variant, weights=config.weights,
             standardise_with=config.standardise, uniqueness_k=config.uniqueness_k,
             disparity=config.disparity, times=config.times, size_weight_floor=config.size_weight_floor,
-            method=config.signature_method,
+            method=config.signature_method, position_weight=config.position_weight,
         )
         notes.extend(descriptors.notes)
         if config.variant != "baseline" and not descriptors.unique_sketch and not descriptors.unique_metric:
@@ -324,15 +366,32 @@ def seed_cap(max_seeds, n_sketch: int, n_metric: int) -> int | None:
     return max_seeds
 
 
-def _cost_of(prepared: Prepared, index_pairs) -> tuple[float, float]:
+def pair_cost_matrix(config: MatchConfig, c_matrix: np.ndarray, m: float) -> np.ndarray | None:
+    """Per-pair term of the hypothesis score for ``config.hypothesis_score`` (None for 'structure').
+
+    Examples
+    --------
+    >>> pair_cost_matrix(MatchConfig(hypothesis_score="substitutions"), np.array([[0.1, 0.3]]), 0.2).tolist()
+    [[0.0, 1.0]]
+    """
+    if config.hypothesis_score == "structure" or config.score_weight == 0:
+        return None
+    if config.hypothesis_score == "substitutions":
+        return (np.asarray(c_matrix) > m).astype(np.float64)
+    return np.asarray(c_matrix, dtype=np.float64)
+
+
+def _cost_of(prepared: Prepared, index_pairs, pair_costs) -> tuple[float, float]:
     first, second = prepared.sketch_planar, prepared.metric_planar
     total = first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges)
     if not index_pairs:
         return math.inf, 1.0
     from .planar import hypothesis_cost
 
-    cost = hypothesis_cost(first, second, index_pairs)
-    return float(cost), (cost / total if total else 0.0)
+    cost = float(hypothesis_cost(first, second, index_pairs))
+    if pair_costs is not None:
+        cost += prepared.config.score_weight * float(sum(pair_costs[i, j] for i, j in index_pairs))
+    return cost, (cost / total if total else 0.0)
 
 
 def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
@@ -370,6 +429,7 @@ def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
     index_pairs: list = []
     seeds_count = 0
     hypotheses = 0
+    pair_costs = pair_cost_matrix(config, c_matrix, m) if descriptors is not None else None
     if descriptors is not None:
         if config.matcher == "planar":
             seeds = seed_pairs(c_matrix, m, max_seeds=seed_cap(config.max_seeds, *c_matrix.shape))
@@ -379,7 +439,9 @@ def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
             else:
                 same = (c_matrix <= m).tolist()
                 outcome = planar_match(prepared.sketch_planar, prepared.metric_planar, same, seeds=seeds,
-                                       rotation_search=config.rotation_search, reflections=config.reflections)
+                                       rotation_search=config.rotation_search, reflections=config.reflections,
+                                       pair_costs=None if pair_costs is None else pair_costs.tolist(),
+                                       pair_cost_weight=config.score_weight)
                 index_pairs = outcome.pairs
                 hypotheses = outcome.hypotheses
         elif config.matcher == "hungarian":
@@ -397,7 +459,7 @@ def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
                 reasons.append(found.gave_up)
             elif not index_pairs:
                 reasons.append(f"no subgraph isomorphism with c <= m = {m:g}")
-    cost, normalised = _cost_of(prepared, index_pairs)
+    cost, normalised = _cost_of(prepared, index_pairs, pair_costs)
     sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
     pairs = [(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs]
     return MatchResult(

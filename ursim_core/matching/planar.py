@@ -19,6 +19,10 @@ The algorithm follows the released code (``original_code.md`` §1.10 and §1.12)
    + |#edges among matched in G1 - #edges among matched in G2|``.
    The best hypothesis is the one with the lowest cost; ties go to the earliest one (the
    one-pair hypotheses in seed order come first, then expansions in seed order).
+   Option (``pair_costs``, ``pair_cost_weight`` = w): add ``w * sum of pair_costs[v][v']`` over
+   the hypothesis' pairs. With ``pair_costs = (c > m)`` and w = 1 this is the paper's "replace: 1"
+   edit cost, which the released code computes but leaves at 0; with ``pair_costs = c`` it is the
+   signature-aware score of the recommended configuration (see ``ursim_core.matching.auto_m``).
 
 Neighbour order: the released code sorts a region's neighbours by the angle
 ``atan2(n - v) - atan2(first - v)`` in [0, 2 pi) of the region centroids in image coordinates
@@ -84,7 +88,10 @@ class PlanarResult:
     pairs : list of (int, int)
         Best hypothesis as index pairs (sketch index, metric index), in expansion order.
     cost : float
-        Its cost (see the module docstring); ``inf`` when there was no seed.
+        Its score (see the module docstring): the structural cost plus the weighted pair
+        costs when given; ``inf`` when there was no seed.
+    structural_cost : float
+        Its structural cost alone (the released code's score).
     hypotheses : int
         Number of hypotheses scored (one-pair ones included).
     seeds_expanded : int
@@ -98,6 +105,7 @@ class PlanarResult:
     hypotheses: int
     seeds_expanded: int
     alternatives: list = field(default_factory=list)
+    structural_cost: float = math.inf
 
 
 def cyclic_neighbours(graph: nx.Graph, nodes: Sequence) -> list[list[int]]:
@@ -230,6 +238,8 @@ def planar_match(
     rotation_search: str = "min",
     reflections: bool = False,
     keep_alternatives: bool = False,
+    pair_costs: Sequence[Sequence[float]] | None = None,
+    pair_cost_weight: float = 0.0,
 ) -> PlanarResult:
     """Algorithm 1: seed-and-expand planar matching of two region graphs.
 
@@ -250,6 +260,10 @@ def planar_match(
     keep_alternatives : bool
         Also return every expanded hypothesis (for inspection and for rules that
         re-rank them).
+    pair_costs : 2-D sequence of float, optional
+        Cost of matching sketch vertex i to metric vertex j, added to the score with
+        weight ``pair_cost_weight`` (see the module docstring).
+    pair_cost_weight : float
 
     Returns
     -------
@@ -271,9 +285,18 @@ def planar_match(
         return PlanarResult(pairs=[], cost=math.inf, hypotheses=0, seeds_expanded=0)
     n_first, n_second = first.n_vertices, second.n_vertices
     edges_first, edges_second = len(first.edges), len(second.edges)
-    # Every one-pair hypothesis has the same cost; as they come first, the first seed wins among them.
-    best_pairs = [seeds[0]]
-    best_cost = (n_first - 1) + (n_second - 1) + edges_first + edges_second
+    weighted = pair_costs is not None and pair_cost_weight != 0
+
+    def pair_term(pairs):
+        return pair_cost_weight * sum(pair_costs[a][b] for a, b in pairs) if weighted else 0
+
+    # Every one-pair hypothesis has the same structural cost; they come first, so the first seed
+    # wins among them (the first of the lowest pair cost when pair costs are used).
+    single_structure = (n_first - 1) + (n_second - 1) + edges_first + edges_second
+    best_seed = min(seeds, key=lambda seed: pair_term([seed])) if weighted else seeds[0]
+    best_pairs = [best_seed]
+    best_structure = single_structure
+    best_cost = single_structure + pair_term(best_pairs)
     hypotheses = len(seeds)
     consumed = set()
     seeds_expanded = 0
@@ -316,11 +339,13 @@ def planar_match(
         inner_first = sum(1 for v in matched for n in first_sets[v] if n in matched) // 2
         matched_second = set(matched.values())
         inner_second = sum(1 for v in matched_second for n in second_sets[v] if n in matched_second) // 2
-        cost = ((n_first - len(pairs)) + (n_second - len(pairs)) + (edges_first - inner_first)
-                + (edges_second - inner_second) + abs(inner_first - inner_second))
+        structure = ((n_first - len(pairs)) + (n_second - len(pairs)) + (edges_first - inner_first)
+                     + (edges_second - inner_second) + abs(inner_first - inner_second))
+        cost = structure + pair_term(pairs)
         if keep_alternatives:
             alternatives.append((cost, pairs))
-        if cost < best_cost:
-            best_cost, best_pairs = cost, pairs
+        # A small tolerance so that float sums of pair costs do not break the earliest-wins tie rule.
+        if cost < best_cost - 1e-12:
+            best_cost, best_pairs, best_structure = cost, pairs, structure
     return PlanarResult(pairs=best_pairs, cost=best_cost, hypotheses=hypotheses, seeds_expanded=seeds_expanded,
-                        alternatives=alternatives)
+                        alternatives=alternatives, structural_cost=best_structure)

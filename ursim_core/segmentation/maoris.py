@@ -677,7 +677,11 @@ class ZoneGraph:
                 target[neighbour] = edge
                 adj[neighbour][into] = edge
             else:
-                if _EXP.get('existing', True) and minimum is not None and (existing.minimum is None or minimum < existing.minimum):
+                ex = _EXP.get('existing', True)
+                if ex == 'has':
+                    if existing.minimum is not None and minimum is not None and minimum < existing.minimum:
+                        existing.minimum = minimum
+                elif ex and minimum is not None and (existing.minimum is None or minimum < existing.minimum):
                     existing.minimum = minimum
                 existing.unbreakable = existing.unbreakable or old.unbreakable
 
@@ -781,7 +785,21 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     >>> graph.labels.tolist()
     [[1, 1, 1, 1]]
     """
+    if _EXP.get('small_repeat'):
+        _EXP['small_repeat'] = False
+        try:
+            while True:
+                before = len(graph)
+                remove_small_zones(graph, min_size=min_size)
+                if len(graph) == before or not any(graph.size(z) < min_size for z in graph.vertices()):
+                    break
+        finally:
+            _EXP['small_repeat'] = True
+        return graph
     graph.invalidate_contacts()
+    saved = dict(_EXP)
+    if not _EXP.get('small_record', True):
+        _EXP['record'] = False
     for zone in graph.vertices():
         if zone not in graph or graph.size(zone) >= min_size:
             continue
@@ -796,6 +814,7 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
             if closest_gap is None or gap < closest_gap:
                 closest, closest_gap = other, gap
         graph.fuse(zone, closest)
+    _EXP.clear(); _EXP.update(saved)
     return graph
 
 
@@ -825,11 +844,18 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
         for other, edge in graph.adj[zone].items():
             if edge.unbreakable or graph.contact_percent(zone, other) < ripples:
                 continue
+            if _EXP.get('ripple_higher') == 'ge' and graph.value(other) < value:
+                continue
+            if _EXP.get('ripple_higher') == 'gt' and graph.value(other) <= value:
+                continue
             gap = abs(graph.value(other) - value)
             if best is None or gap < best_gap:
                 best, best_gap = other, gap
         if best is not None:
-            queue.extend(graph.adj[zone])
+            if _EXP.get('ripple_nodup'):
+                queue.extend(n for n in graph.adj[zone] if n not in queue)
+            else:
+                queue.extend(graph.adj[zone])
             graph.fuse(zone, best)
     return graph
 
@@ -842,7 +868,8 @@ def mark_unbreakable_edges(graph: ZoneGraph, *, threshold: float) -> ZoneGraph:
     """
     for a in graph.vertices():
         for b, edge in graph.adj[a].items():
-            if edge.minimum is not None and edge.minimum <= max(graph.value(a), graph.value(b)) * (1 - threshold):
+            ref = min(graph.value(a), graph.value(b)) if _EXP.get('unbreak_min') else max(graph.value(a), graph.value(b))
+            if edge.minimum is not None and edge.minimum <= ref * (1 - threshold):
                 edge.unbreakable = True
     return graph
 
@@ -854,6 +881,11 @@ def _similar(a: int, b: int, threshold: float) -> bool:
 
 def _close_neighbour(graph: ZoneGraph, current: int, candidate: int, threshold: float) -> bool:
     value_current, value_candidate = graph.value(current), graph.value(candidate)
+    mode = _EXP.get('close', 'both')
+    if mode == 'cur':
+        return any(_similar(graph.value(m), value_candidate, threshold) for m in graph.adj[current] if m != candidate)
+    if mode == 'cand':
+        return any(_similar(graph.value(m), value_current, threshold) for m in graph.adj[candidate] if m != current)
     if any(_similar(graph.value(m), value_current, threshold) for m in graph.adj[candidate] if m != current):
         return True
     return any(_similar(graph.value(m), value_candidate, threshold) for m in graph.adj[current] if m != candidate)
@@ -892,13 +924,14 @@ def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10)
             for neighbour, edge in edges:
                 if edge.unbreakable or neighbour in visited or neighbour in absorbed:
                     continue
-                visited.add(neighbour)
+                if not _EXP.get('visit_on_absorb'):
+                    visited.add(neighbour)
                 a, b = graph.value(current), graph.value(neighbour)
                 high, low = max(a, b), min(a, b)
                 if low >= high * (1 - threshold) or (
                     low >= high * low_factor and _close_neighbour(graph, current, neighbour, threshold)
                 ):
-                    absorbed.add(neighbour)
+                    absorbed.add(neighbour); visited.add(neighbour)
                     members.append(neighbour)
                     stack.append((neighbour, iter(list(graph.adj[neighbour].items()))))
                     break

@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView, QVBoxL
 
 __all__ = ["CorrespondenceTableModel", "CorrespondenceTable", "COLUMNS"]
 
-COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval")
+COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval", "Note")
 _MARK_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
 _STATUS_COLOURS = {"accepted": QColor(30, 120, 60), "rejected": QColor(170, 40, 40), "pending": QColor(120, 120, 120)}
 
@@ -83,7 +83,9 @@ class CorrespondenceTableModel(QAbstractTableModel):
             return "" if clique.score is None else f"{clique.score:.3g}"
         if column == 5:
             return clique.effective_status
-        return self._mark(clique.id)
+        if column == 6:
+            return self._mark(clique.id)
+        return clique.note
 
     def _mark(self, clique_id: int) -> str:
         status = self._session.clique_status(clique_id)
