@@ -9,11 +9,14 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QMessageBox, QWidget
 
 __all__ = ["show_error", "ask_unsaved_changes", "ask_recover"]
 
 _log = logging.getLogger("ursim_gui")
+#: Parentless error boxes are kept here while shown; Python would otherwise delete them.
+_open_boxes: set[QMessageBox] = set()
 
 
 def show_error(parent: QWidget | None, title: str, message: str) -> QMessageBox:
@@ -21,6 +24,10 @@ def show_error(parent: QWidget | None, title: str, message: str) -> QMessageBox:
     _log.error("%s: %s", title, message)
     box = QMessageBox(QMessageBox.Icon.Critical, title, message, QMessageBox.StandardButton.Ok, parent)
     box.setObjectName("error_box")
+    box.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose, True)
+    if parent is None:
+        _open_boxes.add(box)
+        box.finished.connect(lambda _result: _open_boxes.discard(box))
     box.open()
     return box
 

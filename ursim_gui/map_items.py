@@ -86,6 +86,10 @@ class ImageItem(QGraphicsItem):
     def image(self) -> QImage:
         return self._image
 
+    def pixels(self) -> np.ndarray | None:
+        """The numpy buffer the image points into (edits show after ``update``)."""
+        return self._keepalive
+
     def boundingRect(self) -> QRectF:
         return QRectF(0, 0, self._image.width(), self._image.height())
 

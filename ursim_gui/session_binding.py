@@ -8,6 +8,8 @@ layer of the other view.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from PySide6.QtGui import QColor
 
@@ -33,6 +35,9 @@ class ViewBinding:
         self.session = session
         self.views = views
         self.connectors = connectors
+        # Colours depend on the clique id only; caching saves an HSV conversion per
+        # clique and side on every edit.
+        self._colour_of = functools.lru_cache(maxsize=4096)(session.color_of_clique)
         session.map_changed.connect(self._map_changed)
         session.segmentation_changed.connect(self._segmentation_changed)
         session.correspondences_changed.connect(self._correspondences_changed)
@@ -111,13 +116,14 @@ class ViewBinding:
         segmentation = self.session.segmentation(side)
         view = self.views[side]
         if segmentation is not None:
-            table = side_colour_table(self.session.correspondences, side, segmentation.labels, self.session.color_of_clique)
+            max_label = max(segmentation.graph.nodes, default=0)
+            table = side_colour_table(self.session.correspondences, side, segmentation.labels, self._colour_of, max_label=max_label)
             view.set_region_colours(table)
             index = SIDES.index(side)
             view.set_anchors({pair[index] for pair in self.session.anchors})
             view.set_selection(self.session.selection.get(side, ()))
         self._badges_changed()
         self.connectors.set_links(
-            (sketch, metric, self.session.color_of_clique(clique_id))
+            (sketch, metric, self._colour_of(clique_id))
             for clique_id, sketch, metric in first_regions(self.session.correspondences)
         )

@@ -6,8 +6,6 @@ document owns the pixels, the tools and the undo stack.
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 from PySide6.QtCore import QPoint, QRect, Qt, Signal
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QPainter
@@ -18,18 +16,16 @@ from PySide6.QtWidgets import (
     QFormLayout,
     QLabel,
     QMainWindow,
-    QMessageBox,
     QScrollArea,
     QSpinBox,
     QWidget,
 )
 
+from ursim_gui.dialogs import show_error
 from ursim_gui.map_items import grey_to_qimage
 from ursim_gui.sketch_document import TOOLS, SketchDocument
 
 __all__ = ["SketchSizeDialog", "SketchCanvas", "SketchWindow"]
-
-_log = logging.getLogger(__name__)
 
 
 class SketchSizeDialog(QDialog):
@@ -184,8 +180,7 @@ class SketchWindow(QMainWindow):
         try:
             self.document.save_png(path)
         except OSError as error:
-            _log.error("saving the sketch failed: %s", error)
-            QMessageBox.critical(self, "Save failed", f"The sketch was not saved:\n{error}")
+            show_error(self, "Save failed", f"The sketch was not saved:\n{error}")
             return False
         self.statusBar().showMessage(f"Saved {path}", 4000)
         return True

@@ -16,16 +16,17 @@ __all__ = ["side_colour_table", "first_regions", "eval_badges"]
 
 
 def side_colour_table(
-    correspondences, side: str, labels: np.ndarray, colour_of: Callable[[int], Colour], *, alpha: int = 255
+    correspondences, side: str, labels: np.ndarray, colour_of: Callable[[int], Colour], *, alpha: int = 255, max_label: int | None = None
 ) -> np.ndarray:
     """Colour lookup table of one side's label image.
 
     Without cliques every region gets its own palette colour (segmentation view). With
     cliques, a region of a clique takes the clique's colour (``colour_of(id)``, the same
     in both views) and the other regions are neutral grey so the matches stand out;
-    rejected cliques stay grey.
+    rejected cliques stay grey. ``max_label`` saves a pass over the image when known.
     """
-    max_label = int(labels.max()) if labels.size else 0
+    if max_label is None:
+        max_label = int(labels.max()) if labels.size else 0
     if not correspondences.cliques:
         return region_colour_table(max_label, alpha=alpha)
     colours: dict[int, Colour] = {}

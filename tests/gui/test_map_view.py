@@ -121,3 +121,16 @@ def test_drop_reports_paths(view, tmp_path):
     event = QDropEvent(QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
     view.dropEvent(event)
     assert dropped == [tmp_path / "map.png"]
+
+
+def test_lut_image_equals_the_numpy_overlay(labels3):
+    """The view's one-gather ARGB image shows exactly overlay_rgba's colours."""
+    from ursim_gui.map_items import lut_qimage
+    from ursim_gui.overlay import overlay_rgba
+
+    table = region_colour_table(3, alpha=255)
+    image, _pixels = lut_qimage(labels3, table)
+    expected = overlay_rgba(labels3, table)
+    for row, col in ((0, 0), (10, 10), (30, 75), (40, 120)):
+        colour = image.pixelColor(col, row)
+        assert (colour.red(), colour.green(), colour.blue(), colour.alpha()) == tuple(expected[row, col])

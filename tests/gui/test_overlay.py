@@ -17,7 +17,7 @@ from ursim_gui.overlay import (
     region_label_positions,
     region_mask,
 )
-from ursim_gui.view_state import clique_marks, missed_reference, partner_regions, side_colour_table
+from ursim_gui.view_state import eval_badges, first_regions, side_colour_table
 
 
 def test_colour_table_makes_background_transparent_and_regions_distinct():
@@ -82,22 +82,18 @@ def _corr():
 def test_side_colours_follow_cliques_and_match_across_views():
     labels = three_room_labels()
     corr = _corr()
-    sketch = side_colour_table(corr, "sketch", labels)
-    metric = side_colour_table(corr, "metric", labels)
+    sketch = side_colour_table(corr, "sketch", labels, clique_colour)
+    metric = side_colour_table(corr, "metric", labels, clique_colour)
     assert tuple(sketch[1, :3]) == clique_colour(1) == tuple(metric[3, :3])
     assert tuple(sketch[2, :3]) == NEUTRAL_REGION        # rejected clique is not coloured
     assert tuple(metric[1, :3]) == NEUTRAL_REGION
-    plain = side_colour_table(Correspondences(), "sketch", labels)
+    plain = side_colour_table(Correspondences(), "sketch", labels, clique_colour)
     assert tuple(plain[1, :3]) == palette_colour(1)
 
 
-def test_partners_marks_and_misses():
-    corr = _corr()
-    assert partner_regions(corr, "sketch", [1]) == {3}
-    assert partner_regions(corr, "metric", [3]) == {1}
-    assert partner_regions(corr, "sketch", [3]) == set()
-    reference = [(frozenset({1}), frozenset({3})), (frozenset({3}), frozenset({1}))]
-    assert clique_marks(corr, reference) == {1: "TP"}
-    assert clique_marks(corr, [(frozenset({1}), frozenset({2}))]) == {1: "FP"}
-    assert clique_marks(corr, None) == {}
-    assert missed_reference(corr, reference) == [(frozenset({3}), frozenset({1}))]
+def test_connector_ends_and_badges():
+    corr = Correspondences(cliques=(*_corr().cliques, Clique(id=3, sketch_regions=(3,))))
+    assert first_regions(corr) == [(1, 1, 3)]             # rejected and one-sided cliques: no line
+    marks = {1: "tp", 2: "fp"}
+    assert eval_badges(corr, "sketch", marks.get) == {1: "TP", 2: "FP"}
+    assert eval_badges(corr, "metric", marks.get) == {3: "TP", 2: "FP"}

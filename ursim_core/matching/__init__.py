@@ -22,8 +22,7 @@ disconnected graphs, constant attributes) never raise: the result is valid, poss
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import networkx as nx
@@ -494,7 +493,3 @@ def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig()) -> Mat
     """
     return match_prepared(prepare(sketch_seg, metric_seg, config))
 
-
-def with_m(config: MatchConfig, m: float) -> MatchConfig:
-    """Copy of ``config`` with a fixed m (helper for sweeps)."""
-    return replace(config, m=m)

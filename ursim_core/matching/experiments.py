@@ -36,6 +36,7 @@ __all__ = [
     "score_pairs",
     "f1_table",
     "summarise",
+    "accuracy_report",
 ]
 
 ANNOTATORS = ("malcolm", "vasiliki")
@@ -228,3 +229,51 @@ def summarise(table: dict) -> dict:
         for key in ("oracle", "first", "best_fixed")
     }
     return summary
+
+
+def accuracy_report(dataset_root=None) -> dict:
+    """Print the accuracy figures quoted in ``ursim_core.matching.auto_m`` from the current code.
+
+    Rows: the paper's method, the released options (on the recommended pipeline and, with
+    fnfix scoring, on the released pipeline: the faithfulness check), ablations of the default and
+    the default itself; columns: oracle m, best fixed m, automatic m (mean F1 per annotator).
+
+    Returns
+    -------
+    dict
+        label -> summary (see :func:`summarise`), for the rows that ran.
+    """
+    from dataclasses import replace
+
+    from ..datasets import dataset_root as locate
+    from . import M_GRID, MatchConfig
+
+    root = locate(dataset_root)
+    if root is None:
+        print("accuracy_report: datasets not found, skipped")
+        return {}
+    rows = [
+        ("paper", "recommended", MatchConfig.paper(), True, True, False),
+        ("released options", "recommended", MatchConfig.released(), True, False, False),
+        ("released options, released pipeline, fnfix", "released", MatchConfig.released(), True, False, "fnfix"),
+        ("default, structure score", "recommended", MatchConfig(hypothesis_score="structure"), False, True, False),
+        ("default, no position", "recommended", MatchConfig(position_weight=0.0), False, True, False),
+        ("default", "recommended", MatchConfig(), True, True, False),
+    ]
+    summaries = {}
+    for label, pipeline, config, with_grid, with_auto, legacy in rows:
+        cases = kth_pairs(root, pipeline=pipeline)
+        parts = [label]
+        if with_grid:
+            s = summarise(f1_table(cases, config, M_GRID, legacy=legacy))
+            summaries[label] = s
+            parts.append("oracle " + " / ".join(f"{s[a]['oracle'][0]:.3f}" for a in ANNOTATORS))
+            parts.append("best fixed " + " / ".join(
+                f"{s[a]['best_fixed'][1]:.3f} (m {M_GRID[s[a]['best_fixed'][0]]})" for a in ANNOTATORS))
+        if with_auto:
+            s = summarise(f1_table(cases, replace(config, m="auto"), legacy=legacy))
+            summaries[label + ", auto"] = s
+            parts.append("auto " + " / ".join(
+                f"{s[a]['first'][0]:.3f} (median {s[a]['first'][1]:.3f})" for a in ANNOTATORS))
+        print(" | ".join(parts), flush=True)
+    return summaries

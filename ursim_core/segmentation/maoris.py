@@ -290,13 +290,34 @@ def inscribed_circle_radii(free: np.ndarray, *, max_radius: int = 500) -> np.nda
     free = _as_free_mask(free)
     if int(max_radius) < 1:
         raise ParameterError(f"must be >= 1, got {max_radius!r}", field="max_radius")
-    rows, cols = free.shape
-    out = np.zeros((rows, cols), np.int32)
-    if not free.any():
+    out = np.zeros(free.shape, np.int32)
+    window = _free_bbox(free, margin=1)
+    if window is None:
         return out
+    out[window] = _inscribed_radii_in_window(free[window], int(max_radius))
+    return out
+
+
+def _free_bbox(free: np.ndarray, *, margin: int) -> tuple[slice, slice] | None:
+    """Bounding box of the free pixels grown by ``margin`` (clipped), or None."""
+    rows = np.flatnonzero(free.any(axis=1))
+    if len(rows) == 0:
+        return None
+    cols = np.flatnonzero(free.any(axis=0))
+    return (
+        slice(max(rows[0] - margin, 0), min(rows[-1] + 1 + margin, free.shape[0])),
+        slice(max(cols[0] - margin, 0), min(cols[-1] + 1 + margin, free.shape[1])),
+    )
+
+
+def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:
+    # Cropping to the free pixels' bounding box plus a 1-pixel obstacle margin
+    # leaves the distance transform unchanged (the margin is obstacle, and the
+    # image border is kept where the box touches it).
+    rows, cols = free.shape
     dist = cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
     # Truncate first, then cap: r = min(int(d), max_radius) as the C++ does.
-    radius = np.minimum(dist, float(max_radius)).astype(np.int16 if max_radius < 2**15 else np.int32)
+    radius = np.minimum(dist, float(max_radius)).astype(np.int16 if max_radius < 2**15 - 2 else np.int32)
 
     # A 4-neighbour dominates when its radius is >= r + 1, a diagonal one
     # when >= r + 2 (integer radii, sqrt(2) rounded up).
@@ -465,19 +486,19 @@ class ZoneGraph:
         value = np.zeros(count + 1, np.int64)
         value[zones.ravel()] = values.ravel()
         self._value: list[int] = value.tolist()
-        self._size: list[int] = np.bincount(zones.ravel(), minlength=count + 1).tolist()
-        self._bbox: dict[int, list[int]] = {}
-        for zone, slices in enumerate(ndi.find_objects(zones), start=1):
-            if slices is not None:
-                self._bbox[zone] = [
-                    slices[0].start + _PAD, slices[0].stop + _PAD, slices[1].start + _PAD, slices[1].stop + _PAD
-                ]
-        self.adj: dict[int, dict[int, ZoneEdge]] = {zone: {} for zone in sorted(self._bbox)}
+        sizes = np.bincount(zones.ravel(), minlength=count + 1)
+        self._size: list[int] = sizes.tolist()
+        # Bounding boxes (padded coordinates, max exclusive), computed when first needed.
+        self._bbox: dict[int, list[int]] | None = None
+        self.adj: dict[int, dict[int, ZoneEdge | None]] = {
+            zone: {} for zone in (np.flatnonzero(sizes[1:]) + 1).tolist()
+        }
         self._add_initial_edges(zones)
         self._contacts: dict[int, dict[int, int]] | None = None
         self._n_contour: dict[int, int] = {}
-        # Fusions not yet written into the label image (zone -> receiver, 0 = deleted).
         self._pending: dict[int, int] = {}
+        self._pending_boxes: list[tuple[int, list[int]]] = []
+        self._dirty: set[int] = set()
 
     def _add_initial_edges(self, zones: np.ndarray) -> None:
         rows, cols = zones.shape
@@ -504,10 +525,10 @@ class ZoneGraph:
         unique_codes = codes[first][np.argsort(position[first], kind="stable")]
         base = len(self._value) + 1
         adj = self.adj
+        # None stands for a plain edge (no minimum, breakable) until one is needed.
         for a, b in zip((unique_codes // base).tolist(), (unique_codes % base).tolist()):
-            edge = ZoneEdge()
-            adj[a][b] = edge
-            adj[b][a] = edge
+            adj[a][b] = None
+            adj[b][a] = None
 
     # -- queries ----------------------------------------------------------
 
@@ -526,8 +547,12 @@ class ZoneGraph:
         return list(self.adj[zone])
 
     def edge(self, a: int, b: int) -> ZoneEdge:
-        """Attributes of the edge between ``a`` and ``b``."""
-        return self.adj[a][b]
+        """Attributes of the edge between ``a`` and ``b`` (``adj[a][b]`` may hold None
+        for a plain edge; this materialises it)."""
+        edge = self.adj[a][b]
+        if edge is None:
+            edge = self.adj[a][b] = self.adj[b][a] = ZoneEdge()
+        return edge
 
     def value(self, zone: int) -> int:
         """Quantised value of a zone (it keeps it when other zones are fused into it)."""
@@ -546,6 +571,8 @@ class ZoneGraph:
     def contact_percent(self, zone: int, other: int) -> int:
         """Integer percentage of ``zone``'s contour pixels having ``other`` in their 3x3 neighbourhood."""
         contacts = self._ensure_contacts()
+        if zone in self._dirty:
+            self._flush()
         total = self._n_contour.get(zone, 0)
         if total == 0:
             return 0
@@ -560,7 +587,7 @@ class ZoneGraph:
         labels = self.labels
         first_pixels = []
         for zone in self.adj:
-            r0, r1, c0, c1 = (x - _PAD for x in self._bbox[zone])
+            r0, r1, c0, c1 = (x - _PAD for x in self._boxes()[zone])
             first_row = labels[r0, c0:c1]
             first_pixels.append((r0, c0 + int(np.argmax(first_row == zone)), zone))
         lookup = np.zeros(len(self._value), np.int32)
@@ -569,20 +596,66 @@ class ZoneGraph:
         return lookup[labels]
 
     # -- contacts and relabelling -------------------------------------------
+    #
+    # Fusions are recorded in `_pending` (zone -> receiver, 0 = deleted) and
+    # written into the label image by `_flush`, in one vectorised pass. While
+    # contacts are tracked, a flush also updates the contact counts around the
+    # fused zones, and `_dirty` holds the zones whose counts a pending fusion
+    # may change: a query about one of them flushes first. This batches the
+    # ripple step's many small fusions into few array passes.
 
-    def _flush(self) -> None:
-        if not self._pending:
-            return
+    def _parent_lookup(self) -> np.ndarray:
         parent = np.arange(len(self._value), dtype=np.int32)
         zones = np.fromiter(self._pending.keys(), np.int32, len(self._pending))
         parent[zones] = np.fromiter(self._pending.values(), np.int32, len(self._pending))
         while True:  # resolve chains z -> b -> c
             grand = parent[parent]
             if np.array_equal(grand, parent):
-                break
+                return parent
             parent = grand
-        self._labels = parent[self._labels]
+
+    def _flush(self) -> None:
+        if not self._pending:
+            return
+        parent = self._parent_lookup()
+        if self._contacts is None:
+            self._labels = parent[self._labels]
+        else:
+            affected = np.unique(np.concatenate([self._near_pixels(zone, box) for zone, box in self._pending_boxes]))
+            codes, deltas = _contact_delta(self._labels, affected, parent, len(self._value))
+            self._apply_contact_delta(codes, deltas)
+            flat_labels = self._labels.ravel()
+            flat_labels[affected] = parent[flat_labels[affected]]
+            for zone in self._pending:
+                self._contacts.pop(zone, None)
+                self._n_contour.pop(zone, None)
         self._pending = {}
+        self._pending_boxes = []
+        self._dirty = set()
+
+    def _near_pixels(self, zone: int, box: list[int]) -> np.ndarray:
+        # Flat indices of the zone's pixels and their 8-neighbours: the pixels
+        # whose contour status or 3x3 neighbourhood a relabelling changes.
+        r0, r1, c0, c1 = box
+        crop = self._labels[r0 - 1 : r1 + 1, c0 - 1 : c1 + 1]
+        near = cv2.dilate((crop == zone).view(np.uint8), _KERNEL_3x3)
+        rows, cols = np.nonzero(near)
+        return (rows + r0 - 1) * self._labels.shape[1] + cols + c0 - 1
+
+    def _apply_contact_delta(self, codes: np.ndarray, deltas: np.ndarray) -> None:
+        base = len(self._value)
+        contacts, n_contour = self._contacts, self._n_contour
+        for code, delta in zip(codes.tolist(), deltas.tolist()):
+            a, b = divmod(code, base)
+            if b == 0:
+                n_contour[a] = n_contour.get(a, 0) + delta
+                continue
+            row = contacts.setdefault(a, {})
+            count = row.get(b, 0) + delta
+            if count:
+                row[b] = count
+            else:
+                del row[b]
 
     def _ensure_contacts(self) -> dict[int, dict[int, int]]:
         if self._contacts is None:
@@ -599,45 +672,36 @@ class ZoneGraph:
         return self._contacts
 
     def invalidate_contacts(self) -> None:
-        """Drop contacts; the next query recomputes them for the whole image.
+        """Stop tracking contacts; the next query recomputes them for the whole image.
 
         Cheaper than local updates when many zones are about to be fused.
         """
         self._contacts = None
         self._n_contour = {}
+        self._pending_boxes = []
+        self._dirty = set()
 
-    def _affected_pixels(self, zone: int) -> np.ndarray:
-        # Pixels whose boundary status or 3x3 neighbourhood changes when `zone`
-        # is relabelled: the zone and its 8-neighbours.
-        r0, r1, c0, c1 = self._bbox[zone]
-        crop = self._labels[r0 - 1 : r1 + 1, c0 - 1 : c1 + 1]
-        near = cv2.dilate((crop == zone).view(np.uint8), _KERNEL_3x3)
-        rows, cols = np.nonzero(near)
-        return (rows + r0 - 1) * self._labels.shape[1] + cols + c0 - 1
+    def _boxes(self) -> dict[int, list[int]]:
+        if self._bbox is None:
+            if self._contacts is None:
+                self._flush()
+            # (While contacts are tracked, boxes exist before any fusion is pending.)
+            self._bbox = {}
+            for zone, slices in enumerate(ndi.find_objects(self._labels), start=1):
+                if slices is not None and zone in self.adj:
+                    self._bbox[zone] = [slices[0].start, slices[0].stop, slices[1].start, slices[1].stop]
+        return self._bbox
 
-    def _relabel(self, zone: int, new_label: int) -> None:
-        if self._contacts is None:
-            self._pending[zone] = new_label
-            return
-        affected = self._affected_pixels(zone)
-        base = len(self._value)
-        codes, deltas = _contact_delta(self._labels, affected, zone, new_label, base)
-        flat_labels = self._labels.ravel()
-        flat_labels[affected[flat_labels[affected] == zone]] = new_label
-        contacts, n_contour = self._contacts, self._n_contour
-        for code, delta in zip(codes.tolist(), deltas.tolist()):
-            a, b = divmod(code, base)
-            if b == 0:
-                n_contour[a] = n_contour.get(a, 0) + delta
-                continue
-            row = contacts.setdefault(a, {})
-            count = row.get(b, 0) + delta
-            if count:
-                row[b] = count
-            else:
-                del row[b]
-        contacts.pop(zone, None)
-        n_contour.pop(zone, None)
+    def _record_relabel(self, zone: int, new_label: int) -> None:
+        if self._contacts is not None:
+            if zone in self._dirty:
+                self._flush()  # its contact row must be exact to know whom it touches
+            # Zones seeing `zone` in their 3x3 neighbourhood are the ones it sees.
+            self._dirty.update(self._contacts.get(zone, ()))
+            if new_label:
+                self._dirty.add(new_label)
+            self._pending_boxes.append((zone, list(self._boxes()[zone])))
+        self._pending[zone] = new_label
 
     # -- mutations -------------------------------------------------------
 
@@ -650,51 +714,43 @@ class ZoneGraph:
         """
         if zone == into:
             raise SegmentationError(f"cannot fuse zone {zone} into itself")
-        self._relabel(zone, into)
+        self._record_relabel(zone, into)
         self._size[into] += self._size[zone]
-        box, other = self._bbox[into], self._bbox.pop(zone)
-        if other[0] < box[0]:
-            box[0] = other[0]
-        if other[1] > box[1]:
-            box[1] = other[1]
-        if other[2] < box[2]:
-            box[2] = other[2]
-        if other[3] > box[3]:
-            box[3] = other[3]
+        if self._bbox is not None:
+            box, other = self._bbox[into], self._bbox.pop(zone)
+            box[0], box[1] = min(box[0], other[0]), max(box[1], other[1])
+            box[2], box[3] = min(box[2], other[2]), max(box[3], other[3])
         zone_value = self._value[zone]
         adj = self.adj
         target = adj[into]
         for neighbour, old in adj.pop(zone).items():
-            del adj[neighbour][zone]
+            neighbour_adj = adj[neighbour]
+            del neighbour_adj[zone]
             if neighbour == into:
                 continue
-            minimum = zone_value if old.minimum is None or zone_value < old.minimum else old.minimum
-            if not _EXP.get('record', True):
-                minimum = old.minimum
-            existing = target.get(neighbour)
-            if existing is None:
-                edge = ZoneEdge(minimum, old.unbreakable)
+            if neighbour not in target:
+                if old is None or old.minimum is None or zone_value < old.minimum:
+                    minimum = zone_value
+                else:
+                    minimum = old.minimum
+                edge = ZoneEdge(minimum, old is not None and old.unbreakable)
                 target[neighbour] = edge
-                adj[neighbour][into] = edge
-            else:
-                ex = _EXP.get('existing', True)
-                if ex == 'has':
-                    if existing.minimum is not None and minimum is not None and minimum < existing.minimum:
-                        existing.minimum = minimum
-                elif ex and minimum is not None and (existing.minimum is None or minimum < existing.minimum):
-                    existing.minimum = minimum
-                existing.unbreakable = existing.unbreakable or old.unbreakable
+                neighbour_adj[into] = edge
+            elif old is not None and old.unbreakable:
+                # A direct contact already exists: no valley between the two,
+                # keep its minimum; unbreakability is kept.
+                self.edge(into, neighbour).unbreakable = True
 
     def remove(self, zone: int) -> None:
         """Delete a zone: its pixels become 0 and its edges disappear."""
-        self._relabel(zone, 0)
-        self._bbox.pop(zone)
+        self._record_relabel(zone, 0)
+        if self._bbox is not None:
+            self._bbox.pop(zone)
         for neighbour in self.adj.pop(zone):
             del self.adj[neighbour][zone]
 
 
 _KERNEL_3x3 = np.ones((3, 3), np.uint8)
-_EXP: dict = {}
 
 
 def _contact_table(labels: np.ndarray, pixels: np.ndarray, base: int) -> tuple[dict, dict]:
@@ -735,21 +791,19 @@ def _contact_table(labels: np.ndarray, pixels: np.ndarray, base: int) -> tuple[d
 
 
 def _contact_delta(
-    labels: np.ndarray, pixels: np.ndarray, zone: int, new_label: int, base: int
+    labels: np.ndarray, pixels: np.ndarray, parent: np.ndarray, base: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """How relabelling ``zone`` as ``new_label`` changes the contact counts.
+    """How relabelling every pixel l as ``parent[l]`` changes the contact counts.
 
-    ``pixels`` must hold every pixel within one pixel (8-connected) of the
-    zone. Returns codes ``a * base + b`` (b = 0: contour size of a) and the
-    signed change of each count.
+    ``pixels`` must hold every pixel within one pixel (8-connected) of a
+    relabelled zone. Returns codes ``a * base + b`` (b = 0: contour size of a)
+    and the signed change of each count.
     """
     width = labels.shape[1]
     # Columns 0..7: the 8-neighbours (_OFFSETS_8 order); column 8: the pixel itself.
     offsets = np.array([d_row * width + d_col for d_row, d_col in _OFFSETS_8] + [0], np.int64)
     before = labels.ravel()[pixels[:, None] + offsets]
-    after = before.copy()
-    after[after == zone] = new_label
-    both = np.concatenate([before, after])
+    both = np.concatenate([before, parent[before]])
     sign = np.repeat(np.array([-1, 1], np.int64), len(pixels))
     own = both[:, 8]
     contour = (own != 0) & (both[:, [1, 3, 4, 6]] != own[:, None]).any(axis=1)
@@ -785,36 +839,44 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     >>> graph.labels.tolist()
     [[1, 1, 1, 1]]
     """
-    if _EXP.get('small_repeat'):
-        _EXP['small_repeat'] = False
-        try:
-            while True:
-                before = len(graph)
-                remove_small_zones(graph, min_size=min_size)
-                if len(graph) == before or not any(graph.size(z) < min_size for z in graph.vertices()):
-                    break
-        finally:
-            _EXP['small_repeat'] = True
-        return graph
     graph.invalidate_contacts()
-    saved = dict(_EXP)
-    if not _EXP.get('small_record', True):
-        _EXP['record'] = False
-    for zone in graph.vertices():
-        if zone not in graph or graph.size(zone) >= min_size:
+    graph._bbox = None  # recomputed when next needed
+    adj, value, size, pending = graph.adj, graph._value, graph._size, graph._pending
+    for zone in list(adj):
+        if size[zone] >= min_size or zone not in adj:
             continue
-        neighbours = graph.adj[zone]
+        neighbours = adj[zone]
         if not neighbours:
             graph.remove(zone)
             continue
-        value = graph.value(zone)
-        closest, closest_gap = 0, None
+        zone_value = value[zone]
+        closest, closest_gap = 0, 256
         for other in neighbours:
-            gap = abs(graph.value(other) - value)
-            if closest_gap is None or gap < closest_gap:
+            gap = value[other] - zone_value
+            if gap < 0:
+                gap = -gap
+            if gap < closest_gap:
                 closest, closest_gap = other, gap
-        graph.fuse(zone, closest)
-    _EXP.clear(); _EXP.update(saved)
+        # ZoneGraph.fuse inlined (no contacts, no boxes): this loop runs for
+        # tens of thousands of one-pixel zones on noisy robot maps.
+        pending[zone] = closest
+        size[closest] += size[zone]
+        target = adj[closest]
+        del adj[zone]
+        for neighbour, old in neighbours.items():
+            neighbour_adj = adj[neighbour]
+            del neighbour_adj[zone]
+            if neighbour == closest:
+                continue
+            if neighbour not in target:
+                if old is None or old.minimum is None or zone_value < old.minimum:
+                    edge = ZoneEdge(zone_value, old is not None and old.unbreakable)
+                else:
+                    edge = ZoneEdge(old.minimum, old.unbreakable)
+                target[neighbour] = edge
+                neighbour_adj[closest] = edge
+            elif old is not None and old.unbreakable:
+                graph.edge(closest, neighbour).unbreakable = True
     return graph
 
 
@@ -842,20 +904,13 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
         value = graph.value(zone)
         best, best_gap = None, None
         for other, edge in graph.adj[zone].items():
-            if edge.unbreakable or graph.contact_percent(zone, other) < ripples:
-                continue
-            if _EXP.get('ripple_higher') == 'ge' and graph.value(other) < value:
-                continue
-            if _EXP.get('ripple_higher') == 'gt' and graph.value(other) <= value:
+            if (edge is not None and edge.unbreakable) or graph.contact_percent(zone, other) < ripples:
                 continue
             gap = abs(graph.value(other) - value)
             if best is None or gap < best_gap:
                 best, best_gap = other, gap
         if best is not None:
-            if _EXP.get('ripple_nodup'):
-                queue.extend(n for n in graph.adj[zone] if n not in queue)
-            else:
-                queue.extend(graph.adj[zone])
+            queue.extend(graph.adj[zone])
             graph.fuse(zone, best)
     return graph
 
@@ -868,8 +923,9 @@ def mark_unbreakable_edges(graph: ZoneGraph, *, threshold: float) -> ZoneGraph:
     """
     for a in graph.vertices():
         for b, edge in graph.adj[a].items():
-            ref = min(graph.value(a), graph.value(b)) if _EXP.get('unbreak_min') else max(graph.value(a), graph.value(b))
-            if edge.minimum is not None and edge.minimum <= ref * (1 - threshold):
+            if edge is not None and edge.minimum is not None and edge.minimum <= max(
+                graph.value(a), graph.value(b)
+            ) * (1 - threshold):
                 edge.unbreakable = True
     return graph
 
@@ -880,12 +936,8 @@ def _similar(a: int, b: int, threshold: float) -> bool:
 
 
 def _close_neighbour(graph: ZoneGraph, current: int, candidate: int, threshold: float) -> bool:
+    # closeNeigh: another neighbour of one of the two is within t of the other one.
     value_current, value_candidate = graph.value(current), graph.value(candidate)
-    mode = _EXP.get('close', 'both')
-    if mode == 'cur':
-        return any(_similar(graph.value(m), value_candidate, threshold) for m in graph.adj[current] if m != candidate)
-    if mode == 'cand':
-        return any(_similar(graph.value(m), value_current, threshold) for m in graph.adj[candidate] if m != current)
     if any(_similar(graph.value(m), value_current, threshold) for m in graph.adj[candidate] if m != current):
         return True
     return any(_similar(graph.value(m), value_candidate, threshold) for m in graph.adj[current] if m != candidate)
@@ -922,16 +974,15 @@ def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10)
         while stack:
             current, edges = stack[-1]
             for neighbour, edge in edges:
-                if edge.unbreakable or neighbour in visited or neighbour in absorbed:
+                if (edge is not None and edge.unbreakable) or neighbour in visited or neighbour in absorbed:
                     continue
-                if not _EXP.get('visit_on_absorb'):
-                    visited.add(neighbour)
+                visited.add(neighbour)
                 a, b = graph.value(current), graph.value(neighbour)
                 high, low = max(a, b), min(a, b)
                 if low >= high * (1 - threshold) or (
                     low >= high * low_factor and _close_neighbour(graph, current, neighbour, threshold)
                 ):
-                    absorbed.add(neighbour); visited.add(neighbour)
+                    absorbed.add(neighbour)
                     members.append(neighbour)
                     stack.append((neighbour, iter(list(graph.adj[neighbour].items()))))
                     break
@@ -1026,6 +1077,12 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if not isinstance(params, MaorisParams):
         raise ParameterError(f"expected MaorisParams, got {type(params).__name__}", field="params")
     free = _as_free_mask(free)
+    labels = np.zeros(free.shape, np.int32)
+    # Everything outside the free pixels' bounding box is obstacle: work on the box.
+    window = _free_bbox(free, margin=1)
+    if window is None:
+        return labels
+    free = free[window]
     values = quantize(inscribed_circle_image(free, max_radius=params.max_radius), quantum=params.quantum)
     graph = ZoneGraph(flat_zones(values), values)
     remove_small_zones(graph, min_size=params.small_before)
@@ -1035,4 +1092,5 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     remove_doors(graph, doors=params.doors)
     remove_small_zones(graph, min_size=params.small_after)
     remove_isolated_zones(graph)
-    return graph.label_image()
+    labels[window] = graph.label_image()
+    return labels

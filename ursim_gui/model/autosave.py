@@ -20,7 +20,6 @@ folder (``~/.local/share/ursim-studio/autosave`` on Linux).
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import os
 import sys
 import time
@@ -141,8 +140,9 @@ class Autosaver:
 
     Notes
     -----
-    The file name is stable per document: a hash of the document's path, or a random id
-    for an untitled document, so a crash leaves one file per open document.
+    The file name is the document's name plus an id unique to this autosaver, so a
+    copy left by a crashed earlier run of the same document is never overwritten (the
+    user may have postponed its recovery). The name follows a "save as".
     """
 
     def __init__(
@@ -159,7 +159,7 @@ class Autosaver:
         self.delay_s = float(delay_s)
         self.max_delay_s = max(float(max_delay_s), self.delay_s)
         self._clock = clock
-        self._untitled_id = uuid.uuid4().hex[:16]
+        self._instance_id = uuid.uuid4().hex[:12]
         self._first_pending: float | None = None
         self._last_pending: float | None = None
         self._written: Path | None = None
@@ -173,12 +173,8 @@ class Autosaver:
     def path(self) -> Path:
         """The file this session's copy is (or would be) written to."""
         document = self.session.path
-        if document is None:
-            name = f"untitled-{self._untitled_id}"
-        else:
-            digest = hashlib.sha256(str(document).encode("utf-8")).hexdigest()[:16]
-            name = f"{document.stem}-{digest}"
-        return self.folder / f"{name}{AUTOSAVE_SUFFIX}"
+        stem = "untitled" if document is None else document.stem
+        return self.folder / f"{stem}-{self._instance_id}{AUTOSAVE_SUFFIX}"
 
     @property
     def pending(self) -> bool:
@@ -241,9 +237,13 @@ class Autosaver:
         self._written = target
 
     def discard(self) -> None:
-        """Remove this session's copy (after a successful save or a deliberate discard)."""
-        for path in {self._written, self.path} - {None}:
-            discard(path)
+        """Remove this session's copy (after a successful save or a deliberate discard).
+
+        Only a file this autosaver wrote is removed: a copy left by a crashed earlier run
+        of the same document stays until the user recovers or discards it.
+        """
+        if self._written is not None:
+            discard(self._written)
         self._written = None
         self._first_pending = self._last_pending = None
 

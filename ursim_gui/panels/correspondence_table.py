@@ -34,9 +34,19 @@ class CorrespondenceTableModel(QAbstractTableModel):
         session.reference_changed.connect(self.refresh)
 
     def refresh(self, *_args) -> None:
-        """Re-read the cliques and evaluation marks from the session."""
+        """Re-read the cliques and evaluation marks from the session.
+
+        When the rows are the same cliques (a status or region edit), only their cells
+        are announced as changed; a reset would make the view re-measure every row.
+        """
+        cliques = tuple(self._session.correspondences.cliques)
+        if [c.id for c in cliques] == [c.id for c in self._cliques]:
+            self._cliques = cliques
+            if cliques:
+                self.dataChanged.emit(self.index(0, 0), self.index(len(cliques) - 1, len(COLUMNS) - 1))
+            return
         self.beginResetModel()
-        self._cliques = tuple(self._session.correspondences.cliques)
+        self._cliques = cliques
         self.endResetModel()
 
     def rowCount(self, parent=QModelIndex()) -> int:
@@ -119,8 +129,10 @@ class CorrespondenceTable(QWidget):
         self.view.verticalHeader().setDefaultSectionSize(22)
         self.view.setAlternatingRowColors(True)
         header = self.view.horizontalHeader()
-        header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        # Measured once per reset, not on every change (ResizeToContents re-reads every row).
+        header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
         header.setStretchLastSection(True)
+        self.model.modelReset.connect(self.view.resizeColumnsToContents)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)

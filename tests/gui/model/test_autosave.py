@@ -272,3 +272,24 @@ def test_the_copy_is_a_valid_correspondence_file(files, clock, autosave_dir):
     loaded = load_correspondences(saver.path)
     assert loaded.sketch.path == files / "rooms.png"
     assert loaded.cliques == session.correspondences.cliques
+
+
+def test_a_crash_copy_of_the_same_document_is_not_removed_by_a_new_session(files, clock, autosave_dir):
+    crashed = make_session(files)
+    crashed.link([1], [1])
+    crashed.save(files / "doc.json")
+    crashed.link([2], [2])
+    Autosaver(crashed, autosave_dir, clock=clock).flush()
+    (crash_copy,) = find_recoverable(autosave_dir)
+
+    # The user declined recovery for now and opens the document again.
+    session = AnnotationSession()
+    saver = Autosaver(session, autosave_dir, clock=clock)
+    session.open(files / "doc.json")
+    saver.flush_if_due(clock.now + 60)
+    session.link([3], [3])
+    saver.flush_if_due(clock.now + 120)
+    assert saver.path != crash_copy and set(find_recoverable(autosave_dir)) == {crash_copy, saver.path}
+    saver.close()
+    assert find_recoverable(autosave_dir) == [crash_copy]
+    assert recover_with_origin(crash_copy)[0] == crashed.correspondences

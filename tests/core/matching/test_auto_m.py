@@ -1,0 +1,62 @@
+"""Automatic choice of m."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from ursim_core.bench_matching import perturbed_copy, random_region_graph
+from ursim_core.matching import MatchConfig, match, match_prepared, prepare
+from ursim_core.matching.auto_m import choose_m, sweep
+
+
+@pytest.fixture(scope="module")
+def pair():
+    graph = random_region_graph(12, seed=21)
+    copy, mapping = perturbed_copy(graph, seed=22, size_noise=0.15, position_noise=20.0)
+    return graph, copy, mapping
+
+
+@pytest.mark.parametrize("rule", ["score", "structure"])
+def test_auto_m_is_in_the_grid_and_deterministic(pair, rule):
+    graph, copy, _ = pair
+    config = MatchConfig(auto_rule=rule)
+    first = match(graph, copy, config=config)
+    second = match(graph, copy, config=config)
+    assert first.m in config.m_grid
+    assert (first.m, first.pairs) == (second.m, second.pairs)
+    assert sorted(first.m_scan) == sorted(config.m_grid)
+    assert first.m_scan[first.m] == min(first.m_scan.values())
+    # The smallest m among equally good ones is chosen.
+    assert all(value > first.m_scan[first.m] for m, value in first.m_scan.items() if m < first.m)
+
+
+def test_auto_result_is_the_fixed_m_result(pair):
+    graph, copy, _ = pair
+    auto = match(graph, copy)
+    fixed = match(graph, copy, config=MatchConfig(m=auto.m))
+    assert auto.pairs == fixed.pairs and auto.cost == pytest.approx(fixed.cost)
+
+
+def test_sweep_reuses_identical_thresholds(pair):
+    graph, copy, _ = pair
+    prepared = prepare(graph, copy, MatchConfig())
+    results = sweep(prepared, [0.0, 0.0001, 0.3])
+    assert [r.m for r in results] == [0.0, 0.0001, 0.3]
+    for r in results:
+        assert r.pairs == match_prepared(prepared, r.m).pairs
+
+
+def test_auto_recovers_a_noisy_copy(pair):
+    graph, copy, mapping = pair
+    result = match(graph, copy)
+    correct = sum(1 for a, b in result.pairs if mapping[a] == b)
+    assert correct >= 10
+
+
+def test_custom_grid_is_respected(pair):
+    graph, copy, _ = pair
+    config = MatchConfig(m_grid=(0.05, 0.15))
+    assert choose_m(prepare(graph, copy, config)).m in (0.05, 0.15)
+    assert replace(config, m=0.05).m == 0.05

@@ -1,0 +1,46 @@
+"""Feature 8: load a reference and see precision / recall / F1 live, TP / FP marks in the
+table and the views, and the missed reference cliques."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtWidgets import QFileDialog
+
+from ursim_core.correspondences import Clique, Correspondences, save_correspondences, save_dat
+
+
+def reference_cliques():
+    # Points inside rooms 1, 2, 3 of both maps (the metric map is the sketch scaled by 2).
+    return Correspondences(cliques=tuple(
+        Clique(id=i, sketch_points=[(30, col)], metric_points=[(60, 2 * col)]) for i, col in ((1, 25), (2, 75), (3, 120))
+    ))
+
+
+@pytest.mark.parametrize("suffix", [".json", ".dat"])
+def test_reference_scores_live_and_marks_cliques(window, tmp_path, monkeypatch, suffix):
+    path = tmp_path / f"reference{suffix}"
+    (save_correspondences if suffix == ".json" else save_dat)(reference_cliques(), path)
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(path), "")))
+    session, panel = window.session, window.evaluation
+    good = session.link([1], [1])
+    bad = session.link([2], [3])
+    panel.load_button.click()
+    assert session.reference is not None
+    assert panel.values["precision"].text() == "0.500"
+    assert panel.values["recall"].text() == "0.333"
+    assert panel.values["counts"].text() == "1 / 1 / 2"
+    model = window.table.model
+    assert model.data(model.index(model.row_of(good), 6)) == "TP"
+    assert model.data(model.index(model.row_of(bad), 6)) == "FP"
+    assert window.views["sketch"].badge_texts() == {1: "TP", 2: "FP"}
+    assert panel.missed.count() == 2 and panel.missed.item(0).text() == "2  ↔  2"
+
+    session.delete_clique(bad)                                   # live: every edit re-scores
+    assert panel.values["precision"].text() == "1.000"
+    session.link([2], [2])
+    session.link([3], [3])
+    assert panel.values["f1"].text() == "1.000" and panel.missed.count() == 0
+
+    panel.clear_button.click()
+    assert session.reference is None and panel.values["f1"].text() == "–"
+    assert model.data(model.index(0, 6)) == "" and window.views["sketch"].badge_texts() == {}

@@ -1,0 +1,50 @@
+"""Feature 5: matching runs in a worker with progress and Cancel; the window stays responsive."""
+
+from __future__ import annotations
+
+import time
+
+from PySide6.QtCore import Qt, QTimer
+
+
+def test_match_button_runs_in_the_worker_and_applies_the_result(window, qtbot):
+    panel = window.matching_panel
+    panel.m_auto.setChecked(False)
+    panel.m_value.setValue(0.2)
+    panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
+    assert panel.config().m == 0.2 and panel.config().matcher == "hungarian"
+    ticks = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(10)
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+        assert not panel.match_button.isEnabled()                  # one job at a time
+    timer.stop()
+    session = window.session
+    assert session.last_match is not None and session.last_match.config.matcher == "hungarian"
+    assert {c.source for c in session.correspondences.cliques} == {"auto"}
+    assert window.table.model.rowCount() == len(session.correspondences.cliques) > 0
+    assert "pairs" in panel.summary.text()
+    qtbot.waitUntil(lambda: panel.match_button.isEnabled())
+    assert max((b - a for a, b in zip(ticks, ticks[1:])), default=0) < 0.5
+
+
+def test_cancel_drops_a_running_segmentation(window, qtbot):
+    before = window.session.segmentation("metric")
+    window.segmentation_panel.boxes["metric"].segment_button.click()
+    assert window.status.cancel_button.isVisible()
+    with qtbot.waitSignal(window.jobs.runner.cancelled, timeout=60_000):
+        qtbot.mouseClick(window.status.cancel_button, Qt.MouseButton.LeftButton)
+    assert window.session.segmentation("metric") is before              # result discarded
+    assert not window.status.cancel_button.isVisible()
+    assert window.matching_panel.match_button.isEnabled()
+
+
+def test_match_without_segmentations_explains_why(window):
+    from conftest import error_boxes
+
+    window.session.set_map("sketch", window.session.map("sketch"))
+    window.jobs.match(window.matching_panel.config())
+    assert error_boxes(window) and "Segment both maps" in error_boxes(window)[0].text()
+    assert not window.jobs.busy

@@ -1,0 +1,70 @@
+"""Feature 4: the segmentation panel segments a side in the worker with a preset and
+parameters, loads a label image instead, and drives the overlay display options."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QFileDialog
+
+from conftest import error_boxes
+
+
+def test_segment_button_runs_maoris_with_the_chosen_preset(window, qtbot):
+    box = window.segmentation_panel.boxes["sketch"]
+    box.preset.setCurrentText("default")
+    box.spins["doors"].setValue(55)
+    assert box.overrides() == {"doors": 55}
+    with qtbot.waitSignal(window.session.segmentation_changed, timeout=60_000):
+        qtbot.mouseClick(box.segment_button, Qt.MouseButton.LeftButton)
+        assert window.status.progress_bar.isVisible()        # job UI shows while it runs
+    segmentation = window.session.segmentation("sketch")
+    assert segmentation.method == "maoris" and segmentation.params["doors"] == 55
+    assert segmentation.n_regions >= 2
+    assert box.summary.text().startswith(f"{segmentation.n_regions} regions")
+    qtbot.waitUntil(lambda: not window.jobs.busy)
+    assert not window.status.progress_bar.isVisible()
+
+
+def test_load_label_image_button(window, map_files, monkeypatch):
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["metric_labels"]), "")))
+    window.session.set_map("metric", window.session.map("metric"))          # drops the segmentation
+    assert window.session.segmentation("metric") is None
+    window.segmentation_panel.boxes["metric"].load_button.click()
+    assert window.session.segmentation("metric").method == "label-image"
+    assert window.views["metric"].labels() is not None
+
+
+def test_label_image_of_the_wrong_size_is_refused(window, map_files, monkeypatch):
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["sketch_labels"]), "")))
+    before = window.session.segmentation("metric")
+    window.segmentation_panel.boxes["metric"].load_button.click()
+    assert error_boxes(window)
+    assert window.session.segmentation("metric") is before
+
+
+def test_display_options_reach_both_views(window, qtbot):
+    panel, views = window.segmentation_panel, window.views
+    panel.opacity.setValue(80)
+    assert all(view.overlay_opacity() == pytest.approx(0.8) for view in views.values())
+    panel.toggles["outlines"].setChecked(False)
+    assert not views["sketch"].layers.outlines.isVisible() and not window.actions["outlines"].isChecked()
+    window.actions["region_ids"].trigger()                                   # menu and checkbox stay in sync
+    assert panel.toggles["region_ids"].isChecked()
+    assert views["metric"].visible_ids() == {1, 2, 3}
+    panel.toggles["graph"].setChecked(True)
+    assert views["sketch"].layers.graph_item.isVisible()
+    assert views["sketch"].layers.graph_item.path().elementCount() > 0
+
+
+def test_anchors_are_marked_and_listed_after_a_match(window, qtbot):
+    from types import SimpleNamespace
+
+    result = SimpleNamespace(pairs=[(1, 1), (2, 2), (3, 3)], anchors=[(1, 1), (3, 3)], m=0.1, cost=1.0, reason="")
+    window.session.apply_match(result)
+    anchors = window.anchors.list
+    assert anchors.count() == 2 and "sketch 1" in anchors.item(0).text()
+    assert window.views["sketch"].marked_regions("anchors") == {1, 3}
+    assert window.views["metric"].marked_regions("anchors") == {1, 3}
+    anchors.itemClicked.emit(anchors.item(1))
+    assert window.session.selection == {"sketch": frozenset({3}), "metric": frozenset({3})}
