@@ -123,6 +123,9 @@ class RegionLayers:
 
     # ---- marks ------------------------------------------------------------------
     def set_marks(self, kind: str, regions) -> None:
+        regions = [int(region) for region in regions]
+        if self._marks[kind] and set(regions) == self.marked_regions(kind):
+            return  # unchanged: keep the items (edits re-send anchors and selection)
         for item in self._marks[kind]:
             self.scene.removeItem(item)
         self._marks[kind] = []
@@ -186,6 +189,8 @@ class RegionLayers:
             self._ids.append(item)
 
     def set_badges(self, badges: dict[int, tuple[str, QColor]]) -> None:
+        if {region: text for region, (text, _colour) in badges.items() if region in self.positions} == self.badge_texts():
+            return
         for item in self._badges.values():
             self.scene.removeItem(item)
         self._badges = {}

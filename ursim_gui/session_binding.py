@@ -96,10 +96,14 @@ class ViewBinding:
         else:
             view.set_segmentation(segmentation.labels, segmentation.graph)
         self._paint(side)
+        self._badges_changed()
+        self._update_links()
 
     def _correspondences_changed(self, *_args) -> None:
         for side in SIDES:
             self._paint(side)
+        self._badges_changed()
+        self._update_links()
 
     def _selection_changed(self, *_args) -> None:
         selection = self.session.selection
@@ -112,7 +116,7 @@ class ViewBinding:
             self.views[side].set_badges({region: (mark, _BADGE_COLOURS[mark]) for region, mark in badges.items()})
 
     def _paint(self, side: str) -> None:
-        """Recolour one side, re-mark its anchors and selection, refresh links and badges."""
+        """Recolour one side and re-mark its anchors and selection."""
         segmentation = self.session.segmentation(side)
         view = self.views[side]
         if segmentation is not None:
@@ -122,7 +126,8 @@ class ViewBinding:
             index = SIDES.index(side)
             view.set_anchors({pair[index] for pair in self.session.anchors})
             view.set_selection(self.session.selection.get(side, ()))
-        self._badges_changed()
+
+    def _update_links(self) -> None:
         self.connectors.set_links(
             (sketch, metric, self._colour_of(clique_id))
             for clique_id, sketch, metric in first_regions(self.session.correspondences)

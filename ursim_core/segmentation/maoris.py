@@ -494,10 +494,9 @@ class ZoneGraph:
             zone: {} for zone in (np.flatnonzero(sizes[1:]) + 1).tolist()
         }
         self._add_initial_edges(zones)
-        self._contacts: dict[int, dict[int, int]] | None = None
-        self._n_contour: dict[int, int] = {}
+        self._contacts: dict[int, int] | None = None
         self._pending: dict[int, int] = {}
-        self._pending_boxes: list[tuple[int, list[int]]] = []
+        self._pending_near: list[np.ndarray] = []
         self._dirty: set[int] = set()
 
     def _add_initial_edges(self, zones: np.ndarray) -> None:
@@ -573,10 +572,11 @@ class ZoneGraph:
         contacts = self._ensure_contacts()
         if zone in self._dirty:
             self._flush()
-        total = self._n_contour.get(zone, 0)
+        key = zone * len(self._value)
+        total = contacts.get(key, 0)
         if total == 0:
             return 0
-        return contacts.get(zone, {}).get(other, 0) * 100 // total
+        return contacts.get(key + other, 0) * 100 // total
 
     def contact_sum(self, zone: int) -> int:
         """Sum of :meth:`contact_percent` over the graph neighbours of ``zone``."""
@@ -597,12 +597,14 @@ class ZoneGraph:
 
     # -- contacts and relabelling -------------------------------------------
     #
-    # Fusions are recorded in `_pending` (zone -> receiver, 0 = deleted) and
-    # written into the label image by `_flush`, in one vectorised pass. While
-    # contacts are tracked, a flush also updates the contact counts around the
-    # fused zones, and `_dirty` holds the zones whose counts a pending fusion
-    # may change: a query about one of them flushes first. This batches the
-    # ripple step's many small fusions into few array passes.
+    # Contact counts live in one dict keyed by ``a * base + b``: the number of
+    # contour pixels of a with b in their 3x3 neighbourhood (b >= 1), and the
+    # number of contour pixels of a (b = 0). Fusions are recorded in
+    # `_pending` (zone -> receiver, 0 = deleted) and written into the label
+    # image by `_flush` in one vectorised pass. While contacts are tracked, a
+    # flush also updates the counts around the fused zones, and `_dirty` holds
+    # the zones whose counts a pending fusion may change: a query about one of
+    # them flushes first. This batches the ripple step's many small fusions.
 
     def _parent_lookup(self) -> np.ndarray:
         parent = np.arange(len(self._value), dtype=np.int32)
@@ -621,54 +623,38 @@ class ZoneGraph:
         if self._contacts is None:
             self._labels = parent[self._labels]
         else:
-            affected = np.unique(np.concatenate([self._near_pixels(zone, box) for zone, box in self._pending_boxes]))
+            affected = np.unique(np.concatenate(self._pending_near))
             codes, deltas = _contact_delta(self._labels, affected, parent, len(self._value))
-            self._apply_contact_delta(codes, deltas)
+            contacts = self._contacts
+            for code, delta in zip(codes.tolist(), deltas.tolist()):
+                count = contacts.get(code, 0) + delta
+                if count:
+                    contacts[code] = count
+                else:
+                    del contacts[code]
             flat_labels = self._labels.ravel()
             flat_labels[affected] = parent[flat_labels[affected]]
-            for zone in self._pending:
-                self._contacts.pop(zone, None)
-                self._n_contour.pop(zone, None)
         self._pending = {}
-        self._pending_boxes = []
+        self._pending_near = []
         self._dirty = set()
 
-    def _near_pixels(self, zone: int, box: list[int]) -> np.ndarray:
+    def _near_pixels(self, zone: int) -> np.ndarray:
         # Flat indices of the zone's pixels and their 8-neighbours: the pixels
         # whose contour status or 3x3 neighbourhood a relabelling changes.
-        r0, r1, c0, c1 = box
+        r0, r1, c0, c1 = self._boxes()[zone]
         crop = self._labels[r0 - 1 : r1 + 1, c0 - 1 : c1 + 1]
         near = cv2.dilate((crop == zone).view(np.uint8), _KERNEL_3x3)
         rows, cols = np.nonzero(near)
         return (rows + r0 - 1) * self._labels.shape[1] + cols + c0 - 1
 
-    def _apply_contact_delta(self, codes: np.ndarray, deltas: np.ndarray) -> None:
-        base = len(self._value)
-        contacts, n_contour = self._contacts, self._n_contour
-        for code, delta in zip(codes.tolist(), deltas.tolist()):
-            a, b = divmod(code, base)
-            if b == 0:
-                n_contour[a] = n_contour.get(a, 0) + delta
-                continue
-            row = contacts.setdefault(a, {})
-            count = row.get(b, 0) + delta
-            if count:
-                row[b] = count
-            else:
-                del row[b]
-
-    def _ensure_contacts(self) -> dict[int, dict[int, int]]:
+    def _ensure_contacts(self) -> dict[int, int]:
         if self._contacts is None:
             self._flush()
             rows, cols = self._labels.shape
-            region = self._labels[1 : rows - 1, 1 : cols - 1]
-            row_index, col_index = np.nonzero(region)
+            row_index, col_index = np.nonzero(self._labels[1 : rows - 1, 1 : cols - 1])
             flat = (row_index + 1) * cols + col_index + 1
-            pairs, contour = _contact_table(self._labels, flat, len(self._value))
-            self._contacts = {}
-            for (a, b), count in pairs.items():
-                self._contacts.setdefault(a, {})[b] = count
-            self._n_contour = contour
+            codes, counts = _contact_table(self._labels, flat, len(self._value))
+            self._contacts = dict(zip(codes.tolist(), counts.tolist()))
         return self._contacts
 
     def invalidate_contacts(self) -> None:
@@ -677,8 +663,7 @@ class ZoneGraph:
         Cheaper than local updates when many zones are about to be fused.
         """
         self._contacts = None
-        self._n_contour = {}
-        self._pending_boxes = []
+        self._pending_near = []
         self._dirty = set()
 
     def _boxes(self) -> dict[int, list[int]]:
@@ -694,13 +679,17 @@ class ZoneGraph:
 
     def _record_relabel(self, zone: int, new_label: int) -> None:
         if self._contacts is not None:
-            if zone in self._dirty:
-                self._flush()  # its contact row must be exact to know whom it touches
-            # Zones seeing `zone` in their 3x3 neighbourhood are the ones it sees.
-            self._dirty.update(self._contacts.get(zone, ()))
+            near = self._near_pixels(zone)
+            self._pending_near.append(near)
+            # Every zone with a pixel next to `zone` may see its counts change;
+            # labels there may still wait for a pending fusion: follow it.
+            for label in np.unique(self._labels.ravel()[near]).tolist():
+                while label in self._pending:
+                    label = self._pending[label]
+                if label:
+                    self._dirty.add(label)
             if new_label:
                 self._dirty.add(new_label)
-            self._pending_boxes.append((zone, list(self._boxes()[zone])))
         self._pending[zone] = new_label
 
     # -- mutations -------------------------------------------------------
@@ -753,58 +742,40 @@ class ZoneGraph:
 _KERNEL_3x3 = np.ones((3, 3), np.uint8)
 
 
-def _contact_table(labels: np.ndarray, pixels: np.ndarray, base: int) -> tuple[dict, dict]:
+def _contact_table(labels: np.ndarray, pixels: np.ndarray, base: int) -> tuple[np.ndarray, np.ndarray]:
     """Contact counts of the contour pixels among ``pixels`` (flat indices).
 
-    Returns ``({(zone, other): n_pixels}, {zone: n_contour_pixels})`` where a
-    contour pixel is a zone pixel with a 4-neighbour of another label, and it
-    counts once for every distinct other non-zero label in its 3x3
-    neighbourhood. Pixels must be at least one pixel away from the border of
-    ``labels``; ``base`` is larger than every label.
+    A contour pixel is a zone pixel with a 4-neighbour of another label; it
+    counts once for every distinct other non-zero label b in its 3x3
+    neighbourhood, under code ``zone * base + b``, and once under
+    ``zone * base`` (contour size). Pixels must be at least one pixel away from
+    the border of ``labels``; ``base`` is larger than every label.
     """
-    flat_labels = labels.ravel()
-    width = labels.shape[1]
-    own = flat_labels[pixels]
-    nonzero = own != 0
-    pixels, own = pixels[nonzero], own[nonzero]
-    boundary = (
-        (flat_labels[pixels - width] != own)
-        | (flat_labels[pixels + width] != own)
-        | (flat_labels[pixels - 1] != own)
-        | (flat_labels[pixels + 1] != own)
-    )
-    pixels, own = pixels[boundary], own[boundary]
-    if len(pixels) == 0:
-        return {}, {}
-    neighbours = np.empty((len(pixels), 8), np.int32)
-    for k, (d_row, d_col) in enumerate(_OFFSETS_8):
-        neighbours[:, k] = flat_labels[pixels + d_row * width + d_col]
-    neighbours[neighbours == own[:, None]] = 0
-    neighbours.sort(axis=1)
-    keep = neighbours != 0
-    keep[:, 1:] &= neighbours[:, 1:] != neighbours[:, :-1]
-    codes = np.repeat(own.astype(np.int64), keep.sum(axis=1)) * base + neighbours[keep]
-    codes, counts = np.unique(codes, return_counts=True)
-    pairs = dict(zip(zip((codes // base).tolist(), (codes % base).tolist()), counts.tolist()))
-    zones, contour_counts = np.unique(own, return_counts=True)
-    return pairs, dict(zip(zones.tolist(), contour_counts.tolist()))
+    identity = np.arange(base, dtype=np.int32)
+    codes, deltas = _contact_delta(labels, pixels, identity, base, before=False)
+    return codes, deltas
 
 
 def _contact_delta(
-    labels: np.ndarray, pixels: np.ndarray, parent: np.ndarray, base: int
+    labels: np.ndarray, pixels: np.ndarray, parent: np.ndarray, base: int, *, before: bool = True
 ) -> tuple[np.ndarray, np.ndarray]:
     """How relabelling every pixel l as ``parent[l]`` changes the contact counts.
 
     ``pixels`` must hold every pixel within one pixel (8-connected) of a
     relabelled zone. Returns codes ``a * base + b`` (b = 0: contour size of a)
-    and the signed change of each count.
+    and the signed change of each count; with ``before=False``, only the
+    counts after relabelling (all positive).
     """
     width = labels.shape[1]
     # Columns 0..7: the 8-neighbours (_OFFSETS_8 order); column 8: the pixel itself.
     offsets = np.array([d_row * width + d_col for d_row, d_col in _OFFSETS_8] + [0], np.int64)
-    before = labels.ravel()[pixels[:, None] + offsets]
-    both = np.concatenate([before, parent[before]])
-    sign = np.repeat(np.array([-1, 1], np.int64), len(pixels))
+    gathered = labels.ravel()[pixels[:, None] + offsets]
+    if before:
+        both = np.concatenate([gathered, parent[gathered]])
+        sign = np.repeat(np.array([-1, 1], np.int64), len(pixels))
+    else:
+        both = parent[gathered]
+        sign = np.ones(len(pixels), np.int64)
     own = both[:, 8]
     contour = (own != 0) & (both[:, [1, 3, 4, 6]] != own[:, None]).any(axis=1)
     own, sign, neighbours = own[contour].astype(np.int64), sign[contour], both[contour, :8]

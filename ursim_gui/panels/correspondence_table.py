@@ -31,7 +31,7 @@ class CorrespondenceTableModel(QAbstractTableModel):
         self._session = session
         self._cliques = tuple(session.correspondences.cliques)
         session.correspondences_changed.connect(self.refresh)
-        session.reference_changed.connect(self.refresh)
+        session.reference_changed.connect(self.reset)
 
     def refresh(self, *_args) -> None:
         """Re-read the cliques and evaluation marks from the session.
@@ -41,12 +41,20 @@ class CorrespondenceTableModel(QAbstractTableModel):
         """
         cliques = tuple(self._session.correspondences.cliques)
         if [c.id for c in cliques] == [c.id for c in self._cliques]:
+            # Marks can change for any row when one clique changes, so compare them too.
+            changed = [row for row, (old, new) in enumerate(zip(self._cliques, cliques)) if old != new]
             self._cliques = cliques
-            if cliques:
-                self.dataChanged.emit(self.index(0, 0), self.index(len(cliques) - 1, len(COLUMNS) - 1))
+            if self._session.reference is not None:
+                changed = range(len(cliques))
+            if changed:
+                self.dataChanged.emit(self.index(min(changed), 0), self.index(max(changed), len(COLUMNS) - 1))
             return
+        self.reset()
+
+    def reset(self, *_args) -> None:
+        """Re-read everything (the reference changed: every Eval cell may differ)."""
         self.beginResetModel()
-        self._cliques = cliques
+        self._cliques = tuple(self._session.correspondences.cliques)
         self.endResetModel()
 
     def rowCount(self, parent=QModelIndex()) -> int:
