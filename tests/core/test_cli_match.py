@@ -1,0 +1,95 @@
+"""``ursim match`` and ``ursim convert`` end to end on a small generated pair."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from ursim_core.cli import main
+from ursim_core.correspondences import load_correspondences, load_dat
+
+
+def building(scale: float = 1.0) -> np.ndarray:
+    """A corridor with four rooms of different sizes above and below it."""
+    s = lambda v: int(round(v * scale))  # noqa: E731
+    image = np.zeros((s(260), s(420)), np.uint8)
+    image[s(110):s(150), s(10):s(410)] = 255  # corridor
+    rooms = [(10, 100, 10, 140), (10, 100, 150, 400), (160, 250, 10, 250), (160, 250, 260, 330)]
+    for r0, r1, c0, c1 in rooms:
+        image[s(r0):s(r1), s(c0):s(c1)] = 255
+        door = (c0 + c1) // 2
+        if r1 <= 110:
+            image[s(r1):s(110), s(door - 5):s(door + 5)] = 255
+        else:
+            image[s(150):s(r0), s(door - 5):s(door + 5)] = 255
+    return image
+
+
+@pytest.fixture()
+def pair(tmp_path):
+    sketch, metric = tmp_path / "sketch.png", tmp_path / "metric.png"
+    cv2.imwrite(str(metric), building())
+    cv2.imwrite(str(sketch), building(1.3))
+    return sketch, metric
+
+
+def test_match_writes_all_outputs(tmp_path, pair):
+    out = tmp_path / "out"
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out)]) == 0
+    corr = load_correspondences(out / "correspondences.json")
+    sketch_labels = cv2.imread(str(out / "sketch.labels.png"), cv2.IMREAD_UNCHANGED)
+    metric_labels = cv2.imread(str(out / "metric.labels.png"), cv2.IMREAD_UNCHANGED)
+    assert sketch_labels.dtype == np.uint16 and metric_labels.dtype == np.uint16
+    assert corr.cliques, "a scaled copy of the map must give matches"
+    for clique in corr.cliques:
+        assert clique.source == "auto"
+        (s_region,), (m_region,) = clique.sketch_regions, clique.metric_regions
+        (s_row, s_col), (m_row, m_col) = clique.sketch_points[0], clique.metric_points[0]
+        assert sketch_labels[s_row, s_col] == s_region and metric_labels[m_row, m_col] == m_region
+    raw = json.loads((out / "correspondences.json").read_text())
+    assert raw["maps"]["sketch"]["sha256"] and raw["matcher"]["m"] is not None
+    figure = cv2.imread(str(out / "matches.png"))
+    assert figure.shape[1] > sketch_labels.shape[1]
+
+
+def test_match_scaled_copy_is_mostly_right(tmp_path, pair):
+    out = tmp_path / "out"
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out)]) == 0
+    corr = load_correspondences(out / "correspondences.json")
+    right = 0
+    for clique in corr.cliques:
+        (s_row, s_col), (m_row, m_col) = clique.sketch_points[0], clique.metric_points[0]
+        right += abs(s_row / 1.3 - m_row) < 25 and abs(s_col / 1.3 - m_col) < 25
+    assert right >= 0.8 * len(corr.cliques)
+
+
+@pytest.mark.parametrize("option", [["--m", "0.1"], ["--variant", "T2"], ["--matcher", "hungarian"], ["--released"]])
+def test_match_options(tmp_path, pair, option):
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(tmp_path / "o"), *option]) == 0
+
+
+def test_match_bad_m_is_an_input_error(tmp_path, pair, capsys):
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(tmp_path / "o"), "--m", "lots"]) == 1
+    assert "--m" in capsys.readouterr().err
+
+
+def test_convert_round_trip(tmp_path, pair):
+    dat = tmp_path / "gt.dat"
+    dat.write_text("# sketch.png metric.png\n# 0match set\n# map1\n30 60\n# map2\n25 50\n\n# 1match set\n# map1\n# map2\n")
+    json_path, back = tmp_path / "gt.json", tmp_path / "back.dat"
+    assert main(["convert", str(dat), str(json_path), "--sketch", str(pair[0]), "--metric", str(pair[1])]) == 0
+    corr = load_correspondences(json_path)
+    assert corr.cliques[0].sketch_points == ((30, 60),) and corr.cliques[0].sketch_regions
+    assert main(["convert", str(json_path), str(back)]) == 0
+    assert [c.sketch_points for c in load_dat(back).cliques] == [c.sketch_points for c in load_dat(dat).cliques]
+
+
+def test_convert_bad_input(tmp_path, capsys):
+    (tmp_path / "bad.json").write_text("{not json")
+    assert main(["convert", str(tmp_path / "bad.json"), str(tmp_path / "x.dat")]) == 1
+    assert "bad.json" in capsys.readouterr().err
+    assert main(["convert", str(tmp_path / "bad.json"), str(tmp_path / "x.txt")]) == 1
