@@ -14,8 +14,3 @@ def main(argv: list[str] | None = None) -> int:
 
     return run(argv)
 
-
-# Must run before any Qt call; see ursim_gui/qt_compat.py (does not import Qt).
-from ursim_gui.qt_compat import protect_none_refcount as _protect_none_refcount
-
-_protect_none_refcount()

@@ -2,4 +2,6 @@
 
 from ursim_gui.app import main
 
-raise SystemExit(main())
+# Guarded: job worker processes are spawned and import this module as __mp_main__.
+if __name__ == "__main__":
+    raise SystemExit(main())

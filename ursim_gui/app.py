@@ -108,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.screenshot:
         return _screenshot(window, Path(args.screenshot), sketch, metric, correspondences, use_example)
     window.show()
+    window.jobs.runner.prewarm()
     if not window.documents.offer_recovery():
         window.open_inputs(sketch, metric, correspondences, example=use_example)
     return app.exec()

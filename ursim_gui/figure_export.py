@@ -87,7 +87,8 @@ def render_figure(sketch_view, metric_view, session, *, map_height: int = 600, c
         painter.setPen(QColor(30, 30, 30))
         painter.drawText(QRectF(rect.x(), _MARGIN, rect.width(), _TITLE_H), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter, f"{side.capitalize()}: {title}")
         if not view.sceneRect().isEmpty():
-            view.scene().render(painter, rect, view.sceneRect(), Qt.AspectRatioMode.KeepAspectRatio)
+            with view.layers.hidden("selection", "highlight"):
+                view.scene().render(painter, rect, view.sceneRect(), Qt.AspectRatioMode.KeepAspectRatio)
         painter.setPen(QPen(QColor(120, 120, 120), 1))
         painter.setBrush(Qt.BrushStyle.NoBrush)
         painter.drawRect(rect)

@@ -13,6 +13,7 @@ from collections import deque
 
 from PySide6.QtCore import QObject, Signal
 
+from ursim_core.errors import UrsimError
 from ursim_gui.dialogs import show_error
 from ursim_gui.model.jobs import MatchJob, SegmentJob
 from ursim_gui.workers import JobRunner
@@ -39,7 +40,7 @@ class JobController(QObject):
         self._parent = parent_widget
         self.runner = JobRunner(self)
         self._queue: deque = deque()
-        self.runner.progress.connect(status_bar.show_progress)
+        self.runner.progress.connect(self._progress)
         self.runner.finished.connect(self._finished)
         self.runner.failed.connect(self._failed)
         self.runner.cancelled.connect(self._cancelled)
@@ -59,8 +60,13 @@ class JobController(QObject):
         self._enqueue(SegmentJob(map_, preset, params, side=side))
 
     def match(self, config=None) -> None:
-        """Queue a match of the two segmentations (taken when the job starts)."""
-        self._enqueue(MatchRequest(config))
+        """Queue a match of the two segmentations (taken when the job starts).
+
+        ``config`` becomes the session's ``match_config``; None uses the session's.
+        """
+        if config is not None:
+            self._session.match_config = config
+        self._enqueue(MatchRequest(self._session.match_config))
 
     def cancel(self) -> None:
         """Cancel the running job and drop the queued ones."""
@@ -69,14 +75,22 @@ class JobController(QObject):
         self._status.cancel_button.setEnabled(False)
         self._status.showMessage("Cancelling…")
 
-    def run_now(self, job) -> object:
-        """Run a job in the calling thread and apply its result (scripted use: --screenshot)."""
+    def run_now(self, job) -> bool:
+        """Run a job in the calling thread and apply its result (scripted use: --screenshot).
+
+        A failure is shown and logged like a worker failure; returns True on success.
+        """
         job = self._resolve(job)
         if job is None:
-            return None
-        result = job.run(lambda fraction, message="": None, lambda: False)
-        self._apply(job, result)
-        return result
+            return False
+        try:
+            result = job.run(lambda fraction, message="": None, lambda: False)
+            self._apply(job, result)
+        except Exception as error:
+            _log.exception("%s failed", job.description)
+            show_error(self._parent, "Job failed", f"{job.description} failed:\n{error}")
+            return False
+        return True
 
     def wait(self, msecs: int = 120_000) -> None:
         """Process events until the queue is empty (tests, scripted runs)."""
@@ -115,7 +129,20 @@ class JobController(QObject):
             return None
         return MatchJob(sketch, metric, job.config)
 
+    def _is_stale(self, job) -> bool:
+        """True when the inputs changed while the job ran (its result belongs to nothing now)."""
+        if isinstance(job, SegmentJob):
+            return self._session.map(job.side) is not job.map
+        return (
+            self._session.segmentation("sketch") is not job.sketch_seg
+            or self._session.segmentation("metric") is not job.metric_seg
+        )
+
     def _apply(self, job, result) -> None:
+        if self._is_stale(job):
+            _log.info("%s: inputs changed meanwhile, result dropped", job.description)
+            self._status.showMessage(f"{job.description}: the maps changed meanwhile; result dropped", 6000)
+            return
         if isinstance(job, SegmentJob):
             self._session.set_segmentation(job.side, result)
             self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
@@ -123,9 +150,17 @@ class JobController(QObject):
             self._session.apply_match(result)
             self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)
 
+    def _progress(self, fraction: float, message: str) -> None:
+        job = self.runner.job
+        prefix = f"{job.description}: " if job is not None and message else ""
+        self._status.show_progress(fraction, prefix + message)
+
     def _finished(self, job, result) -> None:
         try:
             self._apply(job, result)
+        except (UrsimError, ValueError) as error:
+            self._queue.clear()
+            show_error(self._parent, "Cannot use the result", f"{job.description}:\n{error}")
         finally:
             self._start_next()
 

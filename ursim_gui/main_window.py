@@ -111,6 +111,8 @@ class MainWindow(QMainWindow):
 
     def _build_docks(self) -> None:
         right, bottom = Qt.DockWidgetArea.RightDockWidgetArea, Qt.DockWidgetArea.BottomDockWidgetArea
+        # The right column runs to the bottom: the panels get the full height.
+        self.setCorner(Qt.Corner.BottomRightCorner, right)
         self.docks = {
             "segmentation": self._dock("Segmentation", self.segmentation_panel, right, "dock_segmentation", scroll=True),
             "matching": self._dock("Matching", self.matching_panel, right, "dock_matching"),
@@ -120,9 +122,10 @@ class MainWindow(QMainWindow):
         }
         self.tabifyDockWidget(self.docks["evaluation"], self.docks["anchors"])
         self.docks["evaluation"].raise_()
-        self.resizeDocks([self.docks["table"]], [230], Qt.Orientation.Vertical)
-        self.resizeDocks([self.docks["segmentation"]], [300], Qt.Orientation.Horizontal)
-        self.resizeDocks([self.docks["table"], self.docks["evaluation"]], [900, 400], Qt.Orientation.Horizontal)
+        self.docks["segmentation"].setMinimumWidth(330)
+        self.resizeDocks([self.docks["table"]], [240], Qt.Orientation.Vertical)
+        self.resizeDocks([self.docks["segmentation"], self.docks["matching"]], [620, 220], Qt.Orientation.Vertical)
+        self.resizeDocks([self.docks["table"], self.docks["evaluation"]], [800, 380], Qt.Orientation.Horizontal)
 
     def _build_menus(self) -> None:
         groups: dict[str, list[str]] = {}
@@ -171,6 +174,8 @@ class MainWindow(QMainWindow):
             view.cursor_moved.connect(lambda row, col, side=side: self.tools.show_cursor(side, row, col))
             view.zoom_changed.connect(lambda factor, side=side: self._zoom_changed(side, factor))
             box = self.segmentation_panel.boxes[side]
+            box.preset.setCurrentText(self.session.segmentation_preset(side))
+            box.preset.currentTextChanged.connect(lambda preset, side=side: self.session.set_segmentation_preset(side, preset))
             box.segment_requested.connect(lambda s, preset, params: self.jobs.segment(s, preset, params))
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
@@ -234,6 +239,6 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.jobs.cancel()
-        self.jobs.runner.wait(10_000)
+        self.jobs.runner.shutdown()
         self.documents.close_document()
         event.accept()

@@ -69,6 +69,7 @@ class MapView(QGraphicsView):
         self.scene().addItem(self._base)
         self.layers = RegionLayers(self.scene())
         self._hovered = 0
+        self._fitted = False
         self._press_pos = None
         self._panning = False
         self.placeholder = "Drop a map here or use the File menu"
@@ -169,6 +170,7 @@ class MapView(QGraphicsView):
         factor = max(floor, min(MAX_ZOOM, float(factor)))
         if math.isclose(factor, self.zoom_factor(), rel_tol=1e-9):
             return
+        self._fitted = False
         anchor = QPointF(self.viewport().rect().center()) if anchor is None else QPointF(anchor)
         fixed = self.mapToScene(anchor.toPoint())
         step = factor / self.zoom_factor()
@@ -181,7 +183,9 @@ class MapView(QGraphicsView):
         self.viewport_changed.emit()
 
     def fit_to_window(self) -> None:
+        """Show the whole map; it stays fitted when the view is resized until a zoom."""
         if self.has_image():
+            self._fitted = True
             self.fitInView(self.sceneRect(), Qt.AspectRatioMode.KeepAspectRatio)
             self.layers.cull_ids(self.zoom_factor())
             self.zoom_changed.emit(self.zoom_factor())
@@ -248,6 +252,8 @@ class MapView(QGraphicsView):
 
     def resizeEvent(self, event) -> None:
         super().resizeEvent(event)
+        if self._fitted:
+            self.fit_to_window()
         self.viewport_changed.emit()
 
     def dragEnterEvent(self, event) -> None:

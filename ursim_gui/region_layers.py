@@ -8,6 +8,8 @@ cached, so hovering only adds or removes a few small items.
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QImage, QPainterPath, QPen
@@ -26,7 +28,7 @@ _MAX_PATCHED_REGIONS = 64
 _Z_OVERLAY, _Z_OUTLINE, _Z_GRAPH, _Z_MARKS, _Z_LABELS = 1, 2, 3, 4, 5
 #: kind -> (fill, outline colour, pen style, z offset above the marks base)
 MARK_STYLES = {
-    "anchors": (QColor(0, 0, 0, 0), QColor(120, 0, 140), Qt.PenStyle.DashLine, 0.1),
+    "anchors": (QColor(0, 0, 0, 0), QColor(215, 0, 150), Qt.PenStyle.DashLine, 0.1),
     "selection": (QColor(255, 255, 255, 90), QColor(0, 90, 255), Qt.PenStyle.SolidLine, 0.2),
     "highlight": (QColor(255, 200, 0, 150), QColor(230, 120, 0), Qt.PenStyle.SolidLine, 0.3),
 }
@@ -132,7 +134,7 @@ class RegionLayers:
         if self.labels is None:
             return
         fill, line, style, z = MARK_STYLES[kind]
-        pen = cosmetic_pen(line, 2.5)
+        pen = cosmetic_pen(line, 3.0 if kind == "anchors" else 2.5)
         pen.setStyle(style)
         for region in regions:
             if region <= 0 or (self.graph is not None and region not in self.graph):
@@ -147,6 +149,18 @@ class RegionLayers:
 
     def marked_regions(self, kind: str) -> set[int]:
         return {item.data(0) for item in self._marks[kind]}
+
+    @contextlib.contextmanager
+    def hidden(self, *kinds: str):
+        """Hide marks of ``kinds`` inside the block (figures show no selection or hover)."""
+        items = [item for kind in kinds for item in self._marks[kind] if item.isVisible()]
+        for item in items:
+            item.setVisible(False)
+        try:
+            yield
+        finally:
+            for item in items:
+                item.setVisible(True)
 
     def _path(self, region: int) -> QPainterPath:
         # Outlines are computed on first use and cached until the segmentation changes.
@@ -178,7 +192,8 @@ class RegionLayers:
         if self.graph is None or not self._ids_visible:
             return
         for region, (row, col) in self.positions.items():
-            item = LabelItem(str(region), QColor(255, 255, 255, 210), QColor(20, 20, 30))
+            # Above the interior point, badges below: connector lines end between them.
+            item = LabelItem(str(region), QColor(255, 255, 255, 210), QColor(20, 20, 30), offset=(0, -10))
             item.setPos(col + 0.5, row + 0.5)
             item.setZValue(_Z_LABELS)
             bbox = self.graph.nodes[region].get("bbox")
@@ -197,7 +212,7 @@ class RegionLayers:
         for region, (text, colour) in badges.items():
             if region in self.positions:
                 row, col = self.positions[region]
-                item = LabelItem(text, colour, QColor("white"), offset=(0, 16))
+                item = LabelItem(text, colour, QColor("white"), offset=(0, 10))
                 item.setPos(col + 0.5, row + 0.5)
                 item.setZValue(_Z_LABELS)
                 self.scene.addItem(item)

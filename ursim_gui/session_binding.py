@@ -38,6 +38,7 @@ class ViewBinding:
         # Colours depend on the clique id only; caching saves an HSV conversion per
         # clique and side on every edit.
         self._colour_of = functools.lru_cache(maxsize=4096)(session.color_of_clique)
+        self._hovered: tuple[str, int] = ("sketch", 0)
         session.map_changed.connect(self._map_changed)
         session.segmentation_changed.connect(self._segmentation_changed)
         session.correspondences_changed.connect(self._correspondences_changed)
@@ -74,6 +75,7 @@ class ViewBinding:
 
     def hover(self, side: str, region: int) -> None:
         """Highlight the partners of ``region`` in the other view (nothing for 0)."""
+        self._hovered = (side, region)
         other = SIDES[1 - SIDES.index(side)]
         self.views[other].set_highlight(self.session.partners(side, region) if region > 0 else ())
 
@@ -104,6 +106,7 @@ class ViewBinding:
             self._paint(side)
         self._badges_changed()
         self._update_links()
+        self.hover(*self._hovered)  # the hovered region's partners may have changed
 
     def _selection_changed(self, *_args) -> None:
         selection = self.session.selection

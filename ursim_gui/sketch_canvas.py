@@ -143,7 +143,10 @@ class SketchWindow(QMainWindow):
         self.zoom_spin.setSuffix("×")
         self.zoom_spin.valueChanged.connect(self.canvas.set_zoom)
         toolbar.addWidget(self.zoom_spin)
-        toolbar.addSeparator()
+        self.addToolBarBreak()
+        commands = self.addToolBar("Document")
+        commands.setObjectName("sketch_commands")
+        toolbar = commands
         self.undo_action = self._command(toolbar, "Undo", QKeySequence.StandardKey.Undo, self.document.undo, "sketch_undo")
         self.redo_action = self._command(toolbar, "Redo", QKeySequence.StandardKey.Redo, self.document.redo, "sketch_redo")
         self._command(toolbar, "Clear", None, self.document.clear, "sketch_clear")
@@ -152,7 +155,7 @@ class SketchWindow(QMainWindow):
         self._command(toolbar, "Use as sketch", None, self._use_as_sketch, "sketch_use")
         self.document.history_changed.connect(self._update_history)
         self._update_history()
-        self.resize(min(cols + 60, 1400), min(rows + 120, 1000))
+        self.resize(max(620, min(cols + 60, 1400)), min(rows + 120, 1000))
 
     def _command(self, toolbar, text: str, key, slot, name: str) -> QAction:
         action = QAction(text, self)

@@ -62,13 +62,20 @@ class CursorStatusBar(QStatusBar):
         self.zoom_label.setText(format_zoom(factor))
 
     def show_job(self, running: bool) -> None:
-        """Show or hide the progress bar and Cancel button."""
-        self.progress_bar.setValue(0)
+        """Show or hide the progress bar and Cancel button.
+
+        The bar starts indeterminate (a busy animation): the core's long steps report
+        no progress of their own, so a bar frozen at a percentage would mislead.
+        """
+        self.progress_bar.setRange(0, 0)
         self.progress_bar.setVisible(running)
         self.cancel_button.setVisible(running)
         self.cancel_button.setEnabled(running)
 
     def show_progress(self, fraction: float, message: str) -> None:
-        self.progress_bar.setValue(round(max(0.0, min(1.0, fraction)) * 1000))
+        """A job step: the message is shown; a step's end makes the bar determinate."""
+        if fraction >= 1.0:
+            self.progress_bar.setRange(0, 1000)
+            self.progress_bar.setValue(1000)
         if message:
             self.showMessage(message)

@@ -131,26 +131,30 @@ class WindowTools:
         if sketch is not None and metric is not None:
             ok = docs.open_map("sketch", Path(sketch)) and docs.open_map("metric", Path(metric)) and ok
             if ok:
-                self.segment_and_match(wait=wait)
+                ok = self.segment_and_match(wait=wait)
         if reference is not None and ok:
             ok = docs.load_reference(reference)
         return ok
 
-    def segment_and_match(self, *, wait: bool = False) -> None:
-        """Segment both maps with their panel settings, then match."""
+    def segment_and_match(self, *, wait: bool = False) -> bool:
+        """Segment both maps with their panel settings, then match.
+
+        With ``wait`` the jobs run in this thread (False when one failed); else they are
+        queued in the worker and True is returned at once.
+        """
+        from ursim_gui.job_controller import MatchRequest
+        from ursim_gui.model.jobs import SegmentJob
+
         jobs, panel = self.window.jobs, self.window.segmentation_panel
+        config = self.window.matching_panel.config()
+        if not wait:
+            for side in ("sketch", "metric"):
+                jobs.segment(side, panel.boxes[side].preset.currentText(), panel.boxes[side].overrides())
+            jobs.match(config)
+            return True
         for side in ("sketch", "metric"):
             box = panel.boxes[side]
-            if wait:
-                from ursim_gui.model.jobs import SegmentJob
-
-                jobs.run_now(SegmentJob(self.session.map(side), box.preset.currentText(), box.overrides(), side=side))
-            else:
-                jobs.segment(side, box.preset.currentText(), box.overrides())
-        config = self.window.matching_panel.config()
-        if wait:
-            from ursim_gui.job_controller import MatchRequest
-
-            jobs.run_now(MatchRequest(config))
-        else:
-            jobs.match(config)
+            if not jobs.run_now(SegmentJob(self.session.map(side), box.preset.currentText(), box.overrides(), side=side)):
+                return False
+        self.session.match_config = config
+        return jobs.run_now(MatchRequest(config))

@@ -1,10 +1,12 @@
-"""Run a long job (segmentation, matching) in a worker thread and report back in Qt signals.
+"""Run a long job (segmentation, matching) off the GUI thread and report back in Qt signals.
 
-A job is any object with ``run(progress, cancelled)`` (see :mod:`ursim_gui.model.jobs`):
-``progress(fraction, message)`` is called from the worker thread and ``cancelled()`` is
-polled between steps. :class:`JobRunner` owns one job at a time; its signals are
-delivered in the GUI thread (queued connections), so slots may touch widgets and the
-session. A cancelled job's result is dropped, never applied.
+A job is any picklable object with ``run(progress, cancelled)`` (see
+:mod:`ursim_gui.model.jobs`). :class:`JobRunner` runs one job at a time: a pool thread
+hands it to a child process (:class:`~ursim_gui.job_process.JobProcess`, so the GUI
+thread never waits for the interpreter lock) and relays progress and the outcome as
+signals delivered in the GUI thread (queued connections), so slots may touch widgets and
+the session. Cancel stops the child at once; a cancelled job's result is never applied.
+``in_process=True`` runs jobs in the pool thread instead (jobs that cannot be pickled).
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ import traceback
 from typing import Any
 
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
+
+from ursim_gui.job_process import JobProcess
 
 __all__ = ["JobRunner"]
 
@@ -30,22 +34,26 @@ class _Relay(QObject):
 
 
 class _Task(QRunnable):
-    def __init__(self, ticket: int, job: Any, relay: _Relay, cancel: threading.Event):
+    def __init__(self, ticket: int, job: Any, relay: _Relay, cancel: threading.Event, process: JobProcess | None):
         super().__init__()
         self.setAutoDelete(True)
-        self._ticket, self._job, self._relay, self._cancel = ticket, job, relay, cancel
+        self._ticket, self._job, self._relay, self._cancel, self._process = ticket, job, relay, cancel, process
 
     def run(self) -> None:
         def progress(fraction: float, message: str = "") -> None:
             self._relay.progress.emit(self._ticket, float(fraction), str(message))
 
         try:
-            result = self._job.run(progress, self._cancel.is_set)
+            if self._process is None:
+                result = self._job.run(progress, self._cancel.is_set)
+            else:
+                result = self._process.run(self._job, progress, self._cancel.is_set)
         except Exception as error:  # reported to the GUI thread, which shows it
             if self._cancel.is_set():
                 self._relay.done.emit(self._ticket, None)
             else:
-                self._relay.failed.emit(self._ticket, str(error) or type(error).__name__, traceback.format_exc())
+                details = getattr(error, "details", "") or traceback.format_exc()
+                self._relay.failed.emit(self._ticket, str(error) or type(error).__name__, details)
             return
         self._relay.done.emit(self._ticket, result)
 
@@ -70,8 +78,9 @@ class JobRunner(QObject):
     cancelled = Signal(object)
     busy_changed = Signal(bool)
 
-    def __init__(self, parent: QObject | None = None):
+    def __init__(self, parent: QObject | None = None, *, in_process: bool = False):
         super().__init__(parent)
+        self._process = None if in_process else JobProcess()
         self._pool = QThreadPool(self)
         self._pool.setMaxThreadCount(1)
         self._relay = _Relay(self)
@@ -97,7 +106,7 @@ class JobRunner(QObject):
         self._ticket += 1
         self._job = job
         self._cancel = threading.Event()
-        self._pool.start(_Task(self._ticket, job, self._relay, self._cancel))
+        self._pool.start(_Task(self._ticket, job, self._relay, self._cancel, self._process))
         self.started.emit(job)
         self.busy_changed.emit(True)
         return True
@@ -110,6 +119,18 @@ class JobRunner(QObject):
     def wait(self, msecs: int = -1) -> bool:
         """Block until the worker is idle (tests, shutdown); True when it is."""
         return self._pool.waitForDone(msecs)
+
+    def prewarm(self) -> None:
+        """Start the child process now (in the pool) so the first job starts at once."""
+        if self._process is not None and not self.busy:
+            self._pool.start(self._process.start)
+
+    def shutdown(self) -> None:
+        """Cancel any job, wait for the pool and stop the child process."""
+        self.cancel()
+        self._pool.waitForDone(10_000)
+        if self._process is not None:
+            self._process.stop()
 
     def _on_progress(self, ticket: int, fraction: float, message: str) -> None:
         if ticket == self._ticket and self.busy:

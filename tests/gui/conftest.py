@@ -102,8 +102,7 @@ def window(qtbot, tmp_path, map_files):
         labels = load_label_image(map_files[f"{side}_labels"], shape=win.session.map(side).shape)
         win.session.set_segmentation(side, labels)
     yield win
-    win.jobs.cancel()
-    win.jobs.runner.wait(10_000)
+    win.jobs.runner.shutdown()
 
 
 def region_point(view, region: int):

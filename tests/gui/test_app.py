@@ -16,7 +16,17 @@ from PySide6.QtWidgets import QMessageBox
 from ursim_gui import app
 
 
-def test_screenshot_option_writes_a_png_in_process(map_files, tmp_path):
+@pytest.fixture
+def restore_logging():
+    """main() installs log handlers on the root logger; take them off afterwards."""
+    yield
+    root = logging.getLogger()
+    for handler in [h for h in root.handlers if getattr(h, "_ursim_gui", False)]:
+        root.removeHandler(handler)
+        handler.close()
+
+
+def test_screenshot_option_writes_a_png_in_process(map_files, tmp_path, restore_logging):
     shot = tmp_path / "shot.png"
     code = app.main([str(map_files["sketch"]), str(map_files["metric"]), "--screenshot", str(shot)])
     assert code == 0
@@ -53,7 +63,19 @@ def test_excepthook_logs_and_shows_instead_of_crashing(qtbot, caplog, monkeypatc
         box.close()
 
 
-def test_without_arguments_the_example_is_used(monkeypatch):
+def test_without_arguments_the_example_is_opened_segmented_matched_and_scored(qtbot, tmp_path):
+    from ursim_gui.main_window import MainWindow
+    from ursim_gui.window_tools import example_inputs
+
     args = app.parse_args([])
     assert args.maps == [] and not args.no_example
-    assert app.EXAMPLE_DIR.name == "example" and app.EXAMPLE_DIR.parent.name == "resources"
+    if example_inputs() is None:
+        pytest.skip("resources/example is not generated in this checkout")
+    window = MainWindow(data_dir=tmp_path / "data")
+    qtbot.addWidget(window)
+    assert window.open_inputs(example=True, wait=True)
+    session = window.session
+    assert session.map("sketch").path.parent == app.EXAMPLE_DIR
+    assert session.segmentation("sketch") is not None and session.segmentation("metric") is not None
+    assert session.correspondences.cliques and session.evaluation is not None
+    assert window.evaluation.values["f1"].text() != "–"

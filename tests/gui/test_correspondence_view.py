@@ -37,6 +37,8 @@ def test_hover_highlights_partners_in_the_other_view(window, qtbot):
     assert metric.marked_regions("highlight") == set()
     qtbot.mouseMove(metric.viewport(), region_point(metric, 3))
     assert sketch.marked_regions("highlight") == {1}
+    window.session.unlink("sketch", 1)                       # an edit updates the hovered highlight
+    assert sketch.marked_regions("highlight") == set()
 
 
 def test_table_and_views_select_each_other(window, qtbot):
@@ -82,3 +84,21 @@ def test_linked_zoom(window, qtbot):
     window.actions["link_zoom"].setChecked(False)
     sketch.set_zoom(3)
     assert metric.zoom_factor() == 6
+
+
+def test_note_cell_edits_the_clique_note(window, qtbot):
+    clique = window.session.link([1], [1])
+    model = window.table.model
+    note = model.index(model.row_of(clique), model.columnCount() - 1)
+    assert model.flags(note) & Qt.ItemFlag.ItemIsEditable
+    assert not model.flags(model.index(0, 1)) & Qt.ItemFlag.ItemIsEditable
+    window.table.view.edit(note)
+    from PySide6.QtWidgets import QLineEdit
+
+    editor = window.table.view.findChild(QLineEdit)
+    editor.setText("kitchen")
+    qtbot.keyClick(editor, Qt.Key.Key_Return)                # the delegate commits on the next loop
+    qtbot.waitUntil(lambda: window.session.clique(clique).note == "kitchen")
+    assert model.data(note) == "kitchen"
+    window.session.undo()
+    assert window.session.clique(clique).note == ""

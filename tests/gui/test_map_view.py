@@ -48,11 +48,18 @@ def test_wheel_zooms_around_the_cursor_up_to_3200_percent(view):
     assert not view.renderHints() & QPainter.RenderHint.SmoothPixmapTransform
 
 
-def test_fit_to_window_shows_the_whole_map(view):
+def test_fit_to_window_shows_the_whole_map_and_follows_resizes(view, qtbot):
     view.set_zoom(10)
     view.fit_to_window()
     visible = view.mapToScene(view.viewport().rect()).boundingRect()
     assert visible.contains(view.sceneRect().adjusted(1, 1, -1, -1))
+    fitted = view.zoom_factor()
+    view.resize(300, 150)
+    qtbot.waitUntil(lambda: view.zoom_factor() < fitted)           # still fitted after a resize
+    view.set_zoom(4)
+    view.resize(600, 300)
+    qtbot.wait(20)
+    assert view.zoom_factor() == 4                                   # a chosen zoom is kept
 
 
 def test_drag_pans_without_selecting(qtbot, view):

@@ -48,3 +48,12 @@ def test_match_without_segmentations_explains_why(window):
     window.jobs.match(window.matching_panel.config())
     assert error_boxes(window) and "Segment both maps" in error_boxes(window)[0].text()
     assert not window.jobs.busy
+
+
+def test_a_result_for_a_replaced_map_is_dropped(window, qtbot, map_files):
+    before = window.session.segmentation("sketch")
+    window.segmentation_panel.boxes["sketch"].segment_button.click()
+    window.session.load_map("sketch", map_files["sketch"])           # replaced while the job runs
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+    assert window.session.segmentation("sketch") is None               # the stale result was not applied
+    assert before is not None and "dropped" in window.status.currentMessage()

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 from PySide6.QtCore import QMimeData, QPointF, Qt, QUrl
 from PySide6.QtGui import QDropEvent
@@ -101,3 +100,14 @@ def test_bad_json_shows_an_error(empty_window, tmp_path, monkeypatch):
     empty_window.actions["open_correspondences"].trigger()
     assert error_boxes(empty_window)
     assert empty_window.session.path is None
+
+
+def test_command_line_correspondences_option(window, tmp_path, qtbot):
+    window.session.link([2], [2])
+    saved = tmp_path / "cli.json"
+    window.session.save(saved)
+    fresh = MainWindow(data_dir=tmp_path / "cli-data")
+    qtbot.addWidget(fresh)
+    args = parse_args(["--correspondences", str(saved)])
+    assert fresh.open_inputs(correspondences=args.correspondences)
+    assert fresh.session.path == saved and fresh.session.correspondences.cliques[0].sketch_regions == (2,)

@@ -7,7 +7,7 @@ from PySide6.QtCore import QPointF
 from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QFileDialog
 
-from conftest import error_boxes, region_point
+from conftest import error_boxes
 from ursim_gui.status_bar import format_cursor, format_zoom
 
 
@@ -39,6 +39,7 @@ def test_export_figure_writes_a_png_with_a_legend(window, tmp_path, monkeypatch)
     window.session.link([1], [1])
     window.session.link([2], [3])
     window.actions["connectors"].setChecked(True)
+    window.session.select_clique(window.session.correspondences.cliques[0].id)
     target = tmp_path / "figure.png"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", staticmethod(lambda *a, **k: (str(target), "")))
     window.actions["export_figure"].trigger()
@@ -52,6 +53,8 @@ def test_export_figure_writes_a_png_with_a_legend(window, tmp_path, monkeypatch)
         for x in range(0, image.width() // 2, 7) for y in range(0, image.height() // 2, 7)
     )
     assert found
+    assert window.views["sketch"].marked_regions("selection") == {1}      # hidden only while rendering
+    assert all(item.isVisible() for item in window.views["sketch"].layers._marks["selection"])
 
 
 def test_failed_figure_export_shows_an_error(window, tmp_path):

@@ -15,6 +15,7 @@ from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView, QVBoxL
 __all__ = ["CorrespondenceTableModel", "CorrespondenceTable", "COLUMNS"]
 
 COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval", "Note")
+_NOTE_COLUMN = COLUMNS.index("Note")
 _MARK_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
 _STATUS_COLOURS = {"accepted": QColor(30, 120, 60), "rejected": QColor(170, 40, 40), "pending": QColor(120, 120, 120)}
 
@@ -109,6 +110,21 @@ class CorrespondenceTableModel(QAbstractTableModel):
         status = self._session.clique_status(clique_id)
         return status.upper() if status else ""
 
+    def flags(self, index: QModelIndex):
+        flags = super().flags(index)
+        if index.isValid() and index.column() == _NOTE_COLUMN:
+            flags |= Qt.ItemFlag.ItemIsEditable
+        return flags
+
+    def setData(self, index: QModelIndex, value, role=Qt.ItemDataRole.EditRole) -> bool:
+        """Editing the Note cell sets the clique's note in the session (one undo step)."""
+        if not index.isValid() or index.column() != _NOTE_COLUMN or role != Qt.ItemDataRole.EditRole:
+            return False
+        clique = self._cliques[index.row()]
+        if str(value) != clique.note:
+            self._session.set_note(clique.id, str(value))
+        return True
+
     def clique_id(self, row: int) -> int:
         return self._cliques[row].id
 
@@ -132,7 +148,8 @@ class CorrespondenceTable(QWidget):
         self.view.setModel(self.model)
         self.view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.view.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
-        self.view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        # Only the Note column is editable (see the model's flags).
+        self.view.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked | QAbstractItemView.EditTrigger.EditKeyPressed)
         self.view.verticalHeader().setVisible(False)
         self.view.verticalHeader().setDefaultSectionSize(22)
         self.view.setAlternatingRowColors(True)

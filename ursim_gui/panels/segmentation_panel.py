@@ -14,6 +14,7 @@ from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
     QFormLayout,
+    QGridLayout,
     QGroupBox,
     QHBoxLayout,
     QLabel,
@@ -30,6 +31,12 @@ _log = logging.getLogger(__name__)
 _DEFAULT_PRESET = {"sketch": "sketch", "metric": "robot"}
 #: Parameters shown in the panel (the others keep their preset value).
 _SHOWN = ("threshold", "margin", "ripples", "doors")
+_TIPS = {
+    "threshold": "Watershed relative-difference threshold t in [0, 1): higher merges more",
+    "margin": "Extra watershed tolerance when a close neighbour exists, in [0, 1)",
+    "ripples": "Percent of a zone's contour touching a neighbour that makes it a ripple of it",
+    "doors": "Percent of a region's contour touching other regions above which it is a door and is fused",
+}
 
 
 def preset_names() -> list[str]:
@@ -65,8 +72,10 @@ class SideSegmentationBox(QGroupBox):
         self.preset.setObjectName(f"{side}_preset")
         self.preset.addItems(preset_names())
         self.spins: dict[str, QSpinBox | QDoubleSpinBox] = {}
-        form = QFormLayout()
-        form.addRow("Preset", self.preset)
+        # Two parameters per row keeps both sides' boxes visible without scrolling.
+        grid = QGridLayout()
+        grid.addWidget(QLabel("Preset"), 0, 0)
+        grid.addWidget(self.preset, 0, 1, 1, 3)
         for name, value in preset_values(self.preset.itemText(0)).items():
             if name not in _SHOWN:
                 continue
@@ -74,11 +83,15 @@ class SideSegmentationBox(QGroupBox):
             if isinstance(spin, QDoubleSpinBox):
                 spin.setDecimals(3)
                 spin.setSingleStep(0.01)
-                spin.setRange(0.0, 1.0)
+                spin.setRange(0.0, 0.999)
             else:
-                spin.setRange(0, 10_000)
+                spin.setRange(0, 100 if name == "ripples" else 10_000)
+                spin.setSuffix(" %")
             spin.setObjectName(f"{side}_{name}")
-            form.addRow(name.replace("_", " ").capitalize(), spin)
+            spin.setToolTip(_TIPS.get(name, ""))
+            row, column = divmod(len(self.spins), 2)
+            grid.addWidget(QLabel(name.replace("_", " ").capitalize()), row + 1, 2 * column)
+            grid.addWidget(spin, row + 1, 2 * column + 1)
             self.spins[name] = spin
         self.segment_button = QPushButton("Segment")
         self.segment_button.setObjectName(f"{side}_segment")
@@ -90,7 +103,7 @@ class SideSegmentationBox(QGroupBox):
         buttons.addWidget(self.segment_button)
         buttons.addWidget(self.load_button)
         layout = QVBoxLayout(self)
-        layout.addLayout(form)
+        layout.addLayout(grid)
         layout.addLayout(buttons)
         layout.addWidget(self.summary)
         self.preset.currentTextChanged.connect(self._fill_from_preset)

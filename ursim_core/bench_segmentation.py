@@ -1,0 +1,276 @@
+"""Benchmarks of the MAORIS segmentation (hooked into ``ursim bench segment``).
+
+Each function returns a list of rows (dicts) and :func:`print_table` prints
+them. Timings are medians of several runs; wall time and process CPU time are
+both given because the machines are shared (CPU time is less sensitive to
+other processes).
+
+* :func:`bench_segmentation`: the largest KTH sketch and the largest robot map
+  of the research datasets (targets: 0.5 s and 1 s).
+* :func:`bench_scale`: synthetic buildings of growing size (target: 4000 x 4000
+  in 5 s), with peak memory.
+* :func:`bench_quality`: precision/recall/F1 of presets on the MAORIS
+  segmentation ground truth, with the authors' own label images for reference.
+
+Examples
+--------
+>>> rows = bench_scale(sizes=(200,), repeats=1)
+>>> rows[0]["size"], rows[0]["regions"] > 1
+(200, True)
+"""
+
+from __future__ import annotations
+
+import gc
+import resource
+import statistics
+import time
+import tracemalloc
+from pathlib import Path
+from typing import Callable, Iterable, Mapping
+
+import numpy as np
+
+from ursim_core.segmentation.maoris import PRESETS, MaorisParams, maoris_labels
+
+__all__ = [
+    "bench_segmentation",
+    "bench_scale",
+    "bench_quality",
+    "synthetic_building",
+    "print_table",
+]
+
+# The largest sketch (pixels) of ursim_kth_sketches and the largest robot map of
+# maoris_segmentation, as (dataset-relative path, free-space rule, preset).
+_BENCH_MAPS = (
+    ("ursim_kth_sketches/sketches/20.png", "threshold", "sketch"),
+    ("ursim_kth_sketches/sketches/24.png", "threshold", "sketch"),
+    ("maoris_segmentation/robot_maps/maps/Freiburg101_scan.png", "threshold", "robot"),
+    ("maoris_segmentation/robot_maps/maps/office_a.png", "threshold", "robot"),
+)
+
+
+def _time(function: Callable[[], object], repeats: int) -> tuple[float, float, object]:
+    walls, cpus, result = [], [], None
+    for _ in range(max(1, repeats)):
+        gc.collect()
+        wall, cpu = time.perf_counter(), time.process_time()
+        result = function()
+        walls.append(time.perf_counter() - wall)
+        cpus.append(time.process_time() - cpu)
+    return statistics.median(walls), statistics.median(cpus), result
+
+
+def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[dict]:
+    """Median time to segment the largest sketch and the largest robot map.
+
+    Parameters
+    ----------
+    dataset_root : Path or None
+        The shared datasets folder (``ursim_core.datasets.dataset_root()``);
+        None gives no rows.
+    repeats : int, keyword-only
+        Runs per map; the median is reported.
+
+    Returns
+    -------
+    list of dict
+        ``map``, ``shape``, ``preset``, ``regions``, ``wall_s``, ``cpu_s``.
+    """
+    from ursim_core.maps import load_map
+
+    rows: list[dict] = []
+    if dataset_root is None:
+        return rows
+    for relative, _, preset in _BENCH_MAPS:
+        path = Path(dataset_root) / relative
+        if not path.exists():
+            continue
+        free = load_map(path).free
+        wall, cpu, labels = _time(lambda: maoris_labels(free, PRESETS[preset]), repeats)
+        rows.append(
+            {
+                "map": relative,
+                "shape": f"{free.shape[0]}x{free.shape[1]}",
+                "preset": preset,
+                "regions": int(labels.max()),
+                "wall_s": round(wall, 3),
+                "cpu_s": round(cpu, 3),
+            }
+        )
+    return rows
+
+
+def synthetic_building(size: int, *, room: int = 160, wall: int = 6, door: int = 24, corridor: int = 40) -> np.ndarray:
+    """A square floor of ``size`` x ``size`` px: rows of rooms along corridors.
+
+    Horizontal corridors every two rows of rooms; each room has a door onto
+    its corridor. Used by :func:`bench_scale`; deterministic.
+
+    Returns
+    -------
+    ndarray of bool
+        True = free.
+
+    Examples
+    --------
+    >>> free = synthetic_building(400)
+    >>> free.shape, bool(free[0].any()), bool(free[200].any())
+    ((400, 400), False, True)
+    """
+    free = np.zeros((size, size), bool)
+    free[wall : size - wall, wall : size - wall] = True
+    band = 2 * room + corridor
+    for top in range(wall, size - wall, band):
+        corridor_top = top + room
+        # Walls: above and below the corridor, and between rooms.
+        for wall_row in (corridor_top, corridor_top + corridor):
+            free[wall_row : wall_row + wall, :] = False
+        for left in range(wall + room, size - wall, room):
+            free[top:corridor_top, left : left + wall] = False
+            free[corridor_top + corridor + wall : top + band, left : left + wall] = False
+        free[top + band - wall : top + band, :] = False
+        # One door per room onto the corridor, in the middle of its wall.
+        for left in range(wall, size - wall, room):
+            middle = left + room // 2
+            door_cols = slice(middle - door // 2, middle + door // 2)
+            free[corridor_top : corridor_top + wall, door_cols] = True
+            free[corridor_top + corridor : corridor_top + corridor + wall, door_cols] = True
+    border = np.zeros_like(free)
+    border[wall : size - wall, wall : size - wall] = True
+    return free & border
+
+
+def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, preset: str = "robot") -> list[dict]:
+    """Time and peak memory of segmenting synthetic buildings of growing size.
+
+    Returns
+    -------
+    list of dict
+        ``size``, ``pixels``, ``regions``, ``wall_s``, ``cpu_s``,
+        ``peak_traced_mb`` (tracemalloc: numpy and Python allocations),
+        ``maxrss_mb`` (process peak resident size so far; it only grows),
+        ``time_ratio`` (wall time over the previous size's) and
+        ``pixel_ratio``.
+    """
+    rows: list[dict] = []
+    previous: tuple[int, float] | None = None
+    for size in sizes:
+        free = synthetic_building(int(size))
+        wall, cpu, labels = _time(lambda: maoris_labels(free, PRESETS[preset]), repeats)
+        gc.collect()
+        tracemalloc.start()
+        maoris_labels(free, PRESETS[preset])
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        row = {
+            "size": int(size),
+            "pixels": int(size) ** 2,
+            "regions": int(labels.max()),
+            "wall_s": round(wall, 3),
+            "cpu_s": round(cpu, 3),
+            "peak_traced_mb": round(peak / 2**20, 1),
+            "maxrss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
+        }
+        if previous is not None:
+            row["pixel_ratio"] = round(row["pixels"] / previous[0], 2)
+            row["time_ratio"] = round(wall / previous[1], 2) if previous[1] > 0 else None
+        previous = (row["pixels"], wall)
+        rows.append(row)
+    return rows
+
+
+def bench_quality(
+    dataset_root: Path | None,
+    *,
+    presets: Mapping[str, MaorisParams] | None = None,
+    maps: str = "sketches",
+) -> list[dict]:
+    """Segmentation quality of presets on ``maoris_segmentation``.
+
+    Parameters
+    ----------
+    dataset_root : Path or None
+        None gives no rows.
+    presets : mapping of name to MaorisParams, keyword-only
+        Default: every entry of :data:`~ursim_core.segmentation.maoris.PRESETS`.
+    maps : {"sketches", "robot_maps"}, keyword-only
+        Sketches are scored against ``gt_lex`` and ``gt_ezvin`` and the
+        authors' label images (``maoris_output``) are scored too, as
+        "authors"; robot maps against ``gt``.
+
+    Returns
+    -------
+    list of dict
+        ``method``, ``gt``, ``maps`` (count), mean ``precision``, ``recall``,
+        ``f1``, ``evaluator_f1`` over the maps.
+    """
+    from ursim_core.maps import load_map
+    from ursim_core.segmentation.scoring import (
+        gt_labels_from_separator_image,
+        load_label_array,
+        score_segmentation,
+    )
+
+    if dataset_root is None:
+        return []
+    root = Path(dataset_root) / "maoris_segmentation" / maps
+    gt_folders = ("gt_lex", "gt_ezvin") if maps == "sketches" else ("gt",)
+    presets = dict(PRESETS if presets is None else presets)
+    scores: dict[tuple[str, str], list] = {}
+    for map_path in sorted((root / "maps").glob("*.png")):
+        predictions = {}
+        if maps == "sketches":
+            predictions["authors"] = load_label_array(root / "maoris_output" / map_path.name)
+        free = load_map(map_path).free
+        for name, params in presets.items():
+            predictions[name] = maoris_labels(free, params)
+        for gt_folder in gt_folders:
+            gt = gt_labels_from_separator_image(root / gt_folder / map_path.name)
+            for name, labels in predictions.items():
+                scores.setdefault((name, gt_folder), []).append(score_segmentation(labels, gt))
+    rows = []
+    for (name, gt_folder), values in scores.items():
+        rows.append(
+            {
+                "method": name,
+                "gt": gt_folder,
+                "maps": len(values),
+                "precision": round(float(np.mean([s.precision for s in values])), 3),
+                "recall": round(float(np.mean([s.recall for s in values])), 3),
+                "f1": round(float(np.mean([s.f1 for s in values])), 3),
+                "evaluator_f1": round(float(np.mean([s.evaluator_f1 for s in values])), 3),
+            }
+        )
+    return rows
+
+
+def print_table(rows: list[dict]) -> None:
+    """Print rows as an aligned text table (columns = union of the keys).
+
+    Examples
+    --------
+    >>> print_table([{"a": 1, "b": "x"}, {"a": 22}])
+    a   b
+    1   x
+    22
+    """
+    if not rows:
+        print("(no rows)")
+        return
+    columns: list[str] = []
+    for row in rows:
+        columns.extend(key for key in row if key not in columns)
+    cells = [[str(row.get(column, "")) for column in columns] for row in rows]
+    widths = [max(len(column), *(len(line[i]) for line in cells)) for i, column in enumerate(columns)]
+    print("  ".join(column.ljust(width) for column, width in zip(columns, widths)).rstrip())
+    for line in cells:
+        print("  ".join(cell.ljust(width) for cell, width in zip(line, widths)).rstrip())
+
+
+if __name__ == "__main__":  # pragma: no cover - manual run
+    from ursim_core.datasets import dataset_root
+
+    print_table(bench_segmentation(dataset_root()))
+    print_table(bench_scale())
