@@ -1,0 +1,59 @@
+"""Render the README screenshots of the real main window (offscreen).
+
+    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/readme_screenshots.py
+
+Writes docs/images/example_matched.png (the bundled pair, segmented, matched and scored
+against its ground truth) and docs/images/correction.png (an expert rejecting a wrong
+automatic match and selecting regions to link by hand).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+from PySide6.QtWidgets import QApplication  # noqa: E402
+
+from ursim_gui.app import EXAMPLE_DIR  # noqa: E402
+from ursim_gui.main_window import MainWindow  # noqa: E402
+
+OUT = Path(__file__).resolve().parent.parent / "docs" / "images"
+
+
+def main() -> int:
+    app = QApplication.instance() or QApplication(sys.argv)
+    OUT.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as data_dir:
+        window = MainWindow(Path(data_dir))
+        window.resize(1680, 1000)
+        window.show()
+        if not window.open_inputs(example=True, wait=True):
+            print("could not open the example", file=sys.stderr)
+            return 1
+        window.session.load_reference(EXAMPLE_DIR / "ground_truth.json")
+        app.processEvents()
+        window.fit_views()
+        app.processEvents()
+        window.grab().save(str(OUT / "example_matched.png"))
+
+        session = window.session
+        wrong = [c.id for c in session.correspondences.cliques if session.clique_status(c.id) == "fp"]
+        for clique_id in wrong:
+            session.set_status(clique_id, "rejected")
+        sketch_region = max(session.segmentation("sketch").graph.nodes)
+        session.select("sketch", [sketch_region])
+        metric_regions = sorted(session.segmentation("metric").graph.nodes)
+        session.select("metric", metric_regions[-1:])
+        app.processEvents()
+        window.grab().save(str(OUT / "correction.png"))
+        window.discard_and_close()
+    print(f"wrote {OUT / 'example_matched.png'} and {OUT / 'correction.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
