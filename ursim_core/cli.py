@@ -329,6 +329,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from ursim_core import __version__
+    from ursim_core.matching import MATCH_PRESETS
 
     parser = argparse.ArgumentParser(
         prog="ursim",
@@ -361,8 +362,10 @@ def build_parser() -> argparse.ArgumentParser:
     mat.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     mat.add_argument("--matcher", choices=["planar", "hungarian", "vf2"], help="graph matcher")
     mat.add_argument("--released", action="store_true", help="start from the released C++ code's options")
-    mat.add_argument("--sketch-preset", default="sketch", help="segmentation preset for the sketch")
-    mat.add_argument("--metric-preset", default="robot", help="segmentation preset for the metric map")
+    mat.add_argument("--sketch-preset", default=MATCH_PRESETS["sketch"],
+                     help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)")
+    mat.add_argument("--metric-preset", default=MATCH_PRESETS["metric"],
+                     help=f"segmentation preset for the metric map (default {MATCH_PRESETS['metric']})")
     mat.add_argument("--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)")
     _add_map_options(mat)
 
@@ -376,8 +379,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "explains the paper's figures) or 'fnfix' (its flag initialised)")
     ev.add_argument("--released", action="store_true",
                     help="every released-code option on (segmentation, binarisation, statistics, weights, rotations)")
-    ev.add_argument("--preset", help="segmentation preset of the sketches / input maps (default sketch, robot for robot maps)")
-    ev.add_argument("--metric-preset", help="segmentation preset of the model map (default robot)")
+    ev.add_argument("--preset", help=f"segmentation preset of the sketches / input maps (default {MATCH_PRESETS['sketch']})")
+    ev.add_argument("--metric-preset", help=f"segmentation preset of the model map (default {MATCH_PRESETS['metric']})")
     ev.add_argument("--maps", nargs="+", metavar="NAME", help="only these maps (e.g. 00 03 17)")
     ev.add_argument("--cache", metavar="DIR", help="cache segmentations in DIR between runs")
     ev.add_argument("--workers", type=int, default=2, help="processes (default 2)")

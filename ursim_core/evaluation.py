@@ -55,6 +55,7 @@ import numpy as np
 from ursim_core.dataset_layout import Experiment, discover
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation_scoring import MatchScore, score_cliques, score_matches
+from ursim_core.matching import MATCH_PRESETS
 
 __all__ = [
     "DEFAULT_M_GRID",
@@ -445,11 +446,11 @@ def run_evaluation(
     m_grid : sequence of float, keyword-only
         Fixed values of m to run; also the grid the automatic m chooses from.
     preset : str, keyword-only
-        MAORIS preset of the input maps (sketches or robot maps). Default: ``'sketch'`` for
-        sketches, ``'robot'`` for robot maps; ``'ursim-released'`` when ``released``.
+        MAORIS preset of the input maps (sketches or robot maps). Default:
+        ``ursim_core.matching.MATCH_PRESETS`` (``'ursim-released'`` when ``released``).
     metric_preset : str, keyword-only
-        MAORIS preset of the model map. Default: ``'robot'`` (``'ursim-released'`` when
-        ``released``).
+        MAORIS preset of the model map. Default: ``ursim_core.matching.MATCH_PRESETS``
+        (``'ursim-released'`` when ``released``).
     legacy_scoring : {False, True, 'fnfix'}, keyword-only
         False: correct scoring. True: the released binary's (FN always 0). 'fnfix': the released
         scorer with its flag fixed.
@@ -543,8 +544,8 @@ def run_evaluation(
     input_jobs: list[tuple[_SegmentationJob, _SegmentationJob]] = []
     digests: dict[Path, str] = {}
     for experiment in experiments:
-        input_preset = preset or ("ursim-released" if released else ("sketch" if experiment.layout == "kth" else "robot"))
-        model_preset = metric_preset or ("ursim-released" if released else "robot")
+        input_preset = preset or ("ursim-released" if released else MATCH_PRESETS["sketch"])
+        model_preset = metric_preset or ("ursim-released" if released else MATCH_PRESETS["metric"])
         input_jobs.append(
             (
                 _SegmentationJob.of(experiment.sketch, input_preset, load_options, digests),

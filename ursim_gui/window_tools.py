@@ -18,7 +18,6 @@ from ursim_gui.sketch_canvas import SketchSizeDialog, SketchWindow
 __all__ = ["WindowTools", "example_inputs"]
 
 _log = logging.getLogger(__name__)
-_DEFAULT_PRESETS = {"sketch": "sketch", "metric": "robot"}
 
 
 def example_inputs() -> tuple[Path, Path, Path | None] | None:

@@ -57,14 +57,20 @@ def test_match_writes_all_outputs(tmp_path, pair):
 
 
 def test_match_scaled_copy_is_mostly_right(tmp_path, pair):
+    from ursim_core.graph import region_graph
+
     out = tmp_path / "out"
     assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out)]) == 0
     corr = load_correspondences(out / "correspondences.json")
+    sketch_labels = cv2.imread(str(out / "sketch.labels.png"), cv2.IMREAD_UNCHANGED).astype(np.int32)
+    metric_labels = cv2.imread(str(out / "metric.labels.png"), cv2.IMREAD_UNCHANGED).astype(np.int32)
+    centroids = dict(region_graph(sketch_labels).nodes(data="centroid"))
     right = 0
     for clique in corr.cliques:
-        (s_row, s_col), (m_row, m_col) = clique.sketch_points[0], clique.metric_points[0]
-        right += abs(s_row / 1.3 - m_row) < 25 and abs(s_col / 1.3 - m_col) < 25
-    assert right >= 0.8 * len(corr.cliques)
+        (s_region,), (m_region,) = clique.sketch_regions, clique.metric_regions
+        row, col = centroids[s_region]
+        right += metric_labels[round(row / 1.3), round(col / 1.3)] == m_region
+    assert len(corr.cliques) == 5 and right == 5
 
 
 @pytest.mark.parametrize("option", [["--m", "0.1"], ["--variant", "T2"], ["--matcher", "hungarian"], ["--released"]])

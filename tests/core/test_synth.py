@@ -105,8 +105,17 @@ def test_a_map_against_itself_gives_f1_one():
     assert _f1(seg, seg, truth) == pytest.approx(1.0)
 
 
-@pytest.mark.parametrize("seed", [7])
-def test_matcher_recovers_a_sketchified_copy(seed):
-    plan, sketch = make_pair(seed=seed)
+def test_matcher_recovers_the_bundled_example_pair():
+    plan, sketch = make_pair(seed=7)  # the seed of resources/example (tools/make_example.py)
     truth = ground_truth_correspondences(plan, sketch)
     assert _f1(segment(sketch.free, preset="default"), segment(plan.free, preset="default"), truth) >= 0.9
+
+
+def test_matcher_recovers_sketchified_copies_on_average():
+    scores = []
+    for seed in range(12):
+        plan, sketch = make_pair(seed=seed)
+        truth = ground_truth_correspondences(plan, sketch)
+        scores.append(_f1(segment(sketch.free, preset="default"), segment(plan.free, preset="default"), truth))
+    # Measured 0.897 (min 0.74): rooms of equal size along one corridor are the hardest case.
+    assert np.mean(scores) >= 0.85 and min(scores) >= 0.7

@@ -58,7 +58,7 @@ class Segmentation:
 def _maoris(free: np.ndarray, **params: Any) -> np.ndarray:
     from ursim_core.segmentation.maoris import MaorisParams, maoris_labels
 
-    return maoris_labels(free, MaorisParams(**params))
+    return maoris_labels(free, MaorisParams.from_dict(params))
 
 
 #: Segmenters by name: ``callable(free, **params) -> int32 label image``.

@@ -65,7 +65,7 @@ name               t      doors  origin
 ``ursim-released`` 0.50   40     = robot (the released driver used it for
                                  sketches too, ``is_sketch = false``)
 ``icra``           0.30   40     MAORIS paper evaluation
-``sketch``         0.25   60     best single preset measured on sketches
+``sketch``         0.25   50     best single preset measured on sketches
                                  (see below)
 =================  =====  =====  ==========================================
 
@@ -80,7 +80,8 @@ per-predicted-region precision). ``authors`` = their label images
     preset          gt_lex P/R/F1      gt_ezvin P/R/F1    mean F1  evF1 lex/ezvin
     authors         .693 .901 .777     .599 .911 .713     .745     .895 .883
     t=0.25 doors 40 .665 .893 .759     .572 .909 .696     .727     .883 .878
-    t=0.25 doors 60 .720 .889 .792     .615 .904 .725     .758     .890 .884  <- sketch
+    t=0.25 doors 50 .712 .891 .788     .608 .904 .719     .753     .891 .883  <- sketch
+    t=0.25 doors 60 .720 .889 .792     .615 .904 .725     .758     .890 .884
     t=0.30 doors 40 .640 .898 .743     .551 .914 .681     .712     .883 .877
     t=0.30 doors 60 .691 .896 .777     .591 .909 .708     .742     .890 .883
     t=0.35 doors 40 .630 .904 .739     .541 .917 .672     .705     .884 .877
@@ -90,8 +91,13 @@ per-predicted-region precision). ``authors`` = their label images
     t=0.50 doors 40 .541 .923 .675     .470 .932 .615     .645     .877 .870
     t=0.50 doors 60 .549 .922 .681     .478 .931 .621     .651     .877 .870
 
-Outside that grid, t=0.20 with doors 80 reaches mean F1 .789 but over-segments
-(lower precision per predicted region on the robot maps), so it was not kept.
+``sketch`` uses doors 50 rather than the slightly higher-scoring 60: a square
+door passage (as long as it is wide) touches other regions on 52-56 % of its
+contour, so doors 60 leaves such passages as regions of their own, which the
+matcher then has to place; 50 fuses them and still beats the authors' label
+images on both ground truths. Outside the grid, t=0.20 with doors 80 reaches
+mean F1 .789 but over-segments (lower precision per predicted region on the
+robot maps below).
 
 The 15 robot maps of ``maoris_segmentation/robot_maps`` (free = grey > 250)
 against ``gt``, same measure::
@@ -284,7 +290,7 @@ PRESETS: dict[str, MaorisParams] = {
     "ursim-released": MaorisParams(threshold=0.50, doors=40),
     "icra": MaorisParams(threshold=0.30, doors=40),
     # Measured best on the sketch segmentation ground truth (module docstring).
-    "sketch": MaorisParams(threshold=0.25, doors=60),
+    "sketch": MaorisParams(threshold=0.25, doors=50),
 }
 
 
@@ -550,6 +556,8 @@ class ZoneGraph:
         self._contacts: dict[int, int] | None = None
         self._pending: dict[int, int] = {}
         self._pending_near: list[np.ndarray] = []
+        self._pending_members: list[np.ndarray] = []
+        self._identity = np.arange(count + 1, dtype=np.int32)
         self._dirty: set[int] = set()
 
     def _add_initial_edges(self, zones: np.ndarray) -> None:
@@ -688,10 +696,11 @@ class ZoneGraph:
         if not self._pending:
             return
         resolved = self._resolved_pending()
-        parent = np.arange(len(self._value), dtype=np.int32)
-        parent[np.fromiter(resolved.keys(), np.int64, len(resolved))] = np.fromiter(
-            resolved.values(), np.int64, len(resolved)
-        )
+        zones = np.fromiter(resolved.keys(), np.int64, len(resolved))
+        # A persistent identity lookup, patched for this flush: allocating one per
+        # flush would cost O(zones) each time.
+        parent = self._identity
+        parent[zones] = np.fromiter(resolved.values(), np.int64, len(resolved))
         if self._contacts is None:
             self._labels = parent[self._labels]
         else:
@@ -704,20 +713,30 @@ class ZoneGraph:
                     contacts[code] = count
                 else:
                     del contacts[code]
+            members = np.concatenate(self._pending_members)
             flat_labels = self._labels.ravel()
-            flat_labels[affected] = parent[flat_labels[affected]]
+            flat_labels[members] = parent[flat_labels[members]]
+        parent[zones] = zones
         self._pending = {}
         self._pending_near = []
+        self._pending_members = []
         self._dirty = set()
 
-    def _near_pixels(self, zone: int) -> np.ndarray:
-        # Flat indices of the zone's pixels and their 8-neighbours: the pixels
-        # whose contour status or 3x3 neighbourhood a relabelling changes.
+    def _near_pixels(self, zone: int) -> tuple[np.ndarray, np.ndarray]:
+        """Flat indices of the pixels a relabelling of `zone` affects, and of its pixels.
+
+        Affected: the zone's 8-neighbours and its pixels that are not
+        8-interior (an interior pixel stays interior, its counts unchanged).
+        """
         r0, r1, c0, c1 = self._boxes()[zone]
         crop = self._labels[r0 - 1 : r1 + 1, c0 - 1 : c1 + 1]
-        near = cv2.dilate((crop == zone).view(np.uint8), _KERNEL_3x3)
+        mask = (crop == zone).view(np.uint8)
+        near = cv2.dilate(mask, _KERNEL_3x3) - cv2.erode(mask, _KERNEL_3x3)
+        width = self._labels.shape[1]
+        offset = (r0 - 1) * width + c0 - 1
         rows, cols = np.nonzero(near)
-        return (rows + r0 - 1) * self._labels.shape[1] + cols + c0 - 1
+        member_rows, member_cols = np.nonzero(mask)
+        return rows * width + cols + offset, member_rows * width + member_cols + offset
 
     def _ensure_contacts(self) -> dict[int, int]:
         if self._contacts is None:
@@ -742,6 +761,7 @@ class ZoneGraph:
         """
         self._contacts = None
         self._pending_near = []
+        self._pending_members = []
         self._dirty = set()
 
     def _boxes(self) -> dict[int, list[int]]:
@@ -757,8 +777,9 @@ class ZoneGraph:
 
     def _record_relabel(self, zone: int, new_label: int) -> None:
         if self._contacts is not None:
-            near = self._near_pixels(zone)
+            near, members = self._near_pixels(zone)
             self._pending_near.append(near)
+            self._pending_members.append(members)
             # Every zone with a pixel next to `zone` may see its counts change;
             # labels there may still wait for a pending fusion: follow it.
             for label in set(self._labels.ravel()[near].tolist()):
@@ -775,9 +796,19 @@ class ZoneGraph:
     def fuse(self, zone: int, into: int) -> None:
         """Fuse ``zone`` into its neighbour ``into``: pixels, size and edges move.
 
-        ``into`` keeps its value. Each transferred edge (into, n) records the
-        lowest value met: ``min(value(zone), old minimum, existing minimum)``;
-        an unbreakable edge stays unbreakable. No self-loops or duplicate edges.
+        ``into`` keeps its value. An edge (zone, n) whose n is not yet a
+        neighbour of ``into`` becomes a new edge (into, n) recording the lowest
+        value met, ``min(value(zone), minimum of (zone, n))``; an existing
+        (into, n) keeps its minimum. Unbreakable edges stay unbreakable. No
+        self-loops or duplicate edges.
+
+        Examples
+        --------
+        >>> values = np.array([[90, 40, 90]], np.uint8)
+        >>> graph = ZoneGraph(flat_zones(values), values)
+        >>> graph.fuse(2, 1)
+        >>> graph.neighbours(1), graph.edge(1, 3).minimum, graph.size(1)
+        ([3], 40, 2)
         """
         if zone == into:
             raise SegmentationError(f"cannot fuse zone {zone} into itself")
@@ -1115,6 +1146,15 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     -------
     ndarray of int32
         0 = no region; regions 1..N in the raster order of their first pixel.
+
+    Notes
+    -----
+    As in the C++, some free pixels get no region: the row and column just
+    above and left of walls (the one-pixel shift of the inscribed discs),
+    regions deleted for having no neighbour when there are several, and
+    everything when the map has no obstacle pixel at all (the inscribed-circle
+    image is then constant and normalises to 0). A map without free pixels
+    gives all zeros.
 
     Examples
     --------

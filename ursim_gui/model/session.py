@@ -42,6 +42,7 @@ from ursim_core.correspondences import (
     utc_timestamp,
 )
 from ursim_core.errors import SegmentationError, UrsimError
+from ursim_core.matching import MATCH_PRESETS
 from ursim_gui.model.history import History
 from ursim_gui.model.signals import Signal
 
@@ -60,7 +61,7 @@ APP_TITLE = "URSIM Studio"
 #: Pixels a reference point may lie off a region and still count for it (the released code's value).
 REFERENCE_TOLERANCE = 10
 #: Segmentation preset a side starts with.
-DEFAULT_PRESETS = {"sketch": "sketch", "metric": "robot"}
+DEFAULT_PRESETS = dict(MATCH_PRESETS)
 #: Top-level key of an autosave file naming the document it belongs to (see autosave.py).
 AUTOSAVE_ORIGIN_KEY = "autosave_of"
 

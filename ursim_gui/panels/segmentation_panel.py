@@ -25,10 +25,12 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from ursim_gui.model.session import DEFAULT_PRESETS
+
 __all__ = ["SegmentationPanel", "SideSegmentationBox", "preset_names", "preset_values"]
 
 _log = logging.getLogger(__name__)
-_DEFAULT_PRESET = {"sketch": "sketch", "metric": "robot"}
+
 #: Parameters shown in the panel (the others keep their preset value).
 _SHOWN = ("threshold", "margin", "ripples", "doors")
 _TIPS = {
@@ -107,7 +109,7 @@ class SideSegmentationBox(QGroupBox):
         layout.addLayout(buttons)
         layout.addWidget(self.summary)
         self.preset.currentTextChanged.connect(self._fill_from_preset)
-        index = self.preset.findText(_DEFAULT_PRESET.get(side, "default"))
+        index = self.preset.findText(DEFAULT_PRESETS.get(side, "default"))
         self.preset.setCurrentIndex(max(0, index))
         self._fill_from_preset(self.preset.currentText())
         self.segment_button.clicked.connect(lambda: self.segment_requested.emit(self.side, self.preset.currentText(), self.overrides()))
