@@ -293,6 +293,14 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         progress(done, total, text)
 
     legacy: bool | str = {"none": False, "as-built": True, "fnfix": "fnfix"}[args.legacy_scoring]
+    overrides = None
+    if args.paper:
+        import dataclasses
+
+        from ursim_core.matching import MatchConfig
+
+        set_by_runner = {"variant", "matcher", "m", "weights", "m_grid"}
+        overrides = {k: v for k, v in dataclasses.asdict(MatchConfig.paper()).items() if k not in set_by_runner}
     result = run_evaluation(
         Path(args.dataset),
         matchers=args.matchers,
@@ -304,6 +312,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         maps=args.maps,
         workers=args.workers,
         cache_dir=args.cache,
+        config_overrides=overrides,
         progress=report_progress,
     )
     print(format_tables(result))
@@ -377,6 +386,8 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--legacy-scoring", nargs="?", const="as-built", default="none", choices=["none", "as-built", "fnfix"],
                     help="reproduce the released scorer: 'as-built' (default when given: false negatives dropped, "
                          "explains the paper's figures) or 'fnfix' (its flag initialised)")
+    ev.add_argument("--paper", action="store_true",
+                    help="the paper's method (no position term, structural score + substitutions) instead of the default")
     ev.add_argument("--released", action="store_true",
                     help="every released-code option on (segmentation, binarisation, statistics, weights, rotations)")
     ev.add_argument("--preset", help=f"segmentation preset of the sketches / input maps (default {MATCH_PRESETS['sketch']})")
