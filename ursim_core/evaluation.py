@@ -744,13 +744,21 @@ def _segment_job(job: _SegmentationJob):
     return segment(load_map(job.path, **job.load), preset=job.preset)
 
 
+@functools.lru_cache(maxsize=1)
+def _segmenter_code_digest() -> str:
+    from ursim_core.segmentation import maoris
+
+    return hashlib.sha256(Path(maoris.__file__).read_bytes()).hexdigest()
+
+
 def _disk_cache_path(cache_dir: Path, job: _SegmentationJob) -> Path:
     from ursim_core.segmentation import resolve_params
 
-    # The resolved parameters (not only the preset name) go in the key, so a changed preset
-    # definition invalidates the cache.
+    # The resolved parameters (not only the preset name) and the segmenter's source go in the
+    # key, so a changed preset definition or a changed MAORIS implementation invalidates the cache.
     identity = json.dumps(
-        {"sha256": job.digest, "params": resolve_params("maoris", job.preset), "load": job.load, "version": 1},
+        {"sha256": job.digest, "params": resolve_params("maoris", job.preset), "load": job.load, "version": 1,
+         "code": _segmenter_code_digest()},
         sort_keys=True,
     )
     return cache_dir / f"{job.path.stem}-{hashlib.sha256(identity.encode()).hexdigest()[:24]}.npz"

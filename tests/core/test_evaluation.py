@@ -220,7 +220,7 @@ GRID = (0.0, 0.1, 0.2)
 def synthetic_result(synthetic_dataset) -> EvaluationResult:
     return run_evaluation(
         synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "baseline"], m_grid=GRID,
-        preset="robot", workers=1,
+        preset="robot", metric_preset="robot", workers=1,
     )
 
 
@@ -289,7 +289,7 @@ def test_legacy_scoring_modes(synthetic_dataset):
 def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_path):
     calls = []
     cache: dict = {}
-    options = dict(matchers=["hungarian"], variants=["T1", "T2"], m_grid=(0.1,), preset="robot", workers=1,
+    options = dict(matchers=["hungarian"], variants=["T1", "T2"], m_grid=(0.1,), preset="robot", metric_preset="robot", workers=1,
                    segmentation_cache=cache, cache_dir=tmp_path / "segcache")
     first = run_evaluation(synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options)
     total = 2 + 2 * 2 + 1  # distinct maps + (experiment x variant) tasks + human vs human
@@ -400,7 +400,7 @@ def test_disk_cache_misses_when_a_map_changes(synthetic_dataset, tmp_path):
 
     dataset = tmp_path / "dataset"
     shutil.copytree(synthetic_dataset, dataset)
-    options = dict(matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot", workers=1,
+    options = dict(matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot", metric_preset="robot", workers=1,
                    cache_dir=tmp_path / "segcache", auto_m=False, human=False)
     run_evaluation(dataset, **options)
     Image.fromarray(_plan(1.2)).save(dataset / "sketches" / "small.png")
