@@ -187,7 +187,7 @@ def generate_floor_plan(
     corridor_width: int = 30,
     wall_thickness: int = 4,
     door_width: int = 10,
-    room_depth: tuple[int, int] = (70, 110),
+    room_depth: tuple[int, int] = (80, 140),
     room_width: tuple[int, int] = (60, 150),
     margin: int = 12,
     room_door_probability: float = 0.2,
