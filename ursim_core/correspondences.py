@@ -10,7 +10,7 @@ Two file formats:
 
 - ``.json`` (``"format": "ursim-correspondences"``, versioned, validated on load
   with the JSON Schema shipped in ``ursim_core/schemas/``). Unknown keys are
-  preserved on re-save. See ``docs/correspondence_format.md``.
+  preserved on re-save. See the "Correspondence format" section of README.md.
 - ``.dat``, the original annotators' text format (points only), kept for the
   published ground truth. Read with :func:`load_dat`, written with :func:`save_dat`.
 

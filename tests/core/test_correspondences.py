@@ -672,7 +672,7 @@ def test_regions_survive_a_json_round_trip_with_points(tmp_path):
 
 def test_documented_example_is_what_save_writes(tmp_path):
     repo = Path(__file__).resolve().parents[2]
-    documents = [repo / "docs" / "correspondence_format.md", repo / "README.md"]
+    documents = [repo / "README.md"]
     blocks = [
         block
         for document in documents
