@@ -551,8 +551,9 @@ def sketchify(
     drop_room : bool, keyword-only
         Leave out one room that has a single door.
     extra_corridor : bool, keyword-only
-        Add a short corridor stub through the outer wall that the plan does not have (when a
-        corridor reaches the outer wall somewhere). Its id is the plan's largest id + 1.
+        Add a corridor stub, narrower than the corridors, through the outer wall off a corridor
+        that is not a dead end (when one reaches the outer wall; every generated plan has
+        one). The plan does not have it; its id is the plan's largest id + 1.
 
     Returns
     -------
@@ -610,7 +611,9 @@ def sketchify(
     if extra_corridor:
         width = int(round(cw * rng.uniform(0.6, 0.85)))
         length = int(round(cw * rng.uniform(1.6, 2.6)))
-        candidates = [c for c in _stub_candidates(original, plan, width, length) if c[0] not in dropped]
+        # Not off a dead end: a dead end drawn longer is no new place to the eye.
+        candidates = [c for c in _stub_candidates(original, plan, width, length)
+                      if c[0] not in dropped and plan.graph.degree(c[0]) > 1]
         if candidates:
             parent, direction, (r0, r1, c0, c1) = candidates[int(rng.integers(len(candidates)))]
             stub = max(kinds, default=0) + 1

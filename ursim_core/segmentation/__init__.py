@@ -15,7 +15,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-__all__ = ["Segmentation", "SEGMENTERS", "segment", "resolve_params", "load_label_image", "save_label_image"]
+__all__ = ["Segmentation", "SEGMENTERS", "segment", "resolve_params", "read_label_array", "load_label_image", "save_label_image"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,23 +127,15 @@ def segment(
     return Segmentation(labels=labels, graph=region_graph(labels), method=method, params=resolved)
 
 
-def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) -> Segmentation:
-    """Load a label image (8- or 16-bit single-channel PNG, 0 = no region) as a segmentation.
+def read_label_array(path: str | Path) -> np.ndarray:
+    """Read a label image file as an int32 array of the stored ids (0 = no region).
 
-    Region ids are kept as stored, so ids in a correspondence file that references this
-    image stay valid.
-
-    Parameters
-    ----------
-    path : str or Path
-        The label image.
-    shape : (rows, cols), optional
-        Required size (the map's); a mismatch raises :class:`~ursim_core.errors.SegmentationError`.
+    Accepts 8- or 16-bit single-channel images, and colour images whose channels are equal.
+    Raises :class:`~ursim_core.errors.SegmentationError` naming the file otherwise.
     """
     import cv2
 
     from ursim_core.errors import SegmentationError
-    from ursim_core.graph import region_graph
 
     path = Path(path)
     if not path.is_file():
@@ -158,12 +150,33 @@ def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) 
         labels = channels[..., 0]
     if labels.dtype not in (np.uint8, np.uint16):
         raise SegmentationError(f"a label image must be 8 or 16 bit, got {labels.dtype}", path=path)
+    return labels.astype(np.int32)
+
+
+def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) -> Segmentation:
+    """Load a label image (8- or 16-bit single-channel PNG, 0 = no region) as a segmentation.
+
+    Region ids are kept as stored, so ids in a correspondence file that references this
+    image stay valid.
+
+    Parameters
+    ----------
+    path : str or Path
+        The label image.
+    shape : (rows, cols), optional
+        Required size (the map's); a mismatch raises :class:`~ursim_core.errors.SegmentationError`.
+    """
+
+    from ursim_core.errors import SegmentationError
+    from ursim_core.graph import region_graph
+
+    path = Path(path)
+    labels = read_label_array(path)
     if shape is not None and tuple(labels.shape) != tuple(shape):
         raise SegmentationError(
             f"label image is {labels.shape[0]}x{labels.shape[1]} (rows x cols) but the map is {shape[0]}x{shape[1]}",
             path=path,
         )
-    labels = labels.astype(np.int32)
     return Segmentation(labels=labels, graph=region_graph(labels), method="label-image", params={}, source=path)
 
 

@@ -274,15 +274,6 @@ def load_label_array(path: str | Path) -> np.ndarray:
     ...     load_label_array(path).tolist()
     [[0, 1, 2]]
     """
-    path = Path(path)
-    image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if image is None:
-        raise SegmentationError("cannot read label image", path=path)
-    if image.ndim == 3:
-        channels = image[..., :3]
-        if not (np.array_equal(channels[..., 0], channels[..., 1]) and np.array_equal(channels[..., 0], channels[..., 2])):
-            raise SegmentationError("colour label image: channels differ, cannot read labels", path=path)
-        image = channels[..., 0]
-    if image.dtype not in (np.uint8, np.uint16):
-        raise SegmentationError(f"unsupported label image type {image.dtype}", path=path)
-    return relabel_in_raster_order(image.astype(np.int32))
+    from ursim_core.segmentation import read_label_array
+
+    return relabel_in_raster_order(read_label_array(path))

@@ -124,11 +124,11 @@ def test_load_label_array(tmp_path: Path):
 
 
 def test_load_label_array_errors(tmp_path: Path):
-    with pytest.raises(SegmentationError, match="cannot read"):
+    with pytest.raises(SegmentationError, match="label image not found"):
         load_label_array(tmp_path / "missing.png")
     colour = tmp_path / "colour.png"
     cv2.imwrite(str(colour), np.dstack([np.full((2, 2), 1, np.uint8), np.full((2, 2), 2, np.uint8), np.zeros((2, 2), np.uint8)]))
-    with pytest.raises(SegmentationError, match="channels differ"):
+    with pytest.raises(SegmentationError, match="got colour"):
         load_label_array(colour)
 
 
