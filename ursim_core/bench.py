@@ -26,13 +26,10 @@ def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats:
         print("== segmentation scale (generated buildings)")
         print_table(bench_scale())
     if what in ("match", "all"):
-        from ursim_core.bench_matching import bench_kth, bench_scale as bench_match_scale, print_table as print_match
+        from ursim_core.bench_matching import main as bench_matching
 
+        print("== matching (KTH pairs, then generated graphs of 300 and 1000 regions)")
         if root is None:
-            print(f"match: skipped ({MISSING_REASON})")
-        else:
-            print("== matching on the KTH sketches")
-            print_match(bench_kth(root))
-        print("== matching scale (generated graphs)")
-        print_match(bench_match_scale((300, 1000)))
+            print(f"match on KTH: skipped ({MISSING_REASON})")
+        bench_matching(["--datasets", str(root)] if root is not None else ["--skip-kth"])
     return 0
