@@ -3,8 +3,8 @@
     QT_QPA_PLATFORM=offscreen .venv/bin/python tools/readme_screenshots.py
 
 Writes docs/images/example_matched.png (the bundled pair, segmented, matched and scored
-against its ground truth) and docs/images/correction.png (an expert rejecting a wrong
-automatic match and selecting regions to link by hand).
+against its ground truth) and docs/images/correction.png (a review in progress: wrong automatic
+matches rejected, the first ones accepted, the next one selected).
 """
 
 from __future__ import annotations
@@ -41,13 +41,15 @@ def main() -> int:
         window.grab().save(str(OUT / "example_matched.png"))
 
         session = window.session
-        wrong = [c.id for c in session.correspondences.cliques if session.clique_status(c.id) == "fp"]
-        for clique_id in wrong:
-            session.set_status(clique_id, "rejected")
-        sketch_region = max(session.segmentation("sketch").graph.nodes)
-        session.select("sketch", [sketch_region])
-        metric_regions = sorted(session.segmentation("metric").graph.nodes)
-        session.select("metric", metric_regions[-1:])
+        cliques = session.correspondences.cliques
+        # A review half done: wrong automatic matches rejected, the first ones accepted, the
+        # next one selected (its regions outlined in both views and its row highlighted).
+        for clique in cliques:
+            if session.clique_status(clique.id) == "fp":
+                session.set_status(clique.id, "rejected")
+        for clique in cliques[:4]:
+            session.set_status(clique.id, "accepted")
+        session.select_clique(cliques[4].id)
         app.processEvents()
         window.grab().save(str(OUT / "correction.png"))
         window.discard_and_close()

@@ -157,7 +157,7 @@ class CorrespondenceTable(QWidget):
         # Measured once per reset, not on every change (ResizeToContents re-reads every row).
         header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
         header.setStretchLastSection(True)
-        self.model.modelReset.connect(self.view.resizeColumnsToContents)
+        self.model.modelReset.connect(self._fit_columns)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)
@@ -165,6 +165,14 @@ class CorrespondenceTable(QWidget):
         self.view.selectionModel().selectionChanged.connect(self._row_selected)
         self.model.modelReset.connect(self.show_session_selection)
         session.selection_changed.connect(self.show_session_selection)
+
+    def _fit_columns(self) -> None:
+        self.view.resizeColumnsToContents()
+        # A status can change without a reset; leave room for the widest one.
+        status_column = COLUMNS.index("Status")
+        widest = self.view.fontMetrics().horizontalAdvance("accepted") + 24
+        if self.view.columnWidth(status_column) < widest:
+            self.view.setColumnWidth(status_column, widest)
 
     def _row_selected(self, *_args) -> None:
         if self._syncing:
