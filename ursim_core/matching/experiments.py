@@ -64,14 +64,10 @@ def reference_cliques(labels: np.ndarray, metric_labels: np.ndarray, cliques, *,
     >>> reference_cliques(sketch, metric, [Clique(id=1, sketch_points=[(0, 2)], metric_points=[(0, 0)])])
     [({2}, {5})]
     """
-    from ..correspondences import regions_at_points
+    from ..correspondences import Correspondences, assign_regions
 
-    reference = []
-    for clique in cliques:
-        sketch_regions = {r for r in regions_at_points(labels, clique.sketch_points, tolerance=tolerance) if r}
-        metric_regions = {r for r in regions_at_points(metric_labels, clique.metric_points, tolerance=tolerance) if r}
-        reference.append((sketch_regions, metric_regions))
-    return reference
+    assigned = assign_regions(Correspondences(cliques=tuple(cliques)), labels, metric_labels, tolerance=tolerance)
+    return [(set(c.sketch_regions), set(c.metric_regions)) for c in assigned.cliques]
 
 
 def score_pairs(pairs, reference, *, legacy=False):
