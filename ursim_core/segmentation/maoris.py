@@ -584,22 +584,11 @@ class ZoneGraph:
         first[1:] = codes[1:] != codes[:-1]
         unique_codes = codes[first][np.argsort(position[first], kind="stable")]
         base = len(self._value) + 1
-        # Every vertex's neighbours in the order their edges are inserted
-        # (rank of the first contact): both directions of each edge, sorted
-        # by (vertex, rank). One dict.fromkeys per vertex instead of two dict
-        # stores per edge: this runs for up to millions of flat zones.
-        low, high = unique_codes // base, unique_codes % base
-        rank = np.arange(len(unique_codes))
-        source = np.concatenate([low, high])
-        target = np.concatenate([high, low])
-        order = np.lexsort((np.concatenate([rank, rank]), source))
-        source, target = source[order], target[order]
-        starts = np.flatnonzero(np.r_[True, source[1:] != source[:-1]])
-        ends = np.r_[starts[1:], len(source)]
-        adj, targets = self.adj, target.tolist()
+        adj = self.adj
         # None stands for a plain edge (no minimum, breakable) until one is needed.
-        for vertex, start, end in zip(source[starts].tolist(), starts.tolist(), ends.tolist()):
-            adj[vertex] = dict.fromkeys(targets[start:end])
+        for a, b in zip((unique_codes // base).tolist(), (unique_codes % base).tolist()):
+            adj[a][b] = None
+            adj[b][a] = None
 
     # -- queries ----------------------------------------------------------
 
