@@ -18,7 +18,7 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 	touch $@
 
 run: $(VENV)/.installed-gui
-	$(BIN)/ursim-gui
+	$(BIN)/ursim-gui $(ARGS)
 
 test: $(VENV)/.installed-dev
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -n 2 -q
