@@ -32,12 +32,12 @@ from typing import Callable, Iterable, Mapping
 import numpy as np
 
 from ursim_core.segmentation.maoris import PRESETS, MaorisParams, maoris_labels
+from ursim_core.synth import make_large_building
 
 __all__ = [
     "bench_segmentation",
     "bench_scale",
     "bench_quality",
-    "synthetic_building",
     "print_table",
 ]
 
@@ -102,48 +102,11 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
     return rows
 
 
-def synthetic_building(size: int, *, room: int = 160, wall: int = 6, door: int = 24, corridor: int = 40) -> np.ndarray:
-    """A square floor of ``size`` x ``size`` px: rows of rooms along corridors.
-
-    Horizontal corridors every two rows of rooms; each room has a door onto
-    its corridor. Used by :func:`bench_scale`; deterministic.
-
-    Returns
-    -------
-    ndarray of bool
-        True = free.
-
-    Examples
-    --------
-    >>> free = synthetic_building(400)
-    >>> free.shape, bool(free[0].any()), bool(free[200].any())
-    ((400, 400), False, True)
-    """
-    free = np.zeros((size, size), bool)
-    free[wall : size - wall, wall : size - wall] = True
-    band = 2 * room + corridor
-    for top in range(wall, size - wall, band):
-        corridor_top = top + room
-        # Walls: above and below the corridor, and between rooms.
-        for wall_row in (corridor_top, corridor_top + corridor):
-            free[wall_row : wall_row + wall, :] = False
-        for left in range(wall + room, size - wall, room):
-            free[top:corridor_top, left : left + wall] = False
-            free[corridor_top + corridor + wall : top + band, left : left + wall] = False
-        free[top + band - wall : top + band, :] = False
-        # One door per room onto the corridor, in the middle of its wall.
-        for left in range(wall, size - wall, room):
-            middle = left + room // 2
-            door_cols = slice(middle - door // 2, middle + door // 2)
-            free[corridor_top : corridor_top + wall, door_cols] = True
-            free[corridor_top + corridor : corridor_top + corridor + wall, door_cols] = True
-    border = np.zeros_like(free)
-    border[wall : size - wall, wall : size - wall] = True
-    return free & border
-
-
 def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, preset: str = "robot") -> list[dict]:
-    """Time and peak memory of segmenting synthetic buildings of growing size.
+    """Time and peak memory of segmenting generated buildings of growing size.
+
+    The buildings come from :func:`ursim_core.synth.make_large_building` (bands of rooms along
+    corridors; about a thousand rooms at 4000 x 4000).
 
     Returns
     -------
@@ -157,7 +120,7 @@ def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, 
     rows: list[dict] = []
     previous: tuple[int, float] | None = None
     for size in sizes:
-        free = synthetic_building(int(size))
+        free = make_large_building(int(size)).free
         wall, cpu, labels = _time(lambda: maoris_labels(free, PRESETS[preset]), repeats)
         gc.collect()
         tracemalloc.start()
