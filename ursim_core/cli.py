@@ -203,7 +203,7 @@ def _match_config(args: argparse.Namespace):
         overrides["variant"] = args.variant
     if args.matcher:
         overrides["matcher"] = args.matcher
-    return base.replace(**overrides) if hasattr(base, "replace") else type(base)(**{**base.__dict__, **overrides})
+    return base.replace(**overrides)
 
 
 def _matcher_record(config, result) -> dict[str, Any]:
@@ -216,9 +216,8 @@ def _matcher_record(config, result) -> dict[str, Any]:
             return None
         return value
 
-    settings = dataclasses.asdict(config) if dataclasses.is_dataclass(config) else {}
     return {
-        "config": json.loads(json.dumps(settings, default=str)),
+        "config": json.loads(json.dumps(dataclasses.asdict(config), default=str)),
         "m": safe(float(result.m)) if result.m is not None else None,
         "cost": safe(float(result.cost)) if result.cost is not None else None,
         "anchors": [[int(a), int(b)] for a, b in result.anchors],
