@@ -498,15 +498,20 @@ def correspondences_to_json(
     return _collapse_number_lists(text) + "\n"
 
 
-def _read_json_object(path: Path) -> dict:
+def _read_bytes(path: Path, *, what: str) -> bytes:
+    """The file's bytes, or a FormatError naming the file and why it cannot be read."""
     try:
-        raw = path.read_bytes()
+        return path.read_bytes()
     except FileNotFoundError:
         raise FormatError("file not found", path=path) from None
     except IsADirectoryError:
-        raise FormatError("is a folder, not a correspondence file", path=path) from None
+        raise FormatError(f"is a folder, not {what}", path=path) from None
     except OSError as error:
         raise FormatError(f"cannot read file: {error.strerror or error}", path=path) from None
+
+
+def _read_json_object(path: Path) -> dict:
+    raw = _read_bytes(path, what="a correspondence file")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as error:
@@ -956,14 +961,7 @@ def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
 
 
 def _read_dat_lines(path: Path) -> list[str]:
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise FormatError("file not found", path=path) from None
-    except IsADirectoryError:
-        raise FormatError("is a folder, not a .dat file", path=path) from None
-    except OSError as error:
-        raise FormatError(f"cannot read file: {error.strerror or error}", path=path) from None
+    raw = _read_bytes(path, what="a .dat file")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as error:
