@@ -189,4 +189,4 @@ class SketchWindow(QMainWindow):
         return True
 
     def _use_as_sketch(self) -> None:
-        self.use_as_sketch.emit(np.array(self.document.image, copy=True))
+        self.use_as_sketch.emit(self.document.map_image())

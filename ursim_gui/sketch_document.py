@@ -120,9 +120,37 @@ class SketchDocument:
             self.changed.emit()
             self.history_changed.emit()
 
+    def map_image(self) -> np.ndarray:
+        """The sketch as a map: paper outside the outermost walls becomes outside (black).
+
+        People draw a building's outline on white paper; the paper around it is not free space
+        (the KTH sketches are filled black there). Paper connected to the canvas border is
+        therefore outside, unless nothing would be left (no closed outline yet).
+
+        Examples
+        --------
+        >>> doc = SketchDocument(20, 30)
+        >>> doc.image[2, 2:28] = doc.image[17, 2:28] = INK
+        >>> doc.image[2:18, 2] = doc.image[2:18, 27] = INK
+        >>> map_ = doc.map_image()
+        >>> int(map_[0, 0]), int(map_[10, 15])
+        (0, 255)
+        """
+        paper = (self.image > INK).astype(np.uint8)
+        count, labels = cv2.connectedComponents(paper, connectivity=4)
+        border = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+        outside = np.isin(labels, border[border > 0])
+        if not (paper.astype(bool) & ~outside).any():
+            return self.image.copy()
+        return np.where(outside, INK, self.image).astype(np.uint8)
+
     def save_png(self, path: str | Path) -> None:
-        """Write the sketch as an 8-bit grey PNG, atomically (raises OSError on failure)."""
-        ok, encoded = cv2.imencode(".png", self.image)
+        """Write the sketch as an 8-bit grey PNG of :meth:`map_image`, atomically.
+
+        Raises OSError on failure. Saving the map image means a saved sketch loads back as
+        exactly the map that "Use as sketch" gives.
+        """
+        ok, encoded = cv2.imencode(".png", self.map_image())
         if not ok:
             raise OSError(f"{path}: could not encode the sketch as PNG")
         atomic_write_bytes(Path(path), encoded.tobytes())

@@ -61,12 +61,18 @@ def test_new_sketch_from_the_menu_draw_undo_save_and_use(window, qtbot, tmp_path
 
     saved = tmp_path / "drawn.png"
     assert sketch.save_to(str(saved))
-    assert np.array_equal(cv2.imread(str(saved), cv2.IMREAD_UNCHANGED), sketch.document.image)
+    # Saved as the map it stands for: paper around the drawing is outside; the rectangle's
+    # inside (closed by the walls) stays free.
+    written = cv2.imread(str(saved), cv2.IMREAD_UNCHANGED)
+    assert np.array_equal(written, sketch.document.map_image())
+    assert written[5, 5] == INK and written[80, 80] == PAPER
 
     sketch.findChild(type(sketch.undo_action), "sketch_use").trigger()
     session_sketch = window.session.map("sketch")
     assert session_sketch.shape == (120, 200)
     assert not session_sketch.free[110, 100] and session_sketch.free[80, 80]
+    assert not session_sketch.free[5, 5], "paper outside the drawn walls is not free space"
+    assert np.array_equal(session_sketch.free, written > 250)
     assert window.views["sketch"].sceneRect().width() == 200
     sketch.close()
 

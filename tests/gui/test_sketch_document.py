@@ -69,3 +69,17 @@ def test_save_png_round_trips(tmp_path):
 def test_too_small_canvas_is_refused():
     with pytest.raises(ValueError):
         SketchDocument(4, 100)
+
+
+def test_map_image_keeps_open_drawings_and_fills_outside_closed_ones():
+    from ursim_gui.sketch_document import INK, PAPER, SketchDocument
+
+    doc = SketchDocument(30, 40)
+    doc.image[15, 5:35] = INK                       # one wall, no outline: nothing is outside
+    assert (doc.map_image() == doc.image).all()
+    doc.image[3, 3:37] = doc.image[26, 3:37] = INK  # now a closed outline
+    doc.image[3:27, 3] = doc.image[3:27, 36] = INK
+    drawn = doc.map_image()
+    assert drawn[0, 0] == INK and drawn[29, 39] == INK
+    assert drawn[8, 20] == PAPER and drawn[20, 20] == PAPER
+    assert (doc.image[0, 0] == PAPER), "the drawing itself is not changed"
