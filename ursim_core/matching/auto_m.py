@@ -23,7 +23,7 @@ at > 250, correct scoring; mean F1 as malcolm / vasiliki; ``ursim evaluate`` on
 configuration                                         oracle m     best fixed m auto m
 ====================================================  ===========  ===========  ===========
 ``--paper`` (T4, structure + substitutions)           .67 pooled   .55 pooled   .53 pooled
-``--released --legacy-scoring fnfix`` (faithfulness)  .54 / .54    .46 / .46    --
+``--released --legacy-scoring fnfix`` (faithfulness)  .48 / .47    .45 / .45    --
 **default** ``MatchConfig()``                         .66 / .72    .62 / .70    **.65 / .71**
 ====================================================  ===========  ===========  ===========
 
