@@ -64,8 +64,9 @@ class CursorStatusBar(QStatusBar):
     def show_job(self, running: bool) -> None:
         """Show or hide the progress bar and Cancel button.
 
-        The bar starts indeterminate (a busy animation): the core's long steps report
-        no progress of their own, so a bar frozen at a percentage would mislead.
+        The bar starts indeterminate (a busy animation): segmentation reports no progress of
+        its own, so a bar frozen at a percentage would mislead; matching with the automatic
+        m turns it into a percentage (:meth:`show_progress`).
         """
         self.progress_bar.setRange(0, 0)
         self.progress_bar.setVisible(running)
@@ -73,9 +74,10 @@ class CursorStatusBar(QStatusBar):
         self.cancel_button.setEnabled(running)
 
     def show_progress(self, fraction: float, message: str) -> None:
-        """A job step: the message is shown; a step's end makes the bar determinate."""
-        if fraction >= 1.0:
+        """A job step: the message is shown; a fraction past the first step makes the bar
+        determinate (the automatic m reports one step per value of m)."""
+        if fraction > 0.05:
             self.progress_bar.setRange(0, 1000)
-            self.progress_bar.setValue(1000)
+            self.progress_bar.setValue(round(1000 * min(fraction, 1.0)))
         if message:
             self.showMessage(message)

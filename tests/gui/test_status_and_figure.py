@@ -60,3 +60,19 @@ def test_export_figure_writes_a_png_with_a_legend(window, tmp_path, monkeypatch)
 def test_failed_figure_export_shows_an_error(window, tmp_path):
     assert not window.tools.export_figure(tmp_path / "nope" / "figure.png")
     assert error_boxes(window)
+
+
+def test_job_progress_starts_busy_and_becomes_a_percentage(qtbot):
+    from ursim_gui.status_bar import CursorStatusBar
+
+    bar = CursorStatusBar()
+    qtbot.addWidget(bar)
+    bar.show_job(True)
+    assert (bar.progress_bar.minimum(), bar.progress_bar.maximum()) == (0, 0)      # busy
+    bar.show_progress(0.05, "matching")
+    assert bar.progress_bar.maximum() == 0
+    bar.show_progress(0.5, "matching at m = 0.225")
+    assert (bar.progress_bar.maximum(), bar.progress_bar.value()) == (1000, 500)
+    assert bar.currentMessage() == "matching at m = 0.225"
+    bar.show_job(False)
+    assert not bar.progress_bar.isVisibleTo(bar)

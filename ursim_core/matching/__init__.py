@@ -417,9 +417,11 @@ def _cost_of(prepared: Prepared, index_pairs, pair_costs) -> tuple[float, float]
     return cost, (cost / total if total else 0.0)
 
 
-def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
+def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None) -> MatchResult:
     """Run the configured matcher at one m (or the automatic m when ``m`` is None and
     the config says ``'auto'``).
+
+    ``progress(fraction, message)``, when given, follows the automatic m's sweep.
 
     Examples
     --------
@@ -435,7 +437,7 @@ def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
         if config.m == "auto":
             from .auto_m import choose_m
 
-            return choose_m(prepared)
+            return choose_m(prepared, progress=progress)
         m = float(config.m)
     m = float(m)
     descriptors = prepared.descriptors
@@ -493,13 +495,15 @@ def match_prepared(prepared: Prepared, m: float | None = None) -> MatchResult:
     )
 
 
-def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig()) -> MatchResult:
+def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig(), progress=None) -> MatchResult:
     """Match the regions of a sketch to the regions of a metric map.
 
     Parameters
     ----------
     sketch_seg, metric_seg : Segmentation or networkx.Graph
     config : MatchConfig
+    progress : callable, optional
+        ``progress(fraction, message)`` during the automatic m's sweep.
 
     Returns
     -------
@@ -515,5 +519,5 @@ def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig()) -> Mat
     >>> sorted(result.pairs), result.reason
     ([(0, 0), (1, 1), (2, 2), (3, 3)], '')
     """
-    return match_prepared(prepare(sketch_seg, metric_seg, config))
+    return match_prepared(prepare(sketch_seg, metric_seg, config), progress=progress)
 

@@ -49,8 +49,10 @@ import numpy as np
 __all__ = ["AUTO_RULES", "choose_m", "sweep"]
 
 
-def sweep(prepared, grid=None) -> list:
+def sweep(prepared, grid=None, *, progress=None) -> list:
     """Match at every m of the grid (``config.m_grid`` by default), in grid order.
+
+    ``progress(fraction, message)``, when given, is called after each m (for progress bars).
 
     Values of m that select exactly the same pairs as the previous one (same "same" relation)
     reuse its result, with ``m`` updated: the matcher would return the same answer.
@@ -72,13 +74,15 @@ def sweep(prepared, grid=None) -> list:
     c_matrix = prepared.c_matrix
     results = []
     previous_mask = None
-    for m in grid:
+    for index, m in enumerate(grid, start=1):
         mask = c_matrix <= float(m)
         if previous_mask is not None and np.array_equal(mask, previous_mask) and results:
             results.append(replace(results[-1], m=float(m)))
-            continue
-        results.append(match_prepared(prepared, float(m)))
-        previous_mask = mask
+        else:
+            results.append(match_prepared(prepared, float(m)))
+            previous_mask = mask
+        if progress is not None:
+            progress(index / len(grid), f"matching at m = {float(m):.3f}")
     return results
 
 
@@ -108,8 +112,10 @@ def _rule_structure(prepared, results) -> list[float]:
 AUTO_RULES = {"score": _rule_score, "structure": _rule_structure}
 
 
-def choose_m(prepared):
+def choose_m(prepared, *, progress=None):
     """Pick m over ``config.m_grid`` with ``config.auto_rule``; return that m's MatchResult.
+
+    ``progress(fraction, message)`` is passed to :func:`sweep`.
 
     The result's ``m_scan`` maps every m of the grid to the rule's statistic (lower is
     better); ties go to the smallest m.
@@ -126,7 +132,7 @@ def choose_m(prepared):
     >>> result.m in MatchConfig().m_grid, sorted(result.pairs)
     (True, [(0, 0), (1, 1), (2, 2), (3, 3)])
     """
-    results = sweep(prepared)
+    results = sweep(prepared, progress=progress)
     scores = AUTO_RULES[prepared.config.auto_rule](prepared, results)
     lowest = min(scores)
     best = next(k for k, value in enumerate(scores) if value <= lowest + 1e-12)

@@ -6,10 +6,11 @@ and hands the result back to the GUI thread, which calls
 ``AnnotationSession.set_segmentation`` or ``apply_match``. Keeping the jobs free of
 Qt means they are tested like plain functions.
 
-The core functions are single calls without progress hooks, so a job reports
-progress and checks for cancellation *between* its steps; a cancel request made
-during the long step takes effect as soon as that step returns, and the result
-is then discarded instead of being applied.
+Segmentation is one core call without progress hooks, so its job reports progress and
+checks for cancellation *between* its steps. Matching with the automatic m reports each
+value of m of its sweep and checks for cancellation between two of them. A cancel
+request made during a step takes effect as soon as that step returns, and the result is
+then discarded instead of being applied.
 """
 
 from __future__ import annotations
@@ -128,13 +129,21 @@ class MatchJob:
         """
         # Imported here: matching pulls in the heavy descriptor code, and the model
         # package must stay cheap to import (and importable while it is absent).
-        from ursim_core.matching import MatchConfig, match
+        from ursim_core.matching import MatchConfig, match_prepared, prepare
 
         progress(0.0, "preparing")
         _check(cancelled, "matching")
         config = self.config if self.config is not None else MatchConfig()
+        prepared = prepare(self.sketch_seg, self.metric_seg, config)
+        _check(cancelled, "matching")
         progress(0.05, "matching")
-        result = match(self.sketch_seg, self.metric_seg, config=config)
+
+        def sweep_progress(fraction: float, message: str) -> None:
+            # The automatic m runs the matcher once per m: cancel between two of them.
+            _check(cancelled, "matching")
+            progress(0.05 + 0.95 * fraction, message)
+
+        result = match_prepared(prepared, progress=sweep_progress)
         _check(cancelled, "matching")
         progress(1.0, f"{len(result.pairs)} pairs")
         return result

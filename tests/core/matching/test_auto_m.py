@@ -60,3 +60,20 @@ def test_custom_grid_is_respected(pair):
     config = MatchConfig(m_grid=(0.05, 0.15))
     assert choose_m(prepare(graph, copy, config)).m in (0.05, 0.15)
     assert replace(config, m=0.05).m == 0.05
+
+
+def test_sweep_reports_progress_once_per_m():
+    import networkx as nx
+
+    from ursim_core.matching import MatchConfig, prepare
+    from ursim_core.matching.auto_m import sweep
+
+    g = nx.cycle_graph(4)
+    nx.set_node_attributes(g, {0: 90, 1: 10, 2: 20, 3: 30}, "size")
+    nx.set_node_attributes(g, {0: 0.1, 1: 0.5, 2: 0.3, 3: 0.2}, "pca_shape")
+    nx.set_node_attributes(g, {0: (0, 0), 1: (0, 10), 2: (10, 10), 3: (10, 0)}, "centroid")
+    calls = []
+    results = sweep(prepare(g, g.copy(), MatchConfig()), [0.0, 0.1, 0.2], progress=lambda f, m: calls.append((f, m)))
+    assert len(results) == 3
+    assert [f for f, _ in calls] == pytest.approx([1 / 3, 2 / 3, 1.0])
+    assert calls[-1][1] == "matching at m = 0.200"

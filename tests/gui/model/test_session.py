@@ -739,3 +739,27 @@ def test_match_config_defaults_to_the_core_defaults(session):
     custom = dataclasses.replace(matching.MatchConfig(), m=0.1)
     session.match_config = custom
     assert session.match_config is custom
+
+
+def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(session):
+    from ursim_core.matching import MatchConfig
+
+    config = MatchConfig(m="auto")
+    reports = []
+    MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
+        lambda fraction, message: reports.append((fraction, message)), lambda: False)
+    fractions = [fraction for fraction, _ in reports]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    steps = [message for _, message in reports if message.startswith("matching at m = ")]
+    assert len(steps) == len(config.m_grid)
+
+    polls = []
+
+    def cancel_during_the_sweep():
+        polls.append(1)
+        return len(polls) > 5
+
+    with pytest.raises(JobCancelled):
+        MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
+            lambda *a: None, cancel_during_the_sweep)
+    assert len(polls) == 6
