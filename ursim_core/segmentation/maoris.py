@@ -630,14 +630,7 @@ class ZoneGraph:
 
     def contact_percent(self, zone: int, other: int) -> int:
         """Integer percentage of ``zone``'s contour pixels having ``other`` in their 3x3 neighbourhood."""
-        contacts = self._ensure_contacts()
-        if zone in self._dirty:
-            self._flush()
-        key = zone * len(self._value)
-        total = contacts.get(key, 0)
-        if total == 0:
-            return 0
-        return contacts.get(key + other, 0) * 100 // total
+        return self.contact_percents(zone)(other)
 
     def contact_percents(self, zone: int) -> Callable[[int], int]:
         """A function ``other -> contact_percent(zone, other)`` valid until the next fusion.
