@@ -22,9 +22,9 @@ at > 250, correct scoring; mean F1 as malcolm / vasiliki; ``ursim evaluate`` on
 ====================================================  ===========  ===========  ===========
 configuration                                         oracle m     best fixed m auto m
 ====================================================  ===========  ===========  ===========
-``--paper`` (T4, structure + substitutions)           .67 pooled   .55 pooled   .53 pooled
-``--released --legacy-scoring fnfix`` (faithfulness)  .48 / .47    .45 / .45    --
-**default** ``MatchConfig()``                         .66 / .72    .62 / .70    **.65 / .71**
+``--paper`` (T4, structure + substitutions)           .68 pooled   .58 pooled   .52 pooled
+``--released --legacy-scoring fnfix`` (faithfulness)  .53 / .54    .47 / .46    --
+**default** ``MatchConfig()``                         .67 / .73    .63 / .70    **.65 / .71**
 ====================================================  ===========  ===========  ===========
 
 The released C++ measured on the same data: oracle .568 / .562, best fixed m .487 / .475

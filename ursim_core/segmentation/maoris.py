@@ -19,6 +19,12 @@ tested on its own:
 
 :func:`maoris_labels` runs them all.
 
+Speed: a 4000 x 4000 map starts with about 1.5 million flat zones, visited
+one by one in an order that decides ties, so steps 3-4 cannot be vectorised;
+they run as compiled code (numba, ``_zone_kernels``) on an array form of the
+zone graph. The kernels compile on first use, about half a minute, once:
+numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
+
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
 
 * The C++ paints, for every free pixel q with r = min(int(dist(q)), 500), a
@@ -44,10 +50,18 @@ Faithfulness notes (see ../shared/design/original_code.md, section 2):
   them, but only those present when :func:`mark_unbreakable_edges` runs
   matter. Also lowering existing edges' minima (a literal reading of the
   design notes) makes nearly every edge unbreakable and matched the released
-  region counts far worse (24 instead of 40 of 57 exact).
+  region counts far worse (24 instead of 40 of 57 exact, measured with the
+  earlier watershed reading).
+* Watershed flood (:func:`watershed_merge`): the recursion scans all
+  neighbours of a zone, marking them visited (also those behind an
+  unbreakable edge), before recursing into the ones it absorbed; closeNeigh
+  only looks through breakable edges. The earlier depth-first reading (a
+  zone behind an unbreakable edge stays absorbable through another path;
+  closeNeigh over all edges) matched 40 instead of 43 of the 57 released
+  region counts and gave the model 5 regions instead of 6.
 * Fidelity, measured against the region counts of the released C++
   (``released_code_results.md``: 18 KTH sketches + the model, three
-  parameter sets, 57 runs): 40 equal, 52 within +-1, all 57 within +-2. The free
+  parameter sets, 57 runs): 43 equal, 52 within +-1, all 57 within +-2. The free
   pixels left unlabelled match the authors' label images to within a few
   pixels per map.
 
@@ -142,6 +156,7 @@ from scipy import ndimage as ndi
 from skimage.measure import label as _label_equal_values
 
 from ursim_core.errors import ParameterError, SegmentationError
+from ursim_core.segmentation import _zone_kernels as _kernels
 
 __all__ = [
     "MaorisParams",
@@ -493,6 +508,7 @@ class ZoneEdge:
         return f"ZoneEdge(minimum={self.minimum}, unbreakable={self.unbreakable})"
 
 
+_MISSING = object()
 _PAD = 2  # label image padding: pixels next to a zone gather their own 3x3 neighbourhood
 _OFFSETS_8 = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
 
@@ -504,12 +520,18 @@ class ZoneGraph:
     of the first pixel); each vertex's neighbours are kept in edge-insertion
     order. A fusion moves the absorbed zone's pixels and transfers its edges.
 
+    The adjacency has two forms. A new graph keeps it in compact arrays (see
+    ``_zone_kernels``): a large map starts with millions of flat zones, and
+    the first steps (:func:`remove_small_zones`, :func:`merge_ripples`) run
+    on them as compiled code. The first access to :attr:`adj` turns it into
+    dicts, which the later steps, on a few hundred zones, read and change;
+    a compiled step converts them back.
+
     Contacts (contour pixels of a zone having another zone in their 3x3
     neighbourhood) are computed for the whole image when first needed, then
     updated locally around each fused zone. Steps that fuse many zones without
-    needing contacts (small-zone removal, watershed) drop them instead and
-    only record the fusions; the label image is rewritten once, when next
-    needed.
+    needing contacts (the watershed) drop them instead and only record the
+    fusions; the label image is rewritten once, when next needed.
 
     Parameters
     ----------
@@ -517,14 +539,6 @@ class ZoneGraph:
         Zone labels 1..N (0 = no zone), e.g. from :func:`flat_zones`.
     values : ndarray, shape (rows, cols)
         The value of every pixel; each zone must be flat.
-
-    Attributes
-    ----------
-    adj : dict of int to dict of int to ZoneEdge or None
-        ``adj[a][b]`` is the edge between a and b, or None for a plain edge
-        (no minimum, breakable) that was never touched; :meth:`edge` always
-        gives a :class:`ZoneEdge`. Read-only for callers: mutate through
-        :meth:`fuse` and :meth:`remove`.
 
     Examples
     --------
@@ -542,17 +556,20 @@ class ZoneGraph:
         self.shape = zones.shape
         self._labels = np.pad(zones.astype(np.int32, copy=False), _PAD)
         count = int(zones.max(initial=0))
-        value = np.zeros(count + 1, np.int64)
+        value = np.zeros(count + 1, np.int32)
         value[zones.ravel()] = values.ravel()
+        self._value_array = value
         self._value: list[int] = value.tolist()
-        sizes = np.bincount(zones.ravel(), minlength=count + 1)
-        self._size: list[int] = sizes.tolist()
+        self._size = np.bincount(zones.ravel(), minlength=count + 1).astype(np.int64)
         # Bounding boxes (padded coordinates, max exclusive), computed when first needed.
         self._bbox: dict[int, list[int]] | None = None
-        self.adj: dict[int, dict[int, ZoneEdge | None]] = {
-            zone: {} for zone in (np.flatnonzero(sizes[1:]) + 1).tolist()
-        }
-        self._add_initial_edges(zones)
+        # The adjacency lives either in compact arrays (the compiled steps'
+        # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
+        self._alive = self._size > 0
+        self._alive[0] = False
+        self._compact: tuple | None = _kernels.build_adjacency(zones.astype(np.int32, copy=False), count + 1)
+        self._free_top = np.zeros(1, np.int64)
+        self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         self._contacts: dict[int, int] | None = None
         self._pending: dict[int, int] = {}
         self._pending_near: list[np.ndarray] = []
@@ -560,47 +577,89 @@ class ZoneGraph:
         self._identity = np.arange(count + 1, dtype=np.int32)
         self._dirty: set[int] = set()
 
-    def _add_initial_edges(self, zones: np.ndarray) -> None:
-        rows, cols = zones.shape
-        lows, highs, positions = [], [], []
-        # A pixel is compared with its left neighbour (kind 0), then its upper one (kind 1).
-        for kind, current, previous in ((0, zones[:, 1:], zones[:, :-1]), (1, zones[1:, :], zones[:-1, :])):
-            touching = (current != previous) & (current > 0) & (previous > 0)
-            where_rows, where_cols = np.nonzero(touching)
-            a = current[where_rows, where_cols].astype(np.int64)
-            b = previous[where_rows, where_cols].astype(np.int64)
-            lows.append(np.minimum(a, b))
-            highs.append(np.maximum(a, b))
-            offset = (0, 1) if kind == 0 else (1, 0)
-            positions.append(((where_rows + offset[0]) * cols + where_cols + offset[1]) * 2 + kind)
-        low, high, position = (np.concatenate(x) for x in (lows, highs, positions))
-        if len(low) == 0:
-            return
-        codes = low * (len(self._value) + 1) + high
-        # First contact of every pair: sort by (pair, position), keep the first of each pair.
-        order = np.lexsort((position, codes))
-        codes, position = codes[order], position[order]
-        first = np.ones(len(codes), bool)
-        first[1:] = codes[1:] != codes[:-1]
-        unique_codes = codes[first][np.argsort(position[first], kind="stable")]
-        base = len(self._value) + 1
-        adj = self.adj
-        # None stands for a plain edge (no minimum, breakable) until one is needed.
-        for a, b in zip((unique_codes // base).tolist(), (unique_codes % base).tolist()):
-            adj[a][b] = None
-            adj[b][a] = None
+    @property
+    def adj(self) -> dict[int, dict[int, ZoneEdge | None]]:
+        """``adj[a][b]``: the edge between a and b, or None for a plain edge (no
+        minimum, breakable) never touched; :meth:`edge` always gives a
+        :class:`ZoneEdge`. Read-only for callers: mutate through :meth:`fuse`
+        and :meth:`remove`."""
+        if self._adj is None:
+            self._adj = self._adjacency_dicts()
+            self._compact = None
+        return self._adj
+
+    def _adjacency_dicts(self) -> dict[int, dict[int, ZoneEdge | None]]:
+        adj: dict[int, dict[int, ZoneEdge | None]] = {zone: {} for zone in np.flatnonzero(self._alive).tolist()}
+        edges: dict[int, ZoneEdge | None] = {}  # node -> the edge object both directions share
+        for zone, other, node, twin, low, unbreakable in _kernels.adjacency_entries(self._alive, self._compact).tolist():
+            edge = edges.pop(twin, _MISSING)
+            if edge is _MISSING:
+                edge = None if low < 0 and not unbreakable else ZoneEdge(None if low < 0 else low, bool(unbreakable))
+                edges[node] = edge
+            adj[zone][other] = edge
+        return adj
+
+    def _compact_adjacency(self) -> tuple:
+        """The adjacency as compact arrays (converted from `_adj` if needed)."""
+        if self._compact is None:
+            count = len(self._value)
+            node_of: dict[tuple[int, int], int] = {}
+            for a, neighbours in self._adj.items():
+                for b in neighbours:
+                    node_of[(a, b)] = len(node_of)
+            capacity = max(len(node_of), 2)
+            head = np.full(count, -1, np.int32)
+            tail = np.full(count, -1, np.int32)
+            degree = np.zeros(count, np.int32)
+            neighbour = np.zeros(capacity, np.int32)
+            next_node = np.full(capacity, -1, np.int32)
+            previous_node = np.full(capacity, -1, np.int32)
+            twin = np.zeros(capacity, np.int32)
+            minimum = np.full(capacity, _kernels.NO_MINIMUM, np.int32)
+            unbreakable = np.zeros(capacity, bool)
+            for a, neighbours in self._adj.items():
+                nodes = [node_of[(a, b)] for b in neighbours]
+                degree[a] = len(nodes)
+                if nodes:
+                    head[a], tail[a] = nodes[0], nodes[-1]
+                for previous, node, following in zip([-1] + nodes[:-1], nodes, nodes[1:] + [-1]):
+                    previous_node[node], next_node[node] = previous, following
+                for b, edge in neighbours.items():
+                    node = node_of[(a, b)]
+                    neighbour[node], twin[node] = b, node_of[(b, a)]
+                    if edge is not None:
+                        minimum[node] = _kernels.NO_MINIMUM if edge.minimum is None else edge.minimum
+                        unbreakable[node] = edge.unbreakable
+            self._alive = np.zeros(count, bool)
+            self._alive[list(self._adj)] = True
+            free = np.empty(capacity, np.int32)
+            self._compact = (head, tail, degree, neighbour, next_node, previous_node, twin, minimum, unbreakable, free)
+            self._free_top[0] = 0
+            self._adj = None
+        return self._compact
+
+    def _run_compiled(self) -> tuple:
+        """Prepare for a compiled step: labels flushed, contacts and boxes dropped."""
+        self._flush()
+        self.invalidate_contacts()
+        self._bbox = None
+        return self._compact_adjacency()
 
     # -- queries ----------------------------------------------------------
 
     def vertices(self) -> list[int]:
         """Zone ids in insertion order."""
-        return list(self.adj)
+        if self._adj is None:
+            return np.flatnonzero(self._alive).tolist()
+        return list(self._adj)
 
     def __len__(self) -> int:
-        return len(self.adj)
+        return int(self._alive.sum()) if self._adj is None else len(self._adj)
 
     def __contains__(self, zone: object) -> bool:
-        return zone in self.adj
+        if self._adj is not None:
+            return zone in self._adj
+        return isinstance(zone, (int, np.integer)) and 0 < zone < len(self._alive) and bool(self._alive[zone])
 
     def neighbours(self, zone: int) -> list[int]:
         """Neighbours of ``zone`` in edge-insertion order."""
@@ -620,7 +679,7 @@ class ZoneGraph:
 
     def size(self, zone: int) -> int:
         """Number of pixels of a zone."""
-        return self._size[zone]
+        return int(self._size[zone])
 
     @property
     def labels(self) -> np.ndarray:
@@ -903,6 +962,7 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
 
     One pass in vertex order, sizes as they are when a zone is visited; ties
     go to the first neighbour; a small zone without neighbours is deleted.
+    Fusions transfer edges as :meth:`ZoneGraph.fuse` does.
 
     Examples
     --------
@@ -911,44 +971,13 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     >>> graph.labels.tolist()
     [[1, 1, 1, 1]]
     """
-    graph.invalidate_contacts()
-    graph._bbox = None  # recomputed when next needed
-    adj, value, size, pending = graph.adj, graph._value, graph._size, graph._pending
-    for zone in list(adj):
-        if size[zone] >= min_size or zone not in adj:
-            continue
-        neighbours = adj[zone]
-        if not neighbours:
-            graph.remove(zone)
-            continue
-        zone_value = value[zone]
-        closest, closest_gap = 0, 256
-        for other in neighbours:
-            gap = value[other] - zone_value
-            if gap < 0:
-                gap = -gap
-            if gap < closest_gap:
-                closest, closest_gap = other, gap
-        # ZoneGraph.fuse inlined (no contacts, no boxes): this loop runs for
-        # tens of thousands of one-pixel zones on noisy robot maps.
-        pending[zone] = closest
-        size[closest] += size[zone]
-        target = adj[closest]
-        del adj[zone]
-        for neighbour, old in neighbours.items():
-            neighbour_adj = adj[neighbour]
-            del neighbour_adj[zone]
-            if neighbour == closest:
-                continue
-            if neighbour not in target:
-                if old is None or old.minimum is None or zone_value < old.minimum:
-                    edge = ZoneEdge(zone_value, old is not None and old.unbreakable)
-                else:
-                    edge = ZoneEdge(old.minimum, old.unbreakable)
-                target[neighbour] = edge
-                neighbour_adj[closest] = edge
-            elif old is not None and old.unbreakable:
-                graph.edge(closest, neighbour).unbreakable = True
+    compact = graph._run_compiled()
+    parent = np.where(graph._alive, np.arange(len(graph._value), dtype=np.int32), 0).astype(np.int32)
+    _kernels.remove_small_zones(
+        int(min_size), graph._value_array, graph._size, graph._alive, parent, compact, graph._free_top
+    )
+    _kernels.resolve_parents(parent, graph._alive)
+    _kernels.relabel(graph._labels, parent)
     return graph
 
 
@@ -957,8 +986,9 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
 
     A zone z is a ripple of a neighbour B when ``contact_percent(z, B) >=
     ripples``. Zones are visited by decreasing value (smaller size first on
-    ties); a ripple is fused into the candidate B of closest value reached
-    through a breakable edge, and its neighbours are queued again.
+    ties, then by id); a ripple is fused into the candidate B of closest value
+    (the first on ties) reached through a breakable edge, and its neighbours
+    are queued again.
 
     Examples
     --------
@@ -967,24 +997,13 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
     >>> len(graph)   # the ring touches the core on >= 40 % of its contour
     1
     """
-    order = sorted(graph.vertices(), key=lambda zone: (-graph.value(zone), graph.size(zone)))
-    queue = deque(order)
-    while queue:
-        zone = queue.popleft()
-        if zone not in graph:
-            continue
-        value = graph.value(zone)
-        percents = graph.contact_percents(zone)
-        best, best_gap = None, None
-        for other, edge in graph.adj[zone].items():
-            if (edge is not None and edge.unbreakable) or percents(other) < ripples:
-                continue
-            gap = abs(graph.value(other) - value)
-            if best is None or gap < best_gap:
-                best, best_gap = other, gap
-        if best is not None:
-            queue.extend(graph.adj[zone])
-            graph.fuse(zone, best)
+    compact = graph._run_compiled()
+    zones = np.flatnonzero(graph._alive)
+    order = zones[np.lexsort((graph._size[zones], -graph._value_array[zones]))].astype(np.int32)
+    _kernels.merge_ripples(
+        order, float(ripples), graph._labels.ravel(), graph._labels.shape[1],
+        graph._value_array, graph._size, graph._alive, compact, graph._free_top,
+    )  # fmt: skip
     return graph
 
 
@@ -1009,22 +1028,32 @@ def _similar(a: int, b: int, threshold: float) -> bool:
 
 
 def _close_neighbour(graph: ZoneGraph, current: int, candidate: int, threshold: float) -> bool:
-    # closeNeigh: another neighbour of one of the two is within t of the other one.
+    # closeNeigh: another neighbour of one of the two, reached through a
+    # breakable edge (the only edges the watershed looks through), is within t
+    # of the other one.
     value_current, value_candidate = graph.value(current), graph.value(candidate)
-    if any(_similar(graph.value(m), value_current, threshold) for m in graph.adj[candidate] if m != current):
-        return True
-    return any(_similar(graph.value(m), value_candidate, threshold) for m in graph.adj[current] if m != candidate)
+    for one, other_value, skip in ((candidate, value_current, current), (current, value_candidate, candidate)):
+        for m, edge in graph.adj[one].items():
+            if m != skip and (edge is None or not edge.unbreakable) and _similar(graph.value(m), other_value, threshold):
+                return True
+    return False
 
 
 def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10) -> ZoneGraph:
     """Merge neighbouring zones of similar value into the highest one (``watershed``).
 
-    Tops are visited by decreasing value (larger size first on ties). From a
-    top, neighbours reached through breakable edges are explored depth-first;
-    with hi/lo the values of the current zone and the neighbour, the neighbour
-    is absorbed if ``lo >= hi * (1 - t)``, or if ``lo >= hi * (1 - t - margin)``
-    and another neighbour of one of the two is within t of the other. All
-    absorptions are decided on the graph as it was at the start, then fused.
+    Tops are visited by decreasing value (larger size first on ties). The
+    flood from a top is the C++ recursion: a call on zone c first scans all
+    of c's neighbours in edge order, marking each one not yet visited as
+    visited, *whether its edge is breakable or not*; a neighbour reached
+    through a breakable edge is absorbed if, with hi/lo the values of c and
+    the neighbour, ``lo >= hi * (1 - t)``, or if ``lo >= hi * (1 - t -
+    margin)`` and another neighbour of one of the two, through a breakable
+    edge, is within t of the other. Only then does the recursion run on the
+    zones absorbed from c, in that order. So a zone met first across an
+    unbreakable edge, or rejected once, is not absorbed through another path
+    of the same flood (a later top may still take it). All absorptions are
+    decided on the graph as it was at the start, then fused.
 
     Examples
     --------
@@ -1043,13 +1072,21 @@ def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10)
         absorbed.add(top)
         visited = {top}
         members: list[int] = []
-        stack = [(top, iter(list(graph.adj[top].items())))]
+        # Stack of the zones still to expand, one list per scanned zone (the
+        # recursion of the C++, without Python's recursion limit).
+        stack = [iter([top])]
         while stack:
-            current, edges = stack[-1]
-            for neighbour, edge in edges:
-                if (edge is not None and edge.unbreakable) or neighbour in visited or neighbour in absorbed:
+            current = next(stack[-1], None)
+            if current is None:
+                stack.pop()
+                continue
+            taken = []
+            for neighbour, edge in graph.adj[current].items():
+                if neighbour in visited or neighbour in absorbed:
                     continue
                 visited.add(neighbour)
+                if edge is not None and edge.unbreakable:
+                    continue
                 a, b = graph.value(current), graph.value(neighbour)
                 high, low = max(a, b), min(a, b)
                 if low >= high * (1 - threshold) or (
@@ -1057,10 +1094,9 @@ def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10)
                 ):
                     absorbed.add(neighbour)
                     members.append(neighbour)
-                    stack.append((neighbour, iter(list(graph.adj[neighbour].items()))))
-                    break
-            else:
-                stack.pop()
+                    taken.append(neighbour)
+            if taken:
+                stack.append(iter(taken))
         if members:
             groups.append((top, members))
     graph.invalidate_contacts()

@@ -472,7 +472,7 @@ def test_region_counts_close_to_the_released_cpp(datasets):
         for (free, params), count in zip(runs, expected):
             differences.append(int(maoris_labels(free, params).max()) - count)
     differences = np.abs(differences)
-    # Measured: 40 of 57 equal, 52 within 1, all within 2.
-    assert (differences == 0).sum() >= 38
+    # Measured: 43 of 57 equal, 52 within 1, all within 2.
+    assert (differences == 0).sum() >= 41
     assert (differences <= 1).sum() >= 50
     assert differences.max() <= 2

@@ -1,0 +1,146 @@
+"""The compiled zone-graph steps against plain-Python replays of the same rules.
+
+The replays run on the dict form of :class:`ZoneGraph` through its public
+mutations (``fuse``, ``remove``) and its incrementally maintained contacts, so
+they share no code with ``_zone_kernels``. They are slow, hence small maps.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+import cv2
+import numpy as np
+import pytest
+
+from ursim_core.segmentation.maoris import (
+    PRESETS,
+    ZoneGraph,
+    flat_zones,
+    inscribed_circle_image,
+    merge_ripples,
+    quantize,
+    remove_small_zones,
+)
+
+
+def replay_remove_small_zones(graph: ZoneGraph, min_size: int) -> None:
+    for zone in graph.vertices():
+        if zone not in graph or graph.size(zone) >= min_size:
+            continue
+        neighbours = graph.neighbours(zone)
+        if not neighbours:
+            graph.remove(zone)
+            continue
+        gaps = [abs(graph.value(other) - graph.value(zone)) for other in neighbours]
+        graph.fuse(zone, neighbours[gaps.index(min(gaps))])
+
+
+def replay_merge_ripples(graph: ZoneGraph, ripples: float) -> None:
+    queue = deque(sorted(graph.vertices(), key=lambda zone: (-graph.value(zone), graph.size(zone), zone)))
+    while queue:
+        zone = queue.popleft()
+        if zone not in graph:
+            continue
+        candidates = [
+            other
+            for other in graph.neighbours(zone)
+            if not graph.edge(zone, other).unbreakable and graph.contact_percent(zone, other) >= ripples
+        ]
+        if candidates:
+            gaps = [abs(graph.value(other) - graph.value(zone)) for other in candidates]
+            queue.extend(graph.neighbours(zone))
+            graph.fuse(zone, candidates[gaps.index(min(gaps))])
+
+
+def graph_state(graph: ZoneGraph) -> tuple:
+    """Everything later steps can observe: labels, sizes, and each neighbour list in order with its edge."""
+    adjacency = {
+        zone: [(other, graph.edge(zone, other).minimum, graph.edge(zone, other).unbreakable) for other in graph.neighbours(zone)]
+        for zone in graph.vertices()
+    }  # fmt: skip
+    sizes = {zone: graph.size(zone) for zone in graph.vertices()}
+    return graph.labels.tolist(), sizes, adjacency
+
+
+def first_contact_adjacency(zones: np.ndarray) -> dict[int, list[int]]:
+    """Neighbour lists in the raster order of first contact (left neighbour, then upper)."""
+    adjacency: dict[int, list[int]] = {int(zone): [] for zone in np.unique(zones) if zone}
+    rows, cols = zones.shape
+    for row in range(rows):
+        for col in range(cols):
+            here = int(zones[row, col])
+            for other_row, other_col in ((row, col - 1), (row - 1, col)):
+                if here == 0 or other_row < 0 or other_col < 0:
+                    continue
+                other = int(zones[other_row, other_col])
+                if other and other != here and other not in adjacency[here]:
+                    low, high = min(here, other), max(here, other)
+                    adjacency[low].append(high)
+                    adjacency[high].append(low)
+    return adjacency
+
+
+def random_values(seed: int, shape=(40, 48)) -> np.ndarray:
+    """A blobby free-space map's quantised inscribed-circle image: rings, ripples and tiny zones."""
+    rng = np.random.default_rng(seed)
+    free = cv2.GaussianBlur(rng.random(shape), (0, 0), 3) > 0.45
+    free[rng.random(shape) < 0.02] = False
+    return quantize(inscribed_circle_image(free))
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_initial_adjacency_is_in_first_contact_order(seed):
+    values = random_values(seed)
+    zones = flat_zones(values)
+    graph = ZoneGraph(zones, values)
+    expected = first_contact_adjacency(zones)
+    assert graph.vertices() == sorted(expected)
+    assert {zone: graph.neighbours(zone) for zone in graph.vertices()} == expected
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_compiled_small_zone_removal_equals_the_replay(seed):
+    values = random_values(seed)
+    compiled = remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=10)
+    replayed = ZoneGraph(flat_zones(values), values)
+    replay_remove_small_zones(replayed, 10)
+    assert graph_state(compiled) == graph_state(replayed)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_compiled_ripple_merging_equals_the_replay(seed):
+    values = random_values(seed)
+    compiled = ZoneGraph(flat_zones(values), values)
+    replayed = ZoneGraph(flat_zones(values), values)
+    remove_small_zones(compiled, min_size=10)
+    remove_small_zones(replayed, min_size=10)
+    merge_ripples(compiled, ripples=PRESETS["default"].ripples)
+    replay_merge_ripples(replayed, PRESETS["default"].ripples)
+    assert graph_state(compiled) == graph_state(replayed)
+
+
+def test_a_graph_changed_in_dict_form_goes_back_to_the_compiled_steps():
+    # Fusions made through the dict form (new edges with minima, an unbreakable
+    # edge) must survive the conversion to arrays and back, in order.
+    values = random_values(3)
+    graphs = [ZoneGraph(flat_zones(values), values) for _ in range(2)]
+    for graph in graphs:
+        zone = graph.vertices()[len(graph) // 2]
+        other = graph.neighbours(zone)[0]
+        graph.edge(zone, other).unbreakable = True
+        graph.fuse(graph.neighbours(zone)[-1], zone)
+    remove_small_zones(graphs[0], min_size=10)
+    replay_remove_small_zones(graphs[1], 10)
+    assert graph_state(graphs[0]) == graph_state(graphs[1])
+
+
+def test_vertices_and_membership_agree_in_both_forms():
+    values = random_values(5)
+    graph = remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=10)
+    compact_vertices, compact_length = graph.vertices(), len(graph)
+    absent = next(zone for zone in range(1, int(flat_zones(values).max()) + 1) if zone not in compact_vertices)
+    assert absent not in graph and compact_vertices[0] in graph
+    graph.adj  # to the dict form
+    assert graph.vertices() == compact_vertices and len(graph) == compact_length
+    assert absent not in graph and compact_vertices[0] in graph
