@@ -17,13 +17,20 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 	$(PIP) install -q -e ".[dev]"
 	touch $@
 
-run: $(VENV)/.installed-gui
+# numba compiles the segmentation kernels on first use and caches them beside the module: do it
+# once here rather than inside the first segmentation (or in both test workers at once).
+$(VENV)/.kernels: ursim_core/segmentation/_zone_kernels.py | $(BIN)/python
+	@echo "Compiling the segmentation kernels (once, about half a minute)..."
+	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; compile_kernels()"
+	touch $@
+
+run: $(VENV)/.installed-gui $(VENV)/.kernels
 	$(BIN)/ursim-gui $(ARGS)
 
-test: $(VENV)/.installed-dev
+test: $(VENV)/.installed-dev $(VENV)/.kernels
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -n 2 -q
 
-bench: $(VENV)/.installed-dev
+bench: $(VENV)/.installed-dev $(VENV)/.kernels
 	$(BIN)/ursim bench all
 
 clean:

@@ -12,6 +12,10 @@ __all__ = ["run_bench"]
 def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats: int = 5) -> int:
     """Run the benchmarks named by ``what`` ('segment', 'scale', 'match' or 'all') and print figures."""
     root = dataset_root(datasets)
+    if what in ("segment", "scale", "all"):
+        from ursim_core.segmentation.maoris import compile_kernels
+
+        print(f"segmentation kernels ready in {compile_kernels():.1f} s (compiled on first use, then cached)")
     if what in ("segment", "all"):
         from ursim_core.bench_segmentation import bench_segmentation, print_table
 

@@ -412,7 +412,7 @@ def _reason_counts(result) -> list[tuple[str, int]]:
 
 
 def _published_markdown(result) -> list[str]:
-    from ursim_core.evaluation import MATCHERS, VARIANTS
+    from ursim_core.evaluation import VARIANTS
 
     header, rows = _paper_table1(VARIANTS, ("hungarian", "vf2", "planar"))
     lines = [

@@ -11,10 +11,12 @@ vectorised. These kernels run them on a compact array form of the graph:
   (minimum, -1 for none, and unbreakability);
 * fusing a zone frees its nodes before it allocates new ones, so the pool
   never grows beyond the initial two nodes per edge;
-* the ripple step keeps each zone's pixels in a linked list (so a fusion
-  relabels only the absorbed zone) and the contact counts up to date: a
-  fusion subtracts the contributions of the pixels around the absorbed zone,
-  relabels, and adds them back.
+* the ripple step keeps the contact counts up to date: a fusion subtracts
+  the contributions of the pixels around the absorbed zone, merges it, and
+  adds them back. Zones are union-find sets of the labels (the image is
+  relabelled once, at the end), each zone keeps a list of its pixels that may
+  still be on its border, and its contact partners sit in a few slots of its
+  own, with a shared hash table for zones that have more.
 
 :class:`ursim_core.segmentation.maoris.ZoneGraph` owns the arrays; the
 functions here only mutate them. Semantics are those documented on
@@ -24,8 +26,7 @@ functions here only mutate them. Semantics are those documented on
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
-from numba.typed import Dict
+from numba import njit
 
 NO_MINIMUM = -1
 
@@ -233,7 +234,7 @@ def remove_small_zones(min_size, value, size, alive, parent, graph, free_top):
 
     ``parent[z]`` records where z went (0 = deleted); sizes are updated.
     """
-    head, tail, degree, neighbour, next_node = graph[0], graph[1], graph[2], graph[3], graph[4]
+    head, degree, neighbour, next_node = graph[0], graph[2], graph[3], graph[4]
     for zone in range(1, len(value)):
         if not alive[zone] or size[zone] >= min_size:
             continue

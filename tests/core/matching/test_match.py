@@ -12,7 +12,7 @@ from ursim_core.bench_matching import perturbed_copy, random_region_graph
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation_scoring import score_matches
 from ursim_core.graph import region_graph
-from ursim_core.matching import M_GRID, MatchConfig, match, match_prepared, prepare, seed_pairs
+from ursim_core.matching import MatchConfig, match, match_prepared, prepare, seed_pairs
 from ursim_core.segmentation import Segmentation
 
 
