@@ -334,44 +334,50 @@ def _table_reserve(keys, counts, meta, more):
     return grown_keys, grown_counts
 
 
-_SLOTS = 8  # contact partners kept beside each zone before the shared table is used
+# Each zone's contacts start in a row of its own in one int64 array (one cache
+# line): [overflow flag, then up to 7 entries (partner << 32) + count, -1 = free].
+# Partners beyond 7 go to the shared table.
+_SLOTS = 8
+_COUNT = np.int64(0xFFFFFFFF)
 
 
 @njit(cache=True, inline="always")
 def contact_get(slots, keys, counts, meta, base, a, b):
-    """Contact count (a, b): from a's own slots, else from the shared table."""
-    partner, partner_count, overflow = slots
-    for k in range(a * _SLOTS, a * _SLOTS + _SLOTS):
-        if partner[k] == b:
-            return partner_count[k]
-    if overflow[a]:
+    """Contact count (a, b): from a's own row, else from the shared table."""
+    start = a * _SLOTS
+    for k in range(start + 1, start + _SLOTS):
+        entry = slots[k]
+        if entry >= 0 and (entry >> 32) == b:
+            return entry & _COUNT
+    if slots[start] != 0:
         return table_get(keys, counts, meta, a * base + b)
     return 0
 
 
 @njit(cache=True, inline="always")
 def _contact_add(slots, keys, counts, meta, base, a, b, delta):
-    partner, partner_count, overflow = slots
+    start = a * _SLOTS
     free = -1
-    for k in range(a * _SLOTS, a * _SLOTS + _SLOTS):
-        if partner[k] == b:
-            partner_count[k] += delta
-            if partner_count[k] == 0:
-                partner[k] = -1
-            return
-        if free == -1 and partner[k] == -1:
+    for k in range(start + 1, start + _SLOTS):
+        entry = slots[k]
+        if entry >= 0:
+            if (entry >> 32) == b:
+                entry += delta
+                slots[k] = entry if entry & _COUNT else -1
+                return
+        elif free == -1:
             free = k
-    if overflow[a]:
+    if slots[start] != 0:
         key = a * base + b
         slot = _slot(keys, meta, key)
         if keys[slot] == key:
             counts[slot] += delta
             return
     if free != -1:
-        partner[free] = b
-        partner_count[free] = delta
+        # A new contact only ever starts with a positive count.
+        slots[free] = (np.int64(b) << 32) + delta
         return
-    overflow[a] = True
+    slots[start] = 1
     _table_add(keys, counts, meta, a * base + b, delta)
 
 
@@ -469,7 +475,9 @@ def merge_ripples(order, ripples, labels, width, value, size, alive, graph, free
     border_head = _filled(n, -1, np.int32)
     border_tail = _filled(n, -1, np.int32)
     keys, counts, meta = _new_table(16)
-    slots = (_filled(n * _SLOTS, -1, np.int32), np.zeros(n * _SLOTS, np.int32), np.zeros(n, np.bool_))
+    slots = _filled(n * _SLOTS, -1, np.int64)
+    for zone in range(n):
+        slots[zone * _SLOTS] = 0
     total = np.zeros(n, np.int64)
     around = np.empty(9, np.int32)
     for pixel in range(labels.size):
