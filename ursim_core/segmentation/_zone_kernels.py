@@ -103,6 +103,36 @@ def _filled(size, fill, dtype):
 
 
 @njit(cache=True)
+def adjacency_from_entries(count, zone, other, minimum, unbreakable):
+    """Linked neighbour lists from (zone, neighbour, minimum, unbreakable)
+    entries, each zone's in list order: the inverse of :func:`adjacency_entries`.
+    Every edge must appear in both directions, with the same attributes."""
+    size = max(len(zone), 2)
+    head = _filled(count, -1, np.int32)
+    tail = _filled(count, -1, np.int32)
+    degree = np.zeros(count, np.int32)
+    neighbour = np.empty(size, np.int32)
+    next_node = _filled(size, -1, np.int32)
+    previous_node = _filled(size, -1, np.int32)
+    for node in range(len(zone)):
+        _append(zone[node], node, other[node], head, tail, degree, neighbour, next_node, previous_node)
+    # The twin of (a -> b) is (b -> a): match the entries' keys with the reversed ones.
+    keys = zone.astype(np.int64) * count + other
+    order = np.argsort(keys)
+    found = np.searchsorted(keys[order], other.astype(np.int64) * count + zone)
+    twin = np.empty(size, np.int32)
+    for node in range(len(zone)):
+        twin[node] = order[found[node]]
+    edge_minimum = _filled(size, NO_MINIMUM, np.int32)
+    edge_unbreakable = np.zeros(size, np.bool_)
+    for node in range(len(zone)):
+        edge_minimum[node] = minimum[node]
+        edge_unbreakable[node] = unbreakable[node]
+    free = np.empty(size, np.int32)
+    return head, tail, degree, neighbour, next_node, previous_node, twin, edge_minimum, edge_unbreakable, free
+
+
+@njit(cache=True)
 def _grown(array, capacity, fill):
     grown = np.empty(capacity, array.dtype)
     for i in range(capacity):

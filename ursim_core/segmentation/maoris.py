@@ -602,38 +602,18 @@ class ZoneGraph:
     def _compact_adjacency(self) -> tuple:
         """The adjacency as compact arrays (converted from `_adj` if needed)."""
         if self._compact is None:
-            count = len(self._value)
-            node_of: dict[tuple[int, int], int] = {}
-            for a, neighbours in self._adj.items():
-                for b in neighbours:
-                    node_of[(a, b)] = len(node_of)
-            capacity = max(len(node_of), 2)
-            head = np.full(count, -1, np.int32)
-            tail = np.full(count, -1, np.int32)
-            degree = np.zeros(count, np.int32)
-            neighbour = np.zeros(capacity, np.int32)
-            next_node = np.full(capacity, -1, np.int32)
-            previous_node = np.full(capacity, -1, np.int32)
-            twin = np.zeros(capacity, np.int32)
-            minimum = np.full(capacity, _kernels.NO_MINIMUM, np.int32)
-            unbreakable = np.zeros(capacity, bool)
-            for a, neighbours in self._adj.items():
-                nodes = [node_of[(a, b)] for b in neighbours]
-                degree[a] = len(nodes)
-                if nodes:
-                    head[a], tail[a] = nodes[0], nodes[-1]
-                for previous, node, following in zip([-1] + nodes[:-1], nodes, nodes[1:] + [-1]):
-                    previous_node[node], next_node[node] = previous, following
-                for b, edge in neighbours.items():
-                    node = node_of[(a, b)]
-                    neighbour[node], twin[node] = b, node_of[(b, a)]
-                    if edge is not None:
-                        minimum[node] = _kernels.NO_MINIMUM if edge.minimum is None else edge.minimum
-                        unbreakable[node] = edge.unbreakable
-            self._alive = np.zeros(count, bool)
+            entries = [
+                (a, b, _kernels.NO_MINIMUM if edge is None or edge.minimum is None else edge.minimum,
+                 edge is not None and edge.unbreakable)
+                for a, neighbours in self._adj.items()
+                for b, edge in neighbours.items()
+            ]  # fmt: skip
+            columns = list(zip(*entries)) or [()] * 4
+            zone, other, minimum = (np.array(column, np.int32) for column in columns[:3])
+            unbreakable = np.array(columns[3], bool)
+            self._compact = _kernels.adjacency_from_entries(len(self._value), zone, other, minimum, unbreakable)
+            self._alive = np.zeros(len(self._value), bool)
             self._alive[list(self._adj)] = True
-            free = np.empty(capacity, np.int32)
-            self._compact = (head, tail, degree, neighbour, next_node, previous_node, twin, minimum, unbreakable, free)
             self._free_top[0] = 0
             self._adj = None
         return self._compact
