@@ -30,26 +30,23 @@ from numba import njit
 
 NO_MINIMUM = -1
 
+# Columns of the zone records (one row of 16 bytes per zone).
+HEAD, TAIL, DEGREE, VALUE = 0, 1, 2, 3
+# Columns of the node records (16 bytes; a node and its twin share 32 bytes).
+# A node's twin is ``node ^ 1``; the edge attributes sit in the ATTRIBUTE
+# column of the pair: the minimum in the even node, unbreakability in the odd one.
+NEIGHBOUR, NEXT, PREVIOUS, ATTRIBUTE = 0, 1, 2, 3
+
 
 @njit(cache=True)
-def build_adjacency(zones, count):
-    """Linked neighbour lists of the 4-adjacency of a zone image (0 = no zone).
-
-    Edges are inserted in the raster order of their first contact: each pixel
-    is compared with its left, then its upper neighbour.
-    """
+def _contacts_in_order(zones, last_partner, records, nodes, count_only):
+    """Scan the 4-contacts of a zone image in raster order (each pixel against
+    its left, then its upper neighbour) and link the new edges; or, with
+    ``count_only``, return how many pairs would be looked up (a bound on the
+    number of edges). Returns the number of nodes used otherwise."""
     rows, cols = zones.shape
-    capacity = 16
-    head = _filled(count, -1, np.int32)
-    tail = _filled(count, -1, np.int32)
-    degree = np.zeros(count, np.int32)
-    neighbour = np.empty(capacity, np.int32)
-    next_node = _filled(capacity, -1, np.int32)
-    previous_node = _filled(capacity, -1, np.int32)
-    twin = np.empty(capacity, np.int32)
+    n_candidates = 0
     n_nodes = 0
-    # The partner each zone met last: long boundaries repeat the same pair.
-    last_partner = np.zeros(count, np.int32)
     for row in range(rows):
         last_left_a, last_left_b = -1, -1
         for col in range(cols):
@@ -57,8 +54,15 @@ def build_adjacency(zones, count):
             if here == 0:
                 continue
             for kind in range(2):
-                other = zones[row, col - 1] if kind == 0 else zones[row - 1, col]
-                if (kind == 0 and col == 0) or (kind == 1 and row == 0) or other == 0 or other == here:
+                if kind == 0:
+                    if col == 0:
+                        continue
+                    other = zones[row, col - 1]
+                else:
+                    if row == 0:
+                        continue
+                    other = zones[row - 1, col]
+                if other == 0 or other == here:
                     continue
                 a, b = min(here, other), max(here, other)
                 if kind == 0:
@@ -66,31 +70,188 @@ def build_adjacency(zones, count):
                     if a == last_left_a and b == last_left_b:
                         continue
                     last_left_a, last_left_b = a, b
-                elif row > 0 and col > 0 and zones[row, col - 1] == here and zones[row - 1, col - 1] == other:
+                elif col > 0 and zones[row, col - 1] == here and zones[row - 1, col - 1] == other:
                     continue  # same pair as the pixel to the left
+                # The partner each zone met last: long boundaries repeat the same pair.
                 if last_partner[a] == b or last_partner[b] == a:
                     continue
                 last_partner[a], last_partner[b] = b, a
-                if _find(a, b, head, degree, neighbour, next_node, twin) != -1:
+                n_candidates += 1
+                if count_only or _find(records, nodes, a, b) != -1:
                     continue
-                if n_nodes + 2 > capacity:
-                    capacity *= 2
-                    neighbour = _grown(neighbour, capacity, 0)
-                    next_node = _grown(next_node, capacity, -1)
-                    previous_node = _grown(previous_node, capacity, -1)
-                    twin = _grown(twin, capacity, 0)
-                _append(a, n_nodes, b, head, tail, degree, neighbour, next_node, previous_node)
-                _append(b, n_nodes + 1, a, head, tail, degree, neighbour, next_node, previous_node)
-                twin[n_nodes], twin[n_nodes + 1] = n_nodes + 1, n_nodes
+                _link_pair(records, nodes, n_nodes, a, b, NO_MINIMUM, 0)
                 n_nodes += 2
-    size = max(n_nodes, 2)
-    neighbour, next_node, previous_node, twin = (
-        neighbour[:size].copy(), next_node[:size].copy(), previous_node[:size].copy(), twin[:size].copy()
-    )
-    minimum = _filled(size, NO_MINIMUM, np.int32)
-    unbreakable = np.zeros(size, np.bool_)
-    free = np.empty(size, np.int32)
-    return head, tail, degree, neighbour, next_node, previous_node, twin, minimum, unbreakable, free
+    return n_candidates if count_only else n_nodes
+
+
+@njit(cache=True)
+def build_adjacency(zones, value):
+    """Zone graph of the 4-adjacency of a zone image (0 = no zone): ``(records, nodes)``.
+
+    ``value[z]`` is zone z's value (``len(value)`` = largest label + 1). Edges
+    are inserted in the raster order of their first contact. Two passes: the
+    first bounds the number of edges, so the node records never move.
+    """
+    count = len(value)
+    records = np.empty((count, 4), np.int32)
+    for zone in range(count):
+        records[zone, HEAD] = -1
+        records[zone, TAIL] = -1
+        records[zone, DEGREE] = 0
+        records[zone, VALUE] = value[zone]
+    last_partner = np.zeros(count, np.int32)
+    bound = _contacts_in_order(zones, last_partner, records, np.empty((2, 4), np.int32), True)
+    for zone in range(count):
+        last_partner[zone] = 0
+    nodes = np.empty((max(2 * bound, 2), 4), np.int32)
+    used = _contacts_in_order(zones, last_partner, records, nodes, False)
+    return records, nodes[: max(used, 2)]
+
+
+@njit(cache=True, inline="always")
+def _link_pair(records, nodes, node, a, b, minimum, unbreakable):
+    """Append the edge (a, b) to both lists as the twin nodes ``node`` (a -> b,
+    ``node`` even) and ``node + 1``."""
+    _append(records, nodes, a, node, b)
+    _append(records, nodes, b, node + 1, a)
+    nodes[node, ATTRIBUTE] = minimum
+    nodes[node + 1, ATTRIBUTE] = unbreakable
+
+
+@njit(cache=True)
+def adjacency_from_entries(zone, other, minimum, unbreakable, value):
+    """Zone graph from (zone, neighbour, minimum, unbreakable) entries, each
+    zone's in list order: the inverse of :func:`adjacency_entries`. Every edge
+    must appear in both directions, with the same attributes."""
+    count = len(value)
+    records = np.empty((count, 4), np.int32)
+    for z in range(count):
+        records[z, HEAD] = -1
+        records[z, TAIL] = -1
+        records[z, DEGREE] = 0
+        records[z, VALUE] = value[z]
+    # Entry i of an edge (low -> high) owns the node pair 2i, 2i + 1; the
+    # reversed entry finds it by key.
+    keys = zone.astype(np.int64) * count + other
+    order = np.argsort(keys)
+    sorted_keys = keys[order]
+    nodes = np.empty((max(2 * len(zone), 2), 4), np.int32)
+    for i in range(len(zone)):
+        low, high = min(zone[i], other[i]), max(zone[i], other[i])
+        owner = order[np.searchsorted(sorted_keys, np.int64(low) * count + high)]
+        node = 2 * owner if zone[i] == low else 2 * owner + 1
+        _append(records, nodes, zone[i], node, other[i])
+        if zone[i] == low:
+            nodes[node, ATTRIBUTE] = minimum[i]
+            nodes[node + 1, ATTRIBUTE] = unbreakable[i]
+    return records, nodes
+
+
+@njit(cache=True)
+def adjacency_entries(alive, graph):
+    """Every (zone, neighbour, node, twin, minimum, unbreakable) of the live
+    zones, zones in id order and each zone's neighbours in list order."""
+    records, nodes = graph
+    total = 0
+    for zone in range(len(alive)):
+        if alive[zone]:
+            total += records[zone, DEGREE]
+    out = np.empty((total, 6), np.int64)
+    k = 0
+    for zone in range(len(alive)):
+        if not alive[zone]:
+            continue
+        node = records[zone, HEAD]
+        while node != -1:
+            out[k, 0] = zone
+            out[k, 1] = nodes[node, NEIGHBOUR]
+            out[k, 2] = node
+            out[k, 3] = node ^ 1
+            out[k, 4] = nodes[node & ~1, ATTRIBUTE]
+            out[k, 5] = nodes[node | 1, ATTRIBUTE]
+            k += 1
+            node = nodes[node, NEXT]
+    return out
+
+
+@njit(cache=True, inline="always")
+def _append(records, nodes, zone, node, other):
+    nodes[node, NEIGHBOUR] = other
+    nodes[node, NEXT] = -1
+    tail = records[zone, TAIL]
+    nodes[node, PREVIOUS] = tail
+    if tail == -1:
+        records[zone, HEAD] = node
+    else:
+        nodes[tail, NEXT] = node
+    records[zone, TAIL] = node
+    records[zone, DEGREE] += 1
+
+
+@njit(cache=True, inline="always")
+def _unlink(records, nodes, zone, node):
+    before, after = nodes[node, PREVIOUS], nodes[node, NEXT]
+    if before == -1:
+        records[zone, HEAD] = after
+    else:
+        nodes[before, NEXT] = after
+    if after == -1:
+        records[zone, TAIL] = before
+    else:
+        nodes[after, PREVIOUS] = before
+    records[zone, DEGREE] -= 1
+
+
+@njit(cache=True)
+def _find(records, nodes, a, b):
+    """Node (a -> b), or -1; walks the shorter of the two lists."""
+    if records[a, DEGREE] <= records[b, DEGREE]:
+        node = records[a, HEAD]
+        while node != -1:
+            if nodes[node, NEIGHBOUR] == b:
+                return node
+            node = nodes[node, NEXT]
+        return -1
+    node = records[b, HEAD]
+    while node != -1:
+        if nodes[node, NEIGHBOUR] == a:
+            return node ^ 1
+        node = nodes[node, NEXT]
+    return -1
+
+
+@njit(cache=True)
+def fuse_edges(zone, into, graph):
+    """Transfer the edges of ``zone`` to ``into`` (``ZoneGraph.fuse``, edges only).
+
+    A new edge (into, n) reuses the node pair of the edge (zone, n) it
+    replaces, so the node records never grow.
+    """
+    records, nodes = graph
+    zone_value = records[zone, VALUE]
+    node = records[zone, HEAD]
+    while node != -1:
+        following = nodes[node, NEXT]
+        other = nodes[node, NEIGHBOUR]
+        old_minimum = nodes[node & ~1, ATTRIBUTE]
+        old_unbreakable = nodes[node | 1, ATTRIBUTE]
+        _unlink(records, nodes, other, node ^ 1)
+        if other != into:
+            existing = _find(records, nodes, into, other)
+            if existing == -1:
+                if old_minimum == NO_MINIMUM or zone_value < old_minimum:
+                    new_minimum = zone_value
+                else:
+                    new_minimum = old_minimum
+                _append(records, nodes, into, node, other)
+                _append(records, nodes, other, node ^ 1, into)
+                nodes[node & ~1, ATTRIBUTE] = new_minimum
+                nodes[node | 1, ATTRIBUTE] = old_unbreakable
+            elif old_unbreakable:
+                nodes[existing | 1, ATTRIBUTE] = 1
+        node = following
+    records[zone, HEAD] = records[zone, TAIL] = -1
+    records[zone, DEGREE] = 0
 
 
 @njit(cache=True)
@@ -103,36 +264,6 @@ def _filled(size, fill, dtype):
 
 
 @njit(cache=True)
-def adjacency_from_entries(count, zone, other, minimum, unbreakable):
-    """Linked neighbour lists from (zone, neighbour, minimum, unbreakable)
-    entries, each zone's in list order: the inverse of :func:`adjacency_entries`.
-    Every edge must appear in both directions, with the same attributes."""
-    size = max(len(zone), 2)
-    head = _filled(count, -1, np.int32)
-    tail = _filled(count, -1, np.int32)
-    degree = np.zeros(count, np.int32)
-    neighbour = np.empty(size, np.int32)
-    next_node = _filled(size, -1, np.int32)
-    previous_node = _filled(size, -1, np.int32)
-    for node in range(len(zone)):
-        _append(zone[node], node, other[node], head, tail, degree, neighbour, next_node, previous_node)
-    # The twin of (a -> b) is (b -> a): match the entries' keys with the reversed ones.
-    keys = zone.astype(np.int64) * count + other
-    order = np.argsort(keys)
-    found = np.searchsorted(keys[order], other.astype(np.int64) * count + zone)
-    twin = np.empty(size, np.int32)
-    for node in range(len(zone)):
-        twin[node] = order[found[node]]
-    edge_minimum = _filled(size, NO_MINIMUM, np.int32)
-    edge_unbreakable = np.zeros(size, np.bool_)
-    for node in range(len(zone)):
-        edge_minimum[node] = minimum[node]
-        edge_unbreakable[node] = unbreakable[node]
-    free = np.empty(size, np.int32)
-    return head, tail, degree, neighbour, next_node, previous_node, twin, edge_minimum, edge_unbreakable, free
-
-
-@njit(cache=True)
 def _grown(array, capacity, fill):
     grown = np.empty(capacity, array.dtype)
     for i in range(capacity):
@@ -141,148 +272,32 @@ def _grown(array, capacity, fill):
 
 
 @njit(cache=True)
-def adjacency_entries(alive, graph):
-    """Every (zone, neighbour, node, twin, minimum, unbreakable) of the live
-    zones, zones in id order and each zone's neighbours in list order."""
-    head, degree, neighbour, next_node, twin, minimum, unbreakable = (
-        graph[0], graph[2], graph[3], graph[4], graph[6], graph[7], graph[8]
-    )
-    total = 0
-    for zone in range(len(alive)):
-        if alive[zone]:
-            total += degree[zone]
-    out = np.empty((total, 6), np.int64)
-    k = 0
-    for zone in range(len(alive)):
-        if not alive[zone]:
-            continue
-        node = head[zone]
-        while node != -1:
-            out[k, 0] = zone
-            out[k, 1] = neighbour[node]
-            out[k, 2] = node
-            out[k, 3] = twin[node]
-            out[k, 4] = minimum[node]
-            out[k, 5] = unbreakable[node]
-            k += 1
-            node = next_node[node]
-    return out
-
-
-@njit(cache=True, inline="always")
-def _append(zone, node, other, head, tail, degree, neighbour, next_node, previous_node):
-    neighbour[node] = other
-    next_node[node] = -1
-    previous_node[node] = tail[zone]
-    if tail[zone] == -1:
-        head[zone] = node
-    else:
-        next_node[tail[zone]] = node
-    tail[zone] = node
-    degree[zone] += 1
-
-
-@njit(cache=True, inline="always")
-def _unlink(zone, node, head, tail, degree, next_node, previous_node):
-    before, after = previous_node[node], next_node[node]
-    if before == -1:
-        head[zone] = after
-    else:
-        next_node[before] = after
-    if after == -1:
-        tail[zone] = before
-    else:
-        previous_node[after] = before
-    degree[zone] -= 1
-
-
-@njit(cache=True)
-def _find(a, b, head, degree, neighbour, next_node, twin):
-    """Node (a -> b), or -1; walks the shorter of the two lists."""
-    if degree[a] <= degree[b]:
-        node = head[a]
-        while node != -1:
-            if neighbour[node] == b:
-                return node
-            node = next_node[node]
-        return -1
-    node = head[b]
-    while node != -1:
-        if neighbour[node] == a:
-            return twin[node]
-        node = next_node[node]
-    return -1
-
-
-@njit(cache=True)
-def fuse_edges(zone, into, value, graph, free_top):
-    """Transfer the edges of ``zone`` to ``into`` (``ZoneGraph.fuse``, edges only).
-
-    ``free_top`` is a one-element array: the size of the free-node stack.
-    """
-    head, tail, degree, neighbour, next_node, previous_node, twin, minimum, unbreakable, free = graph
-    zone_value = value[zone]
-    node = head[zone]
-    while node != -1:
-        following = next_node[node]
-        other = neighbour[node]
-        old_minimum = minimum[node]
-        old_unbreakable = unbreakable[node]
-        back = twin[node]
-        _unlink(other, back, head, tail, degree, next_node, previous_node)
-        free[free_top[0]] = back
-        free[free_top[0] + 1] = node
-        free_top[0] += 2
-        if other != into:
-            existing = _find(into, other, head, degree, neighbour, next_node, twin)
-            if existing == -1:
-                if old_minimum == NO_MINIMUM or zone_value < old_minimum:
-                    new_minimum = zone_value
-                else:
-                    new_minimum = old_minimum
-                forward = free[free_top[0] - 1]
-                backward = free[free_top[0] - 2]
-                free_top[0] -= 2
-                _append(into, forward, other, head, tail, degree, neighbour, next_node, previous_node)
-                _append(other, backward, into, head, tail, degree, neighbour, next_node, previous_node)
-                twin[forward] = backward
-                twin[backward] = forward
-                minimum[forward] = minimum[backward] = new_minimum
-                unbreakable[forward] = unbreakable[backward] = old_unbreakable
-            elif old_unbreakable:
-                unbreakable[existing] = True
-                unbreakable[twin[existing]] = True
-        node = following
-    head[zone] = tail[zone] = -1
-    degree[zone] = 0
-
-
-@njit(cache=True)
-def remove_small_zones(min_size, value, size, alive, parent, graph, free_top):
+def remove_small_zones(min_size, size, alive, parent, graph):
     """One pass in id order: fuse each zone below ``min_size`` px into its
     closest-valued neighbour (first on ties), delete it when it has none.
 
     ``parent[z]`` records where z went (0 = deleted); sizes are updated.
     """
-    head, degree, neighbour, next_node = graph[0], graph[2], graph[3], graph[4]
-    for zone in range(1, len(value)):
+    records, nodes = graph
+    for zone in range(1, len(records)):
         if not alive[zone] or size[zone] >= min_size:
             continue
         alive[zone] = False
-        if degree[zone] == 0:
+        if records[zone, DEGREE] == 0:
             parent[zone] = 0
             continue
-        zone_value = value[zone]
+        zone_value = records[zone, VALUE]
         closest, closest_gap = -1, 1 << 30
-        node = head[zone]
+        node = records[zone, HEAD]
         while node != -1:
-            gap = abs(value[neighbour[node]] - zone_value)
+            other = nodes[node, NEIGHBOUR]
+            gap = abs(records[other, VALUE] - zone_value)
             if gap < closest_gap:
-                closest, closest_gap = neighbour[node], gap
-            node = next_node[node]
+                closest, closest_gap = other, gap
+            node = nodes[node, NEXT]
         parent[zone] = closest
         size[closest] += size[zone]
-        fuse_edges(zone, closest, value, graph, free_top)
+        fuse_edges(zone, closest, graph)
 
 
 # -- contact counts ------------------------------------------------------
@@ -457,6 +472,63 @@ def _count(around, sign, slots, keys, counts, meta, total, base):
 
 
 @njit(cache=True, inline="always")
+def _recount(around, here, into, slots, keys, counts, meta, total, base):
+    """Update the contact counts of a pixel whose 3x3 zones are ``around`` for
+    the fusion of zone ``here`` into ``into``; ``around`` is rewritten to after.
+
+    Only the changes are applied: the counts of ``here`` itself are left as
+    they are, since a fused zone is never queried again.
+    """
+    own = around[4]
+    was_contour = own != 0 and not (
+        around[1] == own and around[3] == own and around[5] == own and around[7] == own
+    )
+    if own == here:
+        for k in range(9):
+            if around[k] == here:
+                around[k] = into
+        _count(around, 1, slots, keys, counts, meta, total, base)
+    elif own == into:
+        if not was_contour:
+            return
+        had_here = False
+        for k in range(9):
+            if around[k] == here:
+                had_here = True
+                around[k] = into
+        if not had_here:
+            return
+        if not (around[1] == own and around[3] == own and around[5] == own and around[7] == own):
+            _contact_add(slots, keys, counts, meta, base, own, here, -1)
+        else:
+            # No longer a contour pixel: it leaves every count of `into`.
+            total[own] -= 1
+            _contact_add(slots, keys, counts, meta, base, own, here, -1)
+            for k in range(9):
+                other = around[k]
+                if other == 0 or other == own:
+                    continue
+                repeated = False
+                for j in range(k):
+                    if around[j] == other:
+                        repeated = True
+                        break
+                if not repeated:
+                    _contact_add(slots, keys, counts, meta, base, own, other, -1)
+    elif was_contour:
+        had_here, had_into = False, False
+        for k in range(9):
+            if around[k] == here:
+                had_here = True
+            elif around[k] == into:
+                had_into = True
+        if had_here:
+            _contact_add(slots, keys, counts, meta, base, own, here, -1)
+            if not had_into:
+                _contact_add(slots, keys, counts, meta, base, own, into, 1)
+
+
+@njit(cache=True, inline="always")
 def _is_inner(labels, parent, pixel, width, own):
     """Whether all 8 neighbours of ``pixel`` are in zone ``own``."""
     raw = labels[pixel]
@@ -475,7 +547,7 @@ def _is_inner(labels, parent, pixel, width, own):
 
 
 @njit(cache=True)
-def merge_ripples(order, ripples, labels, width, value, size, alive, graph, free_top):
+def merge_ripples(order, ripples, labels, width, size, alive, graph):
     """Ripple merging (``removeRiplesv3``) on a padded flat label image.
 
     ``order`` is the initial work list (decreasing value, smaller size first,
@@ -488,11 +560,11 @@ def merge_ripples(order, ripples, labels, width, value, size, alive, graph, free
     a list of its pixels that may still be on its border (a pixel found with
     all 8 neighbours inside is dropped for good).
     """
-    head, degree, neighbour, next_node, unbreakable = graph[0], graph[2], graph[3], graph[4], graph[8]
+    records, nodes = graph
     # Compact ids: the live zones in id order are 1..n - 1.
     original = np.flatnonzero(alive).astype(np.int32)
     n = len(original) + 1
-    compact_of = np.zeros(len(value), np.int32)
+    compact_of = np.zeros(len(records), np.int32)
     for k in range(len(original)):
         compact_of[original[k]] = k + 1
     for pixel in range(labels.size):
@@ -536,30 +608,30 @@ def merge_ripples(order, ripples, labels, width, value, size, alive, graph, free
         start += 1
         if not alive[zone]:
             continue
-        zone_value = value[zone]
+        zone_value = records[zone, VALUE]
         here = compact_of[zone]
         contour = total[here]
         best, best_gap = -1, 0
-        node = head[zone]
+        node = records[zone, HEAD]
         while node != -1:
-            other = neighbour[node]
-            if not unbreakable[node] and contour > 0:
+            other = nodes[node, NEIGHBOUR]
+            if nodes[node | 1, ATTRIBUTE] == 0 and contour > 0:
                 percent = contact_get(slots, keys, counts, meta, base, here, compact_of[other]) * 100 // contour
                 if percent >= ripples:
-                    gap = abs(value[other] - zone_value)
+                    gap = abs(records[other, VALUE] - zone_value)
                     if best == -1 or gap < best_gap:
                         best, best_gap = other, gap
-            node = next_node[node]
+            node = nodes[node, NEXT]
         if best == -1:
             continue
         # Queue the neighbours again.
-        if end + degree[zone] > len(queue):
-            queue = _grown(queue, 2 * (end + degree[zone]), 0)
-        node = head[zone]
+        if end + records[zone, DEGREE] > len(queue):
+            queue = _grown(queue, 2 * (end + records[zone, DEGREE]), 0)
+        node = records[zone, HEAD]
         while node != -1:
-            queue[end] = neighbour[node]
+            queue[end] = nodes[node, NEIGHBOUR]
             end += 1
-            node = next_node[node]
+            node = nodes[node, NEXT]
         # Pixels whose counts may change: the zone's border pixels and their
         # neighbours. Border candidates now inside are dropped from the list.
         into = compact_of[best]
@@ -589,11 +661,8 @@ def merge_ripples(order, ripples, labels, width, value, size, alive, graph, free
         keys, counts = _table_reserve(keys, counts, meta, 8 * n_affected)
         for k in range(n_affected):
             _neighbourhood(labels, parent, affected[k], width, around)
-            _count(around, -1, slots, keys, counts, meta, total, base)
+            _recount(around, here, into, slots, keys, counts, meta, total, base)
         parent[here] = into
-        for k in range(n_affected):
-            _neighbourhood(labels, parent, affected[k], width, around)
-            _count(around, 1, slots, keys, counts, meta, total, base)
         if kept_head != -1:
             if border_tail[into] == -1:
                 border_head[into] = kept_head
@@ -604,7 +673,7 @@ def merge_ripples(order, ripples, labels, width, value, size, alive, graph, free
 
         alive[zone] = False
         size[best] += size[zone]
-        fuse_edges(zone, best, value, graph, free_top)
+        fuse_edges(zone, best, graph)
     lookup = np.zeros(n, np.int32)
     for label in range(1, n):
         lookup[label] = original[_zone_of(label, parent) - 1]

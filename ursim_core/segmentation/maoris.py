@@ -567,8 +567,7 @@ class ZoneGraph:
         # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
         self._alive = self._size > 0
         self._alive[0] = False
-        self._compact: tuple | None = _kernels.build_adjacency(zones.astype(np.int32, copy=False), count + 1)
-        self._free_top = np.zeros(1, np.int64)
+        self._compact: tuple | None = _kernels.build_adjacency(zones.astype(np.int32, copy=False), value)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         self._contacts: dict[int, int] | None = None
         self._pending: dict[int, int] = {}
@@ -611,10 +610,9 @@ class ZoneGraph:
             columns = list(zip(*entries)) or [()] * 4
             zone, other, minimum = (np.array(column, np.int32) for column in columns[:3])
             unbreakable = np.array(columns[3], bool)
-            self._compact = _kernels.adjacency_from_entries(len(self._value), zone, other, minimum, unbreakable)
+            self._compact = _kernels.adjacency_from_entries(zone, other, minimum, unbreakable, self._value_array)
             self._alive = np.zeros(len(self._value), bool)
             self._alive[list(self._adj)] = True
-            self._free_top[0] = 0
             self._adj = None
         return self._compact
 
@@ -953,9 +951,7 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     """
     compact = graph._run_compiled()
     parent = np.where(graph._alive, np.arange(len(graph._value), dtype=np.int32), 0).astype(np.int32)
-    _kernels.remove_small_zones(
-        int(min_size), graph._value_array, graph._size, graph._alive, parent, compact, graph._free_top
-    )
+    _kernels.remove_small_zones(int(min_size), graph._size, graph._alive, parent, compact)
     _kernels.resolve_parents(parent, graph._alive)
     _kernels.relabel(graph._labels, parent)
     return graph
@@ -981,9 +977,8 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
     zones = np.flatnonzero(graph._alive)
     order = zones[np.lexsort((graph._size[zones], -graph._value_array[zones]))].astype(np.int32)
     _kernels.merge_ripples(
-        order, float(ripples), graph._labels.ravel(), graph._labels.shape[1],
-        graph._value_array, graph._size, graph._alive, compact, graph._free_top,
-    )  # fmt: skip
+        order, float(ripples), graph._labels.ravel(), graph._labels.shape[1], graph._size, graph._alive, compact
+    )
     return graph
 
 
