@@ -439,11 +439,17 @@ def _zone_of(label, parent):
 def _neighbourhood(labels, parent, pixel, width, around):
     """Write the zones of a pixel's 3x3 neighbourhood, row by row, into
     ``around`` (index 4: the pixel)."""
-    k = 0
-    for d_row in (-width, 0, width):
-        for d_col in (-1, 0, 1):
-            around[k] = _zone_of(labels[pixel + d_row + d_col], parent)
-            k += 1
+    # Written out: numba compiles loops over tuples of offsets into slow code.
+    up, down = pixel - width, pixel + width
+    around[0] = _zone_of(labels[up - 1], parent)
+    around[1] = _zone_of(labels[up], parent)
+    around[2] = _zone_of(labels[up + 1], parent)
+    around[3] = _zone_of(labels[pixel - 1], parent)
+    around[4] = _zone_of(labels[pixel], parent)
+    around[5] = _zone_of(labels[pixel + 1], parent)
+    around[6] = _zone_of(labels[down - 1], parent)
+    around[7] = _zone_of(labels[down], parent)
+    around[8] = _zone_of(labels[down + 1], parent)
 
 
 @njit(cache=True, inline="always")
@@ -529,21 +535,176 @@ def _recount(around, here, into, slots, keys, counts, meta, total, base):
 
 
 @njit(cache=True, inline="always")
-def _is_inner(labels, parent, pixel, width, own):
-    """Whether all 8 neighbours of ``pixel`` are in zone ``own``."""
+def _same_labels_around(labels, pixel, width):
+    """Whether all 8 neighbours of ``pixel`` carry its own label."""
     raw = labels[pixel]
     up, down = pixel - width, pixel + width
-    if (
+    return (
         labels[up - 1] == raw and labels[up] == raw and labels[up + 1] == raw
         and labels[pixel - 1] == raw and labels[pixel + 1] == raw
         and labels[down - 1] == raw and labels[down] == raw and labels[down + 1] == raw
-    ):  # fmt: skip
-        return _zone_of(raw, parent) == own
-    for d_row in (-width, 0, width):
-        for d_col in (-1, 0, 1):
-            if _zone_of(labels[pixel + d_row + d_col], parent) != own:
-                return False
-    return True
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _is_inner(labels, parent, pixel, width, own):
+    """Whether all 8 neighbours of ``pixel`` are in zone ``own``."""
+    if _same_labels_around(labels, pixel, width):
+        return _zone_of(labels[pixel], parent) == own
+    up, down = pixel - width, pixel + width
+    return (
+        _zone_of(labels[pixel], parent) == own
+        and _zone_of(labels[up - 1], parent) == own and _zone_of(labels[up], parent) == own
+        and _zone_of(labels[up + 1], parent) == own and _zone_of(labels[pixel - 1], parent) == own
+        and _zone_of(labels[pixel + 1], parent) == own and _zone_of(labels[down - 1], parent) == own
+        and _zone_of(labels[down], parent) == own and _zone_of(labels[down + 1], parent) == own
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _compact_labels(labels, alive):
+    """Renumber the live zones 1..n - 1 in id order, in place.
+
+    Returns ``(original, compact_of, n)``: ``original[k - 1]`` is the id of
+    compact zone k, ``compact_of`` the inverse (0 for dead ids).
+    """
+    original = np.flatnonzero(alive).astype(np.int32)
+    n = len(original) + 1
+    compact_of = np.zeros(len(alive), np.int32)
+    for k in range(len(original)):
+        compact_of[original[k]] = k + 1
+    for pixel in range(labels.size):
+        labels[pixel] = compact_of[labels[pixel]]
+    return original, compact_of, n
+
+
+@njit(cache=True)
+def _restore_labels(labels, parent, original):
+    """Undo :func:`_compact_labels`, each label replaced by its current zone."""
+    lookup = np.zeros(len(parent), np.int32)
+    for label in range(1, len(parent)):
+        lookup[label] = original[_zone_of(label, parent) - 1]
+    relabel(labels, lookup)
+
+
+@njit(cache=True)
+def _contacts_start(labels, width, n):
+    """Contact counts of every zone of a compact, padded, flattened label image.
+
+    Returns the tracking state ``(parent, pixels, following, head, tail,
+    keys, counts, meta, slots, total)``: union-find parents of the labels; the
+    border candidates of each zone as linked lists over the candidate arrays
+    (``pixels[k]`` a pixel, ``following[k]`` the next candidate or -1, ``head``
+    / ``tail`` per zone); the contact counts (per-zone slots, the shared table,
+    ``total`` = contour sizes).
+    """
+    parent = np.arange(n).astype(np.int32)
+    pixels = np.empty(1024, np.int32)
+    following = np.empty(1024, np.int32)
+    head = _filled(n, -1, np.int32)
+    tail = _filled(n, -1, np.int32)
+    keys, counts, meta = _new_table(16)
+    slots = _filled(n * _SLOTS, -1, np.int64)
+    for zone in range(n):
+        slots[zone * _SLOTS] = 0
+    total = np.zeros(n, np.int64)
+    around = np.empty(9, np.int32)
+    n_candidates = 0
+    for pixel in range(labels.size):
+        zone = labels[pixel]
+        # No fusion yet: every label is its own zone.
+        if zone == 0 or _same_labels_around(labels, pixel, width):
+            continue
+        if n_candidates == len(pixels):
+            pixels = _grown(pixels, 2 * n_candidates, 0)
+            following = _grown(following, 2 * n_candidates, 0)
+        pixels[n_candidates] = pixel
+        following[n_candidates] = -1
+        if tail[zone] == -1:
+            head[zone] = n_candidates
+        else:
+            following[tail[zone]] = n_candidates
+        tail[zone] = n_candidates
+        n_candidates += 1
+        if 2 * (meta[0] + 8) > len(keys):
+            keys, counts = _table_reserve(keys, counts, meta, 8)
+        _neighbourhood(labels, parent, pixel, width, around)
+        _count(around, 1, slots, keys, counts, meta, total, np.int64(n))
+    return parent, pixels, following, head, tail, keys, counts, meta, slots, total
+
+
+@njit(cache=True, inline="always")
+def _mark(pixel, here, stamp, affected, n_affected):
+    """Append ``pixel`` to ``affected`` unless already marked for this fusion."""
+    if stamp[pixel] != here:
+        stamp[pixel] = here
+        affected[n_affected] = pixel
+        n_affected += 1
+    return n_affected
+
+
+@njit(cache=True)
+def _contacts_fuse(here, into, labels, width, state, stamp, affected):
+    """Fuse compact zone ``here`` into ``into`` in the contact state; returns
+    the state (its table may have grown) and the scratch list ``affected``.
+
+    Only the pixels around ``here`` are visited: its border candidates (those
+    now inside are dropped for good) and their 8-neighbours; ``stamp`` (one
+    entry per pixel, never equal to ``here`` before) marks them once.
+    """
+    parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
+    base = np.int64(len(parent))
+    around = np.empty(9, np.int32)
+    n_affected = 0
+    kept_head, kept_tail = -1, -1
+    candidate = head[here]
+    while candidate != -1:
+        next_candidate = following[candidate]
+        pixel = pixels[candidate]
+        if not _is_inner(labels, parent, pixel, width, here):
+            following[candidate] = -1
+            if kept_tail == -1:
+                kept_head = candidate
+            else:
+                following[kept_tail] = candidate
+            kept_tail = candidate
+            if n_affected + 9 > len(affected):
+                affected = _grown(affected, 2 * len(affected), 0)
+            # The 3x3 neighbourhood, written out (numba compiles loops over
+            # tuples of offsets into slow code).
+            up, down = pixel - width, pixel + width
+            n_affected = _mark(up - 1, here, stamp, affected, n_affected)
+            n_affected = _mark(up, here, stamp, affected, n_affected)
+            n_affected = _mark(up + 1, here, stamp, affected, n_affected)
+            n_affected = _mark(pixel - 1, here, stamp, affected, n_affected)
+            n_affected = _mark(pixel, here, stamp, affected, n_affected)
+            n_affected = _mark(pixel + 1, here, stamp, affected, n_affected)
+            n_affected = _mark(down - 1, here, stamp, affected, n_affected)
+            n_affected = _mark(down, here, stamp, affected, n_affected)
+            n_affected = _mark(down + 1, here, stamp, affected, n_affected)
+        candidate = next_candidate
+    keys, counts = _table_reserve(keys, counts, meta, 8 * n_affected)
+    for k in range(n_affected):
+        _neighbourhood(labels, parent, affected[k], width, around)
+        _recount(around, here, into, slots, keys, counts, meta, total, base)
+    parent[here] = into
+    if kept_head != -1:
+        if tail[into] == -1:
+            head[into] = kept_head
+        else:
+            following[tail[into]] = kept_head
+        tail[into] = kept_tail
+    head[here] = tail[here] = -1
+    return (parent, pixels, following, head, tail, keys, counts, meta, slots, total), affected
+
+
+@njit(cache=True, inline="always")
+def _contact_percent(state, zone, other):
+    """Integer percentage of compact ``zone``'s contour pixels having ``other`` in their 3x3."""
+    parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
+    if total[zone] == 0:
+        return 0
+    return contact_get(slots, keys, counts, meta, np.int64(len(parent)), zone, other) * 100 // total[zone]
 
 
 @njit(cache=True)
@@ -554,55 +715,18 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
     then id); ``labels`` is the flattened label image, padded by at least 2
     pixels of 0 and ``width`` wide, relabelled in place.
 
-    A fusion only touches the pixels around the absorbed zone: zones are
-    union-find sets of the labels (relabelled once, at the end), numbered
-    compactly so that the per-zone arrays stay in cache, and each zone keeps
-    a list of its pixels that may still be on its border (a pixel found with
-    all 8 neighbours inside is dropped for good).
+    Contacts are tracked on compact zone ids (the per-zone arrays stay in
+    cache) as union-find sets of the labels, relabelled once at the end.
     """
     records, nodes = graph
-    # Compact ids: the live zones in id order are 1..n - 1.
-    original = np.flatnonzero(alive).astype(np.int32)
-    n = len(original) + 1
-    compact_of = np.zeros(len(records), np.int32)
-    for k in range(len(original)):
-        compact_of[original[k]] = k + 1
-    for pixel in range(labels.size):
-        labels[pixel] = compact_of[labels[pixel]]
-    base = np.int64(n)
-    parent = np.arange(n).astype(np.int32)
-    # Border candidates of each zone, as linked lists; and the contact counts
-    # (the table is grown outside `_count`, so that it can be inlined).
-    border_next = _filled(labels.size, -1, np.int32)
-    border_head = _filled(n, -1, np.int32)
-    border_tail = _filled(n, -1, np.int32)
-    keys, counts, meta = _new_table(16)
-    slots = _filled(n * _SLOTS, -1, np.int64)
-    for zone in range(n):
-        slots[zone * _SLOTS] = 0
-    total = np.zeros(n, np.int64)
-    around = np.empty(9, np.int32)
-    for pixel in range(labels.size):
-        zone = labels[pixel]
-        if zone == 0 or _is_inner(labels, parent, pixel, width, zone):
-            continue
-        if border_tail[zone] == -1:
-            border_head[zone] = pixel
-        else:
-            border_next[border_tail[zone]] = pixel
-        border_tail[zone] = pixel
-        if 2 * (meta[0] + 8) > len(keys):
-            keys, counts = _table_reserve(keys, counts, meta, 8)
-        _neighbourhood(labels, parent, pixel, width, around)
-        _count(around, 1, slots, keys, counts, meta, total, base)
-
+    original, compact_of, n = _compact_labels(labels, alive)
+    state = _contacts_start(labels, width, n)
+    stamp = np.zeros(labels.size, np.int32)
+    affected = np.empty(1024, np.int32)
     queue = np.empty(max(2 * len(order), 16), np.int32)
     for i in range(len(order)):
         queue[i] = order[i]
     start, end = 0, len(order)
-    stamp = np.zeros(labels.size, np.int32)
-    stamp_id = 0
-    affected = np.empty(1024, np.int32)
     while start < end:
         zone = queue[start]
         start += 1
@@ -610,17 +734,17 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
             continue
         zone_value = records[zone, VALUE]
         here = compact_of[zone]
-        contour = total[here]
         best, best_gap = -1, 0
         node = records[zone, HEAD]
         while node != -1:
             other = nodes[node, NEIGHBOUR]
-            if nodes[node | 1, ATTRIBUTE] == 0 and contour > 0:
-                percent = contact_get(slots, keys, counts, meta, base, here, compact_of[other]) * 100 // contour
-                if percent >= ripples:
-                    gap = abs(records[other, VALUE] - zone_value)
-                    if best == -1 or gap < best_gap:
-                        best, best_gap = other, gap
+            if (
+                nodes[node | 1, ATTRIBUTE] == 0 and state[9][here] > 0
+                and _contact_percent(state, here, compact_of[other]) >= ripples
+            ):  # fmt: skip
+                gap = abs(records[other, VALUE] - zone_value)
+                if best == -1 or gap < best_gap:
+                    best, best_gap = other, gap
             node = nodes[node, NEXT]
         if best == -1:
             continue
@@ -632,52 +756,107 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
             queue[end] = nodes[node, NEIGHBOUR]
             end += 1
             node = nodes[node, NEXT]
-        # Pixels whose counts may change: the zone's border pixels and their
-        # neighbours. Border candidates now inside are dropped from the list.
-        into = compact_of[best]
-        stamp_id += 1
-        n_affected = 0
-        kept_head, kept_tail = -1, -1
-        pixel = border_head[here]
-        while pixel != -1:
-            following = border_next[pixel]
-            if not _is_inner(labels, parent, pixel, width, here):
-                border_next[pixel] = -1
-                if kept_tail == -1:
-                    kept_head = pixel
-                else:
-                    border_next[kept_tail] = pixel
-                kept_tail = pixel
-                for d_row in (-width, 0, width):
-                    for d_col in (-1, 0, 1):
-                        near = pixel + d_row + d_col
-                        if stamp[near] != stamp_id:
-                            stamp[near] = stamp_id
-                            if n_affected == len(affected):
-                                affected = _grown(affected, 2 * len(affected), 0)
-                            affected[n_affected] = near
-                            n_affected += 1
-            pixel = following
-        keys, counts = _table_reserve(keys, counts, meta, 8 * n_affected)
-        for k in range(n_affected):
-            _neighbourhood(labels, parent, affected[k], width, around)
-            _recount(around, here, into, slots, keys, counts, meta, total, base)
-        parent[here] = into
-        if kept_head != -1:
-            if border_tail[into] == -1:
-                border_head[into] = kept_head
-            else:
-                border_next[border_tail[into]] = kept_head
-            border_tail[into] = kept_tail
-        border_head[here] = border_tail[here] = -1
-
+        state, affected = _contacts_fuse(here, compact_of[best], labels, width, state, stamp, affected)
         alive[zone] = False
         size[best] += size[zone]
         fuse_edges(zone, best, graph)
-    lookup = np.zeros(n, np.int32)
-    for label in range(1, n):
-        lookup[label] = original[_zone_of(label, parent) - 1]
-    relabel(labels, lookup)
+    _restore_labels(labels, state[0], original)
+
+
+@njit(cache=True)
+def _contact_sum(state, zone, here, compact_of, graph):
+    """Sum of contact percentages of ``zone`` (compact id ``here``) over its neighbours."""
+    records, nodes = graph
+    result = 0
+    node = records[zone, HEAD]
+    while node != -1:
+        result += _contact_percent(state, here, compact_of[nodes[node, NEIGHBOUR]])
+        node = nodes[node, NEXT]
+    return result
+
+
+@njit(cache=True)
+def remove_doors(doors, labels, width, size, alive, graph):
+    """Door removal (``removeDoors``) on a padded flat label image, relabelled in place.
+
+    Zones in id order: one whose contact sum exceeds ``doors`` is fused into
+    the last neighbour whose sum is below ``doors``, else into its first
+    neighbour; the receiver's sum is then recomputed. Sums are taken once at
+    the start otherwise.
+    """
+    records, nodes = graph
+    original, compact_of, n = _compact_labels(labels, alive)
+    state = _contacts_start(labels, width, n)
+    stamp = np.zeros(labels.size, np.int32)
+    affected = np.empty(1024, np.int32)
+    sums = np.zeros(len(records), np.int64)
+    for k in range(len(original)):
+        zone = original[k]
+        sums[zone] = _contact_sum(state, zone, k + 1, compact_of, graph)
+    for k in range(len(original)):
+        zone = original[k]
+        if not alive[zone] or sums[zone] <= doors or records[zone, DEGREE] == 0:
+            continue
+        node = records[zone, HEAD]
+        target = nodes[node, NEIGHBOUR]
+        while node != -1:
+            if sums[nodes[node, NEIGHBOUR]] < doors:
+                target = nodes[node, NEIGHBOUR]
+            node = nodes[node, NEXT]
+        state, affected = _contacts_fuse(k + 1, compact_of[target], labels, width, state, stamp, affected)
+        alive[zone] = False
+        size[target] += size[zone]
+        fuse_edges(zone, target, graph)
+        sums[target] = _contact_sum(state, target, compact_of[target], compact_of, graph)
+    _restore_labels(labels, state[0], original)
+
+
+@njit(cache=True)
+def contact_table(labels, width, alive):
+    """Every contact count of a padded flat label image, as ``(zone, other,
+    count)`` rows in original ids (other = 0: the zone's contour size)."""
+    work = labels.copy()
+    original, compact_of, n = _compact_labels(work, alive)
+    parent, pixels, following, head, tail, keys, counts, meta, slots, total = _contacts_start(work, width, n)
+    rows = 0
+    for zone in range(1, n):
+        if total[zone] > 0:
+            rows += 1
+        for k in range(zone * _SLOTS + 1, zone * _SLOTS + _SLOTS):
+            if slots[k] >= 0:
+                rows += 1
+    for slot in range(len(keys)):
+        if keys[slot] != _EMPTY and counts[slot] != 0:
+            rows += 1
+    out = np.empty((rows, 3), np.int64)
+    row = 0
+    for zone in range(1, n):
+        if total[zone] > 0:
+            out[row, 0], out[row, 1], out[row, 2] = original[zone - 1], 0, total[zone]
+            row += 1
+        for k in range(zone * _SLOTS + 1, zone * _SLOTS + _SLOTS):
+            if slots[k] >= 0:
+                out[row, 0], out[row, 1] = original[zone - 1], original[(slots[k] >> 32) - 1]
+                out[row, 2] = slots[k] & _COUNT
+                row += 1
+    for slot in range(len(keys)):
+        if keys[slot] != _EMPTY and counts[slot] != 0:
+            out[row, 0] = original[keys[slot] // n - 1]
+            out[row, 1] = original[keys[slot] % n - 1]
+            out[row, 2] = counts[slot]
+            row += 1
+    return out
+
+
+@njit(cache=True)
+def first_pixels(labels, count):
+    """Flat index of the first pixel (raster order) of each label 1..count - 1, -1 if absent."""
+    first = _filled(count, -1, np.int64)
+    flat = labels.ravel()
+    for i in range(len(flat)):
+        if first[flat[i]] == -1:
+            first[flat[i]] = i
+    return first
 
 
 @njit(cache=True)

@@ -151,7 +151,6 @@ from typing import Any, Callable, Mapping
 
 import cv2
 import numpy as np
-from scipy import ndimage as ndi
 from skimage.measure import label as _label_equal_values
 
 from ursim_core.errors import ParameterError, SegmentationError
@@ -510,7 +509,6 @@ class ZoneEdge:
 
 _MISSING = object()
 _PAD = 2  # label image padding: pixels next to a zone gather their own 3x3 neighbourhood
-_OFFSETS_8 = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
 
 
 class ZoneGraph:
@@ -561,20 +559,18 @@ class ZoneGraph:
         self._value_array = value
         self._value: list[int] = value.tolist()
         self._size = np.bincount(zones.ravel(), minlength=count + 1).astype(np.int64)
-        # Bounding boxes (padded coordinates, max exclusive), computed when first needed.
-        self._bbox: dict[int, list[int]] | None = None
         # The adjacency lives either in compact arrays (the compiled steps'
         # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
         self._alive = self._size > 0
         self._alive[0] = False
         self._compact: tuple | None = _kernels.build_adjacency(zones.astype(np.int32, copy=False), value)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
+        # Contact counts, computed for the whole image when first queried and
+        # dropped by the next fusion (the compiled steps track their own).
         self._contacts: dict[int, int] | None = None
+        # Fusions not yet written into the label image: zone -> receiver (0 = deleted).
         self._pending: dict[int, int] = {}
-        self._pending_near: list[np.ndarray] = []
-        self._pending_members: list[np.ndarray] = []
         self._identity = np.arange(count + 1, dtype=np.int32)
-        self._dirty: set[int] = set()
 
     @property
     def adj(self) -> dict[int, dict[int, ZoneEdge | None]]:
@@ -619,8 +615,7 @@ class ZoneGraph:
     def _run_compiled(self) -> tuple:
         """Prepare for a compiled step: labels flushed, contacts and boxes dropped."""
         self._flush()
-        self.invalidate_contacts()
-        self._bbox = None
+        self._contacts = None
         return self._compact_adjacency()
 
     # -- queries ----------------------------------------------------------
@@ -675,8 +670,6 @@ class ZoneGraph:
         Faster than repeated :meth:`contact_percent` calls for one zone.
         """
         contacts = self._ensure_contacts()
-        if zone in self._dirty:
-            self._flush()
         key = zone * len(self._value)
         total = contacts.get(key, 0)
         if total == 0:
@@ -691,29 +684,18 @@ class ZoneGraph:
 
     def label_image(self) -> np.ndarray:
         """Labels renumbered 1..N in the raster order of each region's first pixel."""
-        labels = self.labels
-        first_pixels = []
-        for zone in self.adj:
-            r0, r1, c0, c1 = (x - _PAD for x in self._boxes()[zone])
-            first_row = labels[r0, c0:c1]
-            first_pixels.append((r0, c0 + int(np.argmax(first_row == zone)), zone))
+        self._flush()
+        zones = np.array(self.vertices(), np.int64)
+        # The padding adds no labels, so raster order in it is raster order in the map.
+        first = _kernels.first_pixels(self._labels, len(self._value))[zones]
         lookup = np.zeros(len(self._value), np.int32)
-        for new_label, (_, _, zone) in enumerate(sorted(first_pixels), start=1):
-            lookup[zone] = new_label
-        return lookup[labels]
+        lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
+        return lookup[self.labels]
 
     # -- contacts and relabelling -------------------------------------------
-    #
-    # Contact counts live in one dict keyed by ``a * base + b``: the number of
-    # contour pixels of a with b in their 3x3 neighbourhood (b >= 1), and the
-    # number of contour pixels of a (b = 0). Fusions are recorded in
-    # `_pending` (zone -> receiver, 0 = deleted) and written into the label
-    # image by `_flush` in one vectorised pass. While contacts are tracked, a
-    # flush also updates the counts around the fused zones, and `_dirty` holds
-    # the zones whose counts a pending fusion may change: a query about one of
-    # them flushes first. This batches the ripple step's many small fusions.
 
     def _flush(self) -> None:
+        """Write the pending fusions into the label image, in one vectorised pass."""
         if not self._pending:
             return
         pending = self._pending
@@ -723,102 +705,31 @@ class ZoneGraph:
         parent = self._identity
         parent[zones] = np.fromiter(pending.values(), np.int64, len(pending))
         # Follow chains z -> b -> c so every pending zone maps to its final
-        # receiver: pointer doubling, log(chain length) vectorised passes
-        # (small-zone removal leaves ~10^5-10^6 pending fusions in long chains).
+        # receiver: pointer doubling, log(chain length) vectorised passes.
         while True:
             jumped = parent[parent[zones]]
             if np.array_equal(jumped, parent[zones]):
                 break
             parent[zones] = jumped
-        if self._contacts is None:
-            self._labels = parent[self._labels]
-        else:
-            affected = np.unique(np.concatenate(self._pending_near))
-            codes, deltas = _contact_delta(self._labels, affected, parent, len(self._value))
-            contacts = self._contacts
-            for code, delta in zip(codes.tolist(), deltas.tolist()):
-                count = contacts.get(code, 0) + delta
-                if count:
-                    contacts[code] = count
-                else:
-                    del contacts[code]
-            members = np.concatenate(self._pending_members)
-            flat_labels = self._labels.ravel()
-            flat_labels[members] = parent[flat_labels[members]]
+        self._labels = parent[self._labels]
         parent[zones] = zones
         self._pending = {}
-        self._pending_near = []
-        self._pending_members = []
-        self._dirty = set()
-
-    def _near_pixels(self, zone: int) -> tuple[np.ndarray, np.ndarray]:
-        """Flat indices of the pixels a relabelling of `zone` affects, and of its pixels.
-
-        Affected: the zone's 8-neighbours and its pixels that are not
-        8-interior (an interior pixel stays interior, its counts unchanged).
-        """
-        r0, r1, c0, c1 = self._boxes()[zone]
-        crop = self._labels[r0 - 1 : r1 + 1, c0 - 1 : c1 + 1]
-        mask = (crop == zone).view(np.uint8)
-        near = cv2.dilate(mask, _KERNEL_3x3) - cv2.erode(mask, _KERNEL_3x3)
-        width = self._labels.shape[1]
-        offset = (r0 - 1) * width + c0 - 1
-        rows, cols = np.nonzero(near)
-        member_rows, member_cols = np.nonzero(mask)
-        return rows * width + cols + offset, member_rows * width + member_cols + offset
 
     def _ensure_contacts(self) -> dict[int, int]:
+        # Counts keyed by ``a * base + b``: contour pixels of a with b in their
+        # 3x3 neighbourhood (b >= 1), and the contour size of a (b = 0).
         if self._contacts is None:
             self._flush()
-            labels = self._labels
-            core = labels[1:-1, 1:-1]
-            # Only contour pixels count: find them with whole-image slices first.
-            contour = (core != 0) & (
-                (labels[:-2, 1:-1] != core) | (labels[2:, 1:-1] != core)
-                | (labels[1:-1, :-2] != core) | (labels[1:-1, 2:] != core)
-            )
-            row_index, col_index = np.nonzero(contour)
-            flat = (row_index + 1) * labels.shape[1] + col_index + 1
-            codes, counts = _contact_table(labels, flat, len(self._value))
-            self._contacts = dict(zip(codes.tolist(), counts.tolist()))
+            alive = np.zeros(len(self._value), bool)
+            alive[self.vertices()] = True
+            table = _kernels.contact_table(self._labels.ravel(), self._labels.shape[1], alive)
+            codes = table[:, 0] * len(self._value) + table[:, 1]
+            self._contacts = dict(zip(codes.tolist(), table[:, 2].tolist()))
         return self._contacts
 
     def invalidate_contacts(self) -> None:
-        """Stop tracking contacts; the next query recomputes them for the whole image.
-
-        Cheaper than local updates when many zones are about to be fused.
-        """
+        """Drop the contact counts; the next query recomputes them for the whole image."""
         self._contacts = None
-        self._pending_near = []
-        self._pending_members = []
-        self._dirty = set()
-
-    def _boxes(self) -> dict[int, list[int]]:
-        if self._bbox is None:
-            if self._contacts is None:
-                self._flush()
-            # (While contacts are tracked, boxes exist before any fusion is pending.)
-            self._bbox = {}
-            for zone, slices in enumerate(ndi.find_objects(self._labels), start=1):
-                if slices is not None and zone in self.adj:
-                    self._bbox[zone] = [slices[0].start, slices[0].stop, slices[1].start, slices[1].stop]
-        return self._bbox
-
-    def _record_relabel(self, zone: int, new_label: int) -> None:
-        if self._contacts is not None:
-            near, members = self._near_pixels(zone)
-            self._pending_near.append(near)
-            self._pending_members.append(members)
-            # Every zone with a pixel next to `zone` may see its counts change;
-            # labels there may still wait for a pending fusion: follow it.
-            for label in set(self._labels.ravel()[near].tolist()):
-                while label in self._pending:
-                    label = self._pending[label]
-                if label:
-                    self._dirty.add(label)
-            if new_label:
-                self._dirty.add(new_label)
-        self._pending[zone] = new_label
 
     # -- mutations -------------------------------------------------------
 
@@ -841,12 +752,9 @@ class ZoneGraph:
         """
         if zone == into:
             raise SegmentationError(f"cannot fuse zone {zone} into itself")
-        self._record_relabel(zone, into)
+        self._pending[zone] = into
+        self._contacts = None
         self._size[into] += self._size[zone]
-        if self._bbox is not None:
-            box, other = self._bbox[into], self._bbox.pop(zone)
-            box[0], box[1] = min(box[0], other[0]), max(box[1], other[1])
-            box[2], box[3] = min(box[2], other[2]), max(box[3], other[3])
         zone_value = self._value[zone]
         adj = self.adj
         target = adj[into]
@@ -870,65 +778,10 @@ class ZoneGraph:
 
     def remove(self, zone: int) -> None:
         """Delete a zone: its pixels become 0 and its edges disappear."""
-        self._record_relabel(zone, 0)
-        if self._bbox is not None:
-            self._bbox.pop(zone)
+        self._pending[zone] = 0
+        self._contacts = None
         for neighbour in self.adj.pop(zone):
             del self.adj[neighbour][zone]
-
-
-_KERNEL_3x3 = np.ones((3, 3), np.uint8)
-
-
-def _contact_table(labels: np.ndarray, pixels: np.ndarray, base: int) -> tuple[np.ndarray, np.ndarray]:
-    """Contact counts of the contour pixels among ``pixels`` (flat indices).
-
-    A contour pixel is a zone pixel with a 4-neighbour of another label; it
-    counts once for every distinct other non-zero label b in its 3x3
-    neighbourhood, under code ``zone * base + b``, and once under
-    ``zone * base`` (contour size). Pixels must be at least one pixel away from
-    the border of ``labels``; ``base`` is larger than every label.
-    """
-    identity = np.arange(base, dtype=np.int32)
-    codes, deltas = _contact_delta(labels, pixels, identity, base, before=False)
-    return codes, deltas
-
-
-def _contact_delta(
-    labels: np.ndarray, pixels: np.ndarray, parent: np.ndarray, base: int, *, before: bool = True
-) -> tuple[np.ndarray, np.ndarray]:
-    """How relabelling every pixel l as ``parent[l]`` changes the contact counts.
-
-    ``pixels`` must hold every pixel within one pixel (8-connected) of a
-    relabelled zone. Returns codes ``a * base + b`` (b = 0: contour size of a)
-    and the signed change of each count; with ``before=False``, only the
-    counts after relabelling (all positive).
-    """
-    width = labels.shape[1]
-    # Columns 0..7: the 8-neighbours (_OFFSETS_8 order); column 8: the pixel itself.
-    offsets = np.array([d_row * width + d_col for d_row, d_col in _OFFSETS_8] + [0], np.int64)
-    gathered = labels.ravel()[pixels[:, None] + offsets]
-    if before:
-        both = np.concatenate([gathered, parent[gathered]])
-        sign = np.repeat(np.array([-1, 1], np.int64), len(pixels))
-    else:
-        both = parent[gathered]
-        sign = np.ones(len(pixels), np.int64)
-    own = both[:, 8]
-    contour = (own != 0) & (both[:, [1, 3, 4, 6]] != own[:, None]).any(axis=1)
-    own, sign, neighbours = own[contour].astype(np.int64), sign[contour], both[contour, :8]
-    neighbours[neighbours == own[:, None]] = 0
-    neighbours.sort(axis=1)
-    keep = neighbours != 0
-    keep[:, 1:] &= neighbours[:, 1:] != neighbours[:, :-1]
-    per_row = keep.sum(axis=1)
-    # Contact codes a * base + b, then contour codes a * base + 0.
-    codes = np.concatenate([np.repeat(own, per_row) * base + neighbours[keep], own * base])
-    weights = np.concatenate([np.repeat(sign, per_row), sign])
-    unique_codes, inverse = np.unique(codes, return_inverse=True)
-    deltas = np.bincount(inverse, weights=weights, minlength=len(unique_codes)).astype(np.int64)
-    changed = deltas != 0
-    return unique_codes[changed], deltas[changed]
 
 
 # ---------------------------------------------------------------------------
@@ -1086,7 +939,9 @@ def remove_doors(graph: ZoneGraph, *, doors: float = 40) -> ZoneGraph:
 
     A region whose contact sum (:meth:`ZoneGraph.contact_sum`) exceeds ``doors``
     is fused into the last neighbour whose own sum is below ``doors``, else into
-    its first neighbour; the receiver's sum is then recomputed.
+    its first neighbour; the receiver's sum is then recomputed. Zones are
+    visited in id order, with the sums taken before the first fusion except
+    for receivers. Runs compiled, tracking contacts as :func:`merge_ripples`.
 
     Examples
     --------
@@ -1097,19 +952,10 @@ def remove_doors(graph: ZoneGraph, *, doors: float = 40) -> ZoneGraph:
     >>> graph.contact_sum(3), remove_doors(graph).vertices()
     (100, [1, 2])
     """
-    sums = {zone: graph.contact_sum(zone) for zone in graph.vertices()}
-    for zone in graph.vertices():
-        if zone not in graph or sums[zone] <= doors:
-            continue
-        neighbours = graph.neighbours(zone)
-        if not neighbours:
-            continue
-        target = neighbours[0]
-        for other in neighbours:
-            if sums[other] < doors:
-                target = other
-        graph.fuse(zone, target)
-        sums[target] = graph.contact_sum(target)
+    compact = graph._run_compiled()
+    _kernels.remove_doors(
+        float(doors), graph._labels.ravel(), graph._labels.shape[1], graph._size, graph._alive, compact
+    )
     return graph
 
 
