@@ -104,8 +104,10 @@ def build_adjacency(zones, value):
     for zone in range(count):
         last_partner[zone] = 0
     nodes = np.empty((max(2 * bound, 2), 4), np.int32)
-    used = _contacts_in_order(zones, last_partner, records, nodes, False)
-    return records, nodes[: max(used, 2)]
+    _contacts_in_order(zones, last_partner, records, nodes, False)
+    # Not trimmed to the nodes used: a slice would be typed as another array
+    # layout, and every kernel taking the graph compiled twice.
+    return records, nodes
 
 
 @njit(cache=True, inline="always")
@@ -224,6 +226,8 @@ def _find(records, nodes, a, b):
 def fuse_edges(zone, into, graph):
     """Transfer the edges of ``zone`` to ``into`` (``ZoneGraph.fuse``, edges only).
 
+    Callers pass int64 ids: each other integer type would compile another copy.
+
     A new edge (into, n) reuses the node pair of the edge (zone, n) it
     replaces, so the node records never grow.
     """
@@ -297,7 +301,7 @@ def remove_small_zones(min_size, size, alive, parent, graph):
             node = nodes[node, NEXT]
         parent[zone] = closest
         size[closest] += size[zone]
-        fuse_edges(zone, closest, graph)
+        fuse_edges(np.int64(zone), np.int64(closest), graph)
 
 
 # -- contact counts ------------------------------------------------------
@@ -453,47 +457,84 @@ def _neighbourhood(labels, parent, pixel, width, around):
 
 
 @njit(cache=True, inline="always")
-def _count(around, sign, slots, keys, counts, meta, total, base):
-    """Add ``sign`` times the contact counts of a pixel whose 3x3 zones are ``around``.
+def _raw_neighbourhood(labels, pixel, width, around):
+    """:func:`_neighbourhood` before any fusion (every label its own zone)."""
+    up, down = pixel - width, pixel + width
+    around[0], around[1], around[2] = labels[up - 1], labels[up], labels[up + 1]
+    around[3], around[4], around[5] = labels[pixel - 1], labels[pixel], labels[pixel + 1]
+    around[6], around[7], around[8] = labels[down - 1], labels[down], labels[down + 1]
 
-    A contour pixel (a 4-neighbour in another zone) counts once in its zone's
-    contour size and once for every distinct other zone in its 3x3
-    neighbourhood.
-    """
+
+@njit(cache=True, inline="always")
+def _is_contour(around):
+    """Whether the pixel whose 3x3 zones are ``around`` is a contour pixel: in a
+    zone, with a 4-neighbour in another zone (or none)."""
     own = around[4]
-    if own == 0 or (around[1] == own and around[3] == own and around[5] == own and around[7] == own):
-        return
-    total[own] += sign
+    return own != 0 and not (around[1] == own and around[3] == own and around[5] == own and around[7] == own)
+
+
+@njit(cache=True, inline="always")
+def _distinct_others(around, partners, n):
+    """Append the distinct zones of ``around`` other than 0 and the pixel's own
+    to ``partners[n:]``; returns the new length."""
+    own = around[4]
+    start = n
     for k in range(9):
         other = around[k]
         if other == 0 or other == own:
             continue
         repeated = False
-        for j in range(k):
-            if around[j] == other:
+        for j in range(start, n):
+            if partners[j] == other:
                 repeated = True
                 break
         if not repeated:
-            _contact_add(slots, keys, counts, meta, base, own, other, sign)
+            partners[n] = other
+            n += 1
+    return n
 
 
 @njit(cache=True, inline="always")
-def _recount(around, here, into, slots, keys, counts, meta, total, base):
+def _count(around, partners, slots, keys, counts, meta, total, base):
+    """Add the contact counts of a pixel whose 3x3 zones are ``around``.
+
+    A contour pixel counts once in its zone's contour size and once for every
+    distinct other zone in its 3x3 neighbourhood.
+    """
+    if not _is_contour(around):
+        return
+    own = around[4]
+    total[own] += 1
+    n = _distinct_others(around, partners, 0)
+    for i in range(n):
+        _contact_add(slots, keys, counts, meta, base, own, partners[i], 1)
+
+
+@njit(cache=True, inline="always")
+def _recount(around, here, into, partners, signs, slots, keys, counts, meta, total, base):
     """Update the contact counts of a pixel whose 3x3 zones are ``around`` for
     the fusion of zone ``here`` into ``into``; ``around`` is rewritten to after.
 
     Only the changes are applied: the counts of ``here`` itself are left as
-    they are, since a fused zone is never queried again.
+    they are, since a fused zone is never queried again. The changes are
+    gathered first so that the table is updated from one place (each inlined
+    update costs compilation time).
     """
     own = around[4]
-    was_contour = own != 0 and not (
-        around[1] == own and around[3] == own and around[5] == own and around[7] == own
-    )
+    was_contour = _is_contour(around)
+    n = 0
     if own == here:
+        # The pixel moves to `into` with its contour status and contacts as after.
         for k in range(9):
             if around[k] == here:
                 around[k] = into
-        _count(around, 1, slots, keys, counts, meta, total, base)
+        if not _is_contour(around):
+            return
+        own = into
+        total[own] += 1
+        n = _distinct_others(around, partners, 0)
+        for i in range(n):
+            signs[i] = 1
     elif own == into:
         if not was_contour:
             return
@@ -504,23 +545,14 @@ def _recount(around, here, into, slots, keys, counts, meta, total, base):
                 around[k] = into
         if not had_here:
             return
-        if not (around[1] == own and around[3] == own and around[5] == own and around[7] == own):
-            _contact_add(slots, keys, counts, meta, base, own, here, -1)
-        else:
+        partners[0], signs[0] = here, -1
+        n = 1
+        if not _is_contour(around):
             # No longer a contour pixel: it leaves every count of `into`.
             total[own] -= 1
-            _contact_add(slots, keys, counts, meta, base, own, here, -1)
-            for k in range(9):
-                other = around[k]
-                if other == 0 or other == own:
-                    continue
-                repeated = False
-                for j in range(k):
-                    if around[j] == other:
-                        repeated = True
-                        break
-                if not repeated:
-                    _contact_add(slots, keys, counts, meta, base, own, other, -1)
+            n = _distinct_others(around, partners, 1)
+            for i in range(1, n):
+                signs[i] = -1
     elif was_contour:
         had_here, had_into = False, False
         for k in range(9):
@@ -528,10 +560,15 @@ def _recount(around, here, into, slots, keys, counts, meta, total, base):
                 had_here = True
             elif around[k] == into:
                 had_into = True
-        if had_here:
-            _contact_add(slots, keys, counts, meta, base, own, here, -1)
-            if not had_into:
-                _contact_add(slots, keys, counts, meta, base, own, into, 1)
+        if not had_here:
+            return
+        partners[0], signs[0] = here, -1
+        n = 1
+        if not had_into:
+            partners[1], signs[1] = into, 1
+            n = 2
+    for i in range(n):
+        _contact_add(slots, keys, counts, meta, base, own, partners[i], signs[i])
 
 
 @njit(cache=True, inline="always")
@@ -609,6 +646,7 @@ def _contacts_start(labels, width, n):
         slots[zone * _SLOTS] = 0
     total = np.zeros(n, np.int64)
     around = np.empty(9, np.int32)
+    partners = np.empty(9, np.int32)
     n_candidates = 0
     for pixel in range(labels.size):
         zone = labels[pixel]
@@ -628,15 +666,16 @@ def _contacts_start(labels, width, n):
         n_candidates += 1
         if 2 * (meta[0] + 8) > len(keys):
             keys, counts = _table_reserve(keys, counts, meta, 8)
-        _neighbourhood(labels, parent, pixel, width, around)
-        _count(around, 1, slots, keys, counts, meta, total, np.int64(n))
+        _raw_neighbourhood(labels, pixel, width, around)
+        _count(around, partners, slots, keys, counts, meta, total, np.int64(n))
     return parent, pixels, following, head, tail, keys, counts, meta, slots, total
 
 
 @njit(cache=True, inline="always")
-def _mark(pixel, here, stamp, affected, n_affected):
-    """Append ``pixel`` to ``affected`` unless already marked for this fusion."""
-    if stamp[pixel] != here:
+def _mark(pixel, here, labels, stamp, affected, n_affected):
+    """Append ``pixel`` to ``affected`` unless it has no zone (no counts) or
+    is already marked for this fusion."""
+    if labels[pixel] != 0 and stamp[pixel] != here:
         stamp[pixel] = here
         affected[n_affected] = pixel
         n_affected += 1
@@ -655,6 +694,8 @@ def _contacts_fuse(here, into, labels, width, state, stamp, affected):
     parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
     base = np.int64(len(parent))
     around = np.empty(9, np.int32)
+    partners = np.empty(9, np.int32)
+    signs = np.empty(9, np.int64)
     n_affected = 0
     kept_head, kept_tail = -1, -1
     candidate = head[here]
@@ -673,20 +714,20 @@ def _contacts_fuse(here, into, labels, width, state, stamp, affected):
             # The 3x3 neighbourhood, written out (numba compiles loops over
             # tuples of offsets into slow code).
             up, down = pixel - width, pixel + width
-            n_affected = _mark(up - 1, here, stamp, affected, n_affected)
-            n_affected = _mark(up, here, stamp, affected, n_affected)
-            n_affected = _mark(up + 1, here, stamp, affected, n_affected)
-            n_affected = _mark(pixel - 1, here, stamp, affected, n_affected)
-            n_affected = _mark(pixel, here, stamp, affected, n_affected)
-            n_affected = _mark(pixel + 1, here, stamp, affected, n_affected)
-            n_affected = _mark(down - 1, here, stamp, affected, n_affected)
-            n_affected = _mark(down, here, stamp, affected, n_affected)
-            n_affected = _mark(down + 1, here, stamp, affected, n_affected)
+            n_affected = _mark(up - 1, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(up, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(up + 1, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(pixel - 1, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(pixel, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(pixel + 1, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(down - 1, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(down, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(down + 1, here, labels, stamp, affected, n_affected)
         candidate = next_candidate
     keys, counts = _table_reserve(keys, counts, meta, 8 * n_affected)
     for k in range(n_affected):
         _neighbourhood(labels, parent, affected[k], width, around)
-        _recount(around, here, into, slots, keys, counts, meta, total, base)
+        _recount(around, here, into, partners, signs, slots, keys, counts, meta, total, base)
     parent[here] = into
     if kept_head != -1:
         if tail[into] == -1:
@@ -756,10 +797,12 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
             queue[end] = nodes[node, NEIGHBOUR]
             end += 1
             node = nodes[node, NEXT]
-        state, affected = _contacts_fuse(here, compact_of[best], labels, width, state, stamp, affected)
+        state, affected = _contacts_fuse(
+            np.int64(here), np.int64(compact_of[best]), labels, width, state, stamp, affected
+        )
         alive[zone] = False
         size[best] += size[zone]
-        fuse_edges(zone, best, graph)
+        fuse_edges(np.int64(zone), np.int64(best), graph)
     _restore_labels(labels, state[0], original)
 
 
@@ -792,7 +835,7 @@ def remove_doors(doors, labels, width, size, alive, graph):
     sums = np.zeros(len(records), np.int64)
     for k in range(len(original)):
         zone = original[k]
-        sums[zone] = _contact_sum(state, zone, k + 1, compact_of, graph)
+        sums[zone] = _contact_sum(state, np.int64(zone), np.int64(k + 1), compact_of, graph)
     for k in range(len(original)):
         zone = original[k]
         if not alive[zone] or sums[zone] <= doors or records[zone, DEGREE] == 0:
@@ -803,11 +846,13 @@ def remove_doors(doors, labels, width, size, alive, graph):
             if sums[nodes[node, NEIGHBOUR]] < doors:
                 target = nodes[node, NEIGHBOUR]
             node = nodes[node, NEXT]
-        state, affected = _contacts_fuse(k + 1, compact_of[target], labels, width, state, stamp, affected)
+        state, affected = _contacts_fuse(
+            np.int64(k + 1), np.int64(compact_of[target]), labels, width, state, stamp, affected
+        )
         alive[zone] = False
         size[target] += size[zone]
-        fuse_edges(zone, target, graph)
-        sums[target] = _contact_sum(state, target, compact_of[target], compact_of, graph)
+        fuse_edges(np.int64(zone), np.int64(target), graph)
+        sums[target] = _contact_sum(state, np.int64(target), np.int64(compact_of[target]), compact_of, graph)
     _restore_labels(labels, state[0], original)
 
 
