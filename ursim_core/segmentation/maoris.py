@@ -22,8 +22,9 @@ tested on its own:
 Speed: a 4000 x 4000 map starts with about 1.5 million flat zones, visited
 one by one in an order that decides ties, so steps 3-4 cannot be vectorised;
 they run as compiled code (numba, ``_zone_kernels``) on an array form of the
-zone graph. The kernels compile on first use, about half a minute, once:
-numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
+zone graph. Step 1 paints its discs with compiled code too
+(``_disc_kernels``). The kernels compile on first use, about half a minute,
+once: numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
 
@@ -33,8 +34,9 @@ Faithfulness notes (see ../shared/design/original_code.md, section 2):
   (``maoris_segmentation/sketches/maoris_output``) leave exactly the free
   pixels just above or left of a wall unlabelled, which only the shift
   explains. ``cv::circle`` filled discs are exactly the lattice discs
-  ``{o : |o|^2 <= i^2}`` (checked for every radius up to 500), so painting them
-  with ``cv2.circle`` gives the C++ image bit for bit.
+  ``{o : |o|^2 <= i^2}`` (checked for every radius up to 500), so painting
+  those lattice discs (row spans with integer half-widths ``isqrt(i^2 - dy^2)``)
+  gives the C++ image bit for bit.
 * Contour pixels of a zone (``findContours(RETR_LIST, CHAIN_APPROX_NONE)`` in
   the C++) are exactly the zone pixels with a 4-neighbour outside the zone
   (image border counts as outside); the tests check this equivalence, and it
@@ -124,8 +126,12 @@ against ``gt``, same measure::
     t=0.40 doors 40 .865 .951 .896 .956
     t=0.20 doors 80 .930 .938 .928 .925
 
-Speed: the inscribed-circle image is exact and fast (only non-dominated
-centres are painted, ~5 % of the free pixels, as discs in C). The graph steps
+Speed: the inscribed-circle image is exact and fast: only non-dominated
+centres are painted (a few % of the free pixels), in compiled code, a ridge of
+equal radii as one shape and a room corner's chain of growing discs only where
+the next larger disc leaves them uncovered. On a 4000 px building (14 million
+pixels) the painting takes about 0.1 s of CPU, less than the distance
+transform (0.5 s), instead of 1.7 s with one ``cv2.circle`` per centre. The graph steps
 follow the C++'s sequential order and cost a few microseconds of Python per
 flat zone (robot maps and clean rectangular rooms have one flat zone per 10 to
 20 free pixels, mostly fragments in room corners); fusions in the ripple step
@@ -154,6 +160,7 @@ import numpy as np
 from skimage.measure import label as _label_equal_values
 
 from ursim_core.errors import ParameterError, SegmentationError
+from ursim_core.segmentation import _disc_kernels
 from ursim_core.segmentation import _zone_kernels as _kernels
 
 __all__ = [
@@ -331,9 +338,11 @@ def inscribed_circle_radii(free: np.ndarray, *, max_radius: int = 500) -> np.nda
 
     Instead of painting a disc per pixel, only the *non-dominated* centres are
     painted: q is dominated when a neighbour q2's disc contains q's disc
-    (``r(q2) - r(q) >= |q2 - q|``), which removes ~95 % of them; the rest
-    are painted with ``cv2.circle`` in increasing radius order, so later
-    (larger) values overwrite smaller ones.
+    (``r(q2) - r(q) >= |q2 - q|``), which removes ~95 % of them. The rest are
+    painted row span by row span in compiled code (``_disc_kernels``), each
+    pixel keeping the largest radius: equal-radius rectangles of centres
+    (ridges) as one shape, and lone centres only where no disc of a larger
+    radius beside them covers theirs.
 
     Parameters
     ----------
@@ -379,40 +388,11 @@ def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:
     # Cropping to the free pixels' bounding box plus a 1-pixel obstacle margin
     # leaves the distance transform unchanged (the margin is obstacle, and the
     # image border is kept where the box touches it).
-    rows, cols = free.shape
     dist = cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-    # Truncate first, then cap: r = min(int(d), max_radius) as the C++ does.
-    radius = np.minimum(dist, float(max_radius)).astype(np.int16 if max_radius < 2**15 - 2 else np.int32)
-
-    # A 4-neighbour dominates when its radius is >= r + 1, a diagonal one
-    # when >= r + 2 (integer radii, sqrt(2) rounded up).
-    padded = np.pad(radius, 1)
-    dominated = np.zeros((rows, cols), bool)
-    for d_row, d_col in ((-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)):
-        need = 1 if d_row == 0 or d_col == 0 else 2
-        neighbour = padded[1 + d_row : 1 + d_row + rows, 1 + d_col : 1 + d_col + cols]
-        dominated |= neighbour >= radius + need
-    centre_rows, centre_cols = np.nonzero((radius > 0) & ~dominated)
-    centre_radii = radius[centre_rows, centre_cols].astype(np.int32)
-    order = np.argsort(centre_radii, kind="stable")
-    centre_rows, centre_cols, centre_radii = centre_rows[order], centre_cols[order], centre_radii[order]
-
-    levels = np.unique(centre_radii)
-    # An 8-bit canvas paints twice as fast; store level ranks when they fit.
-    if len(levels) <= 255:
-        canvas = np.zeros((rows, cols), np.uint8)
-        colours = np.searchsorted(levels, centre_radii) + 1
-        lookup = np.concatenate([[0], levels]).astype(np.int32)
-    else:
-        canvas = np.zeros((rows, cols), np.uint16)
-        colours = centre_radii
-        lookup = np.arange(int(levels[-1]) + 1, dtype=np.int32)
-    for row, col, colour, level in zip(
-        (centre_rows - 1).tolist(), (centre_cols - 1).tolist(), colours.tolist(), centre_radii.tolist()
-    ):
-        cv2.circle(canvas, (col, row), level - 1, colour, -1)
-    out = lookup[canvas]
-    out[~free] = 0
+    # Radii are int32 (as the output); a larger cap only matters without any obstacle.
+    shapes = _disc_kernels.centre_rectangles(dist, min(max_radius, np.iinfo(np.int32).max))
+    out = np.zeros(free.shape, np.int32)
+    _disc_kernels.paint_discs(dist, shapes, out)
     return out
 
 

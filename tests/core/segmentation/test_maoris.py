@@ -35,7 +35,8 @@ from ursim_core.segmentation.maoris import (
 def brute_force_radii(free: np.ndarray, max_radius: int = 500) -> np.ndarray:
     """Paint, for every free q, the disc of radius r-1 centred at q-(1,1) (the C++ loop)."""
     rows, cols = free.shape
-    distance = ndi.distance_transform_edt(free)
+    # Without any obstacle the distance is unbounded (cv2 returns 1.8e19): every radius is the cap.
+    distance = np.full(free.shape, float(max_radius)) if free.all() else ndi.distance_transform_edt(free)
     out = np.zeros(free.shape, int)
     for q_row, q_col in zip(*np.nonzero(free)):
         radius = min(int(distance[q_row, q_col]), max_radius)
@@ -99,6 +100,55 @@ def test_inscribed_radii_respects_max_radius():
     free[2:38, 2:38] = True
     np.testing.assert_array_equal(inscribed_circle_radii(free, max_radius=5), brute_force_radii(free, 5))
     assert inscribed_circle_radii(free, max_radius=5).max() == 5
+
+
+def corridors_and_rooms(name: str) -> np.ndarray:
+    """Maps whose disc centres form long equal-radius runs (corridor and room ridges)
+    and diagonal chains of growing radius (room corners)."""
+    if name == "horizontal_corridors":  # 9 and 8 rows wide: one ridge row, then two
+        free = np.zeros((26, 90), bool)
+        free[3:12, 2:88] = True
+        free[15:23, 5:80] = True
+        free[12:15, 30:33] = True
+    elif name == "vertical_corridors":
+        free = corridors_and_rooms("horizontal_corridors").T.copy()
+    elif name == "rooms_odd_and_even":  # 21 x 33 and 22 x 30, and a door
+        free = np.zeros((28, 72), bool)
+        free[3:24, 2:35] = True
+        free[3:25, 39:69] = True
+        free[10:15, 35:39] = True
+    elif name == "touching_border":  # a corridor across the image, a room and a corridor off its edges
+        free = np.zeros((40, 50), bool)
+        free[15:24, :] = True
+        free[:12, 5:30] = True
+        free[24:, 38:45] = True
+    elif name == "diagonal_corridor":
+        rows, cols = np.indices((40, 40))
+        free = (abs(rows - cols) <= 5) & (rows > 1) & (rows < 38)
+    else:  # no obstacle at all
+        free = np.ones((12, 30), bool)
+    return free
+
+
+@pytest.mark.parametrize("max_radius", [500, 3, 2])
+@pytest.mark.parametrize(
+    "shape_name",
+    [
+        "horizontal_corridors",
+        "vertical_corridors",
+        "rooms_odd_and_even",
+        "touching_border",
+        "diagonal_corridor",
+        "no_obstacle",
+    ],
+)
+def test_inscribed_radii_of_corridors_and_rooms_equal_brute_force(shape_name, max_radius):
+    # max_radius 3 and 2 are below the corridors' half-width: the capped radius
+    # makes wide plateaus of equal radius, painted as rectangles.
+    free = corridors_and_rooms(shape_name)
+    np.testing.assert_array_equal(
+        inscribed_circle_radii(free, max_radius=max_radius), brute_force_radii(free, max_radius)
+    )
 
 
 def test_inscribed_radii_shift_leaves_bottom_and_right_border_unlabelled():
