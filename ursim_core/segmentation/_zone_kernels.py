@@ -30,6 +30,66 @@ from numba import njit
 
 NO_MINIMUM = -1
 
+@njit(cache=True)
+def label_flat_zones(values):
+    """4-connected components of equal non-zero value, numbered 1..N in the
+    raster order of their first pixel (0 stays 0).
+
+    One raster pass with union-find over provisional labels: a set's root is
+    always its smallest label, i.e. the one its first pixel created, so
+    numbering the roots in order numbers the zones in first-pixel order.
+    """
+    rows, cols = values.shape
+    labels = np.zeros((rows, cols), np.int32)
+    parent = np.empty(1024, np.int32)
+    n = 0
+    for row in range(rows):
+        for col in range(cols):
+            value = values[row, col]
+            if value == 0:
+                continue
+            left = labels[row, col - 1] if col > 0 and values[row, col - 1] == value else 0
+            up = labels[row - 1, col] if row > 0 and values[row - 1, col] == value else 0
+            if left == 0 and up == 0:
+                n += 1
+                if n == len(parent):
+                    parent = _grown(parent, 2 * n, 0)
+                parent[n] = n
+                labels[row, col] = n
+            else:
+                labels[row, col] = left if left != 0 else up
+                if left != 0 and up != 0:
+                    a, b = _zone_of(left, parent), _zone_of(up, parent)
+                    if a < b:
+                        parent[b] = a
+                    elif b < a:
+                        parent[a] = b
+    final = np.zeros(n + 1, np.int32)
+    zones = 0
+    for label in range(1, n + 1):
+        root = _zone_of(label, parent)
+        if root == label:
+            zones += 1
+            final[label] = zones
+        else:
+            final[label] = final[root]
+    relabel(labels, final)
+    return labels
+
+
+@njit(cache=True)
+def zone_values_and_sizes(zones, values, count):
+    """Each zone's value (of any of its pixels) and size, zones 0..count - 1."""
+    value = np.zeros(count, np.int32)
+    size = np.zeros(count, np.int64)
+    for row in range(zones.shape[0]):
+        for col in range(zones.shape[1]):
+            zone = zones[row, col]
+            value[zone] = values[row, col]
+            size[zone] += 1
+    return value, size
+
+
 # Columns of the zone records (one row of 16 bytes per zone).
 HEAD, TAIL, DEGREE, VALUE = 0, 1, 2, 3
 # Columns of the node records (16 bytes; a node and its twin share 32 bytes).

@@ -157,7 +157,6 @@ from typing import Any, Callable, Mapping
 
 import cv2
 import numpy as np
-from skimage.measure import label as _label_equal_values
 
 from ursim_core.errors import ParameterError, SegmentationError
 from ursim_core.segmentation import _disc_kernels
@@ -471,7 +470,7 @@ def flat_zones(values: np.ndarray) -> np.ndarray:
     values = np.asarray(values)
     if values.ndim != 2:
         raise SegmentationError(f"value image must be 2-D, got shape {values.shape}")
-    return _label_equal_values(values, connectivity=1, background=0).astype(np.int32)
+    return _kernels.label_flat_zones(values)
 
 
 class ZoneEdge:
@@ -532,18 +531,17 @@ class ZoneGraph:
         if zones.shape != values.shape or zones.ndim != 2:
             raise SegmentationError(f"zones {zones.shape} and values {values.shape} must be 2-D of equal shape")
         self.shape = zones.shape
-        self._labels = np.pad(zones.astype(np.int32, copy=False), _PAD)
+        zones = zones.astype(np.int32, copy=False)
+        self._labels = np.pad(zones, _PAD)
         count = int(zones.max(initial=0))
-        value = np.zeros(count + 1, np.int32)
-        value[zones.ravel()] = values.ravel()
+        value, self._size = _kernels.zone_values_and_sizes(zones, values, count + 1)
         self._value_array = value
         self._value: list[int] = value.tolist()
-        self._size = np.bincount(zones.ravel(), minlength=count + 1).astype(np.int64)
         # The adjacency lives either in compact arrays (the compiled steps'
         # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
         self._alive = self._size > 0
         self._alive[0] = False
-        self._compact: tuple | None = _kernels.build_adjacency(zones.astype(np.int32, copy=False), value)
+        self._compact: tuple | None = _kernels.build_adjacency(zones, value)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         # Contact counts, computed for the whole image when first queried and
         # dropped by the next fusion (the compiled steps track their own).

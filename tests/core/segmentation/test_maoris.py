@@ -8,6 +8,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+import skimage.measure
 from scipy import ndimage as ndi
 
 from ursim_core.errors import ParameterError, SegmentationError
@@ -205,6 +206,17 @@ def test_flat_zones_are_4_connected_in_raster_order():
     )
     # The diagonal contact does not join (0,0) with (1,1).
     assert flat_zones(values).tolist() == [[1, 0, 2], [0, 2, 2], [3, 3, 0]]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_flat_zones_equal_scikit_image_labelling(seed):
+    # Few levels make large winding zones whose provisional labels merge (U
+    # shapes, spirals of one value), where the numbering order is easy to get wrong.
+    rng = np.random.default_rng(seed)
+    values = rng.integers(0, 3 + seed, size=(60, 70)).astype(np.uint8)
+    values = np.repeat(np.repeat(values, 1 + seed % 3, axis=0), 1 + seed % 2, axis=1)
+    expected = skimage.measure.label(values, connectivity=1, background=0)
+    np.testing.assert_array_equal(flat_zones(values), expected)
 
 
 def test_zone_graph_edges_are_4_adjacency_only():
