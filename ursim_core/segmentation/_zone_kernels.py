@@ -1,26 +1,33 @@
 """Compiled kernels of the MAORIS zone graph (numba).
 
 A large map starts with millions of flat zones, almost all of them a few
-pixels; the first two graph steps (small-zone removal, then ripple merging)
-visit them one by one in an order that matters, so they cannot be
-vectorised. These kernels run them on a compact array form of the graph:
+pixels; the graph steps visit them one by one in an order that matters, so
+they cannot be vectorised. These kernels run them on a compact array form of
+the graph, laid out so that a step touches few cache lines (at 4000 px the
+work is bound by memory latency, not arithmetic):
 
-* every zone keeps its neighbours in a doubly linked list of *nodes*, in
-  insertion order (the order the C++ boost ``listS`` graph iterates in); a
-  node (a -> b) has a *twin* (b -> a), and both carry the edge attributes
-  (minimum, -1 for none, and unbreakability);
-* fusing a zone frees its nodes before it allocates new ones, so the pool
-  never grows beyond the initial two nodes per edge;
-* the ripple step keeps the contact counts up to date: a fusion subtracts
-  the contributions of the pixels around the absorbed zone, merges it, and
-  adds them back. Zones are union-find sets of the labels (the image is
-  relabelled once, at the end), each zone keeps a list of its pixels that may
-  still be on its border, and its contact partners sit in a few slots of its
-  own, with a shared hash table for zones that have more.
+* a zone is a record of 16 bytes (first and last neighbour node, degree,
+  value); its neighbours form a doubly linked list of *node* records, in
+  insertion order (the order the C++ boost ``listS`` graph iterates in);
+* the node (a -> b) and its twin (b -> a) are neighbours in memory, ``node``
+  and ``node ^ 1``, and share the edge attributes (minimum, -1 for none, in
+  the even node; unbreakability in the odd one); a new edge made by a fusion
+  reuses the pair of the edge it replaces, so no node is ever allocated after
+  the adjacency is built;
+* the steps that need contact counts (ripple merging, door removal) keep them
+  up to date: a fusion visits the pixels around the absorbed zone once and
+  applies only the changes. Zones are union-find sets of compact labels (the
+  image is relabelled once, at the end), each zone keeps a list of its pixels
+  that may still be on its border, and its contact partners sit in a few
+  slots of its own, with a shared hash table for zones that have more.
 
 :class:`ursim_core.segmentation.maoris.ZoneGraph` owns the arrays; the
 functions here only mutate them. Semantics are those documented on
-``remove_small_zones``, ``merge_ripples`` and ``ZoneGraph.fuse``.
+``flat_zones``, ``remove_small_zones``, ``merge_ripples``, ``remove_doors``
+and ``ZoneGraph.fuse``. Compilation takes about half a minute the first time,
+and numba caches it: functions marked ``inline="always"`` are inlined before
+typing, which is fast to run and slow to compile, so only small hot helpers
+are, each from few places.
 """
 
 from __future__ import annotations

@@ -20,10 +20,10 @@ tested on its own:
 :func:`maoris_labels` runs them all.
 
 Speed: a 4000 x 4000 map starts with about 1.5 million flat zones, visited
-one by one in an order that decides ties, so steps 3-4 cannot be vectorised;
-they run as compiled code (numba, ``_zone_kernels``) on an array form of the
-zone graph. Step 1 paints its discs with compiled code too
-(``_disc_kernels``). The kernels compile on first use, about half a minute,
+one by one in an order that decides ties, so the graph steps cannot be
+vectorised; steps 3, 4 and 6 run as compiled code (numba, ``_zone_kernels``)
+on an array form of the zone graph, and step 1 paints its discs with compiled
+code too (``_disc_kernels``). The kernels compile on first use, about 40 s,
 once: numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
@@ -131,11 +131,11 @@ centres are painted (a few % of the free pixels), in compiled code, a ridge of
 equal radii as one shape and a room corner's chain of growing discs only where
 the next larger disc leaves them uncovered. On a 4000 px building (14 million
 pixels) the painting takes about 0.1 s of CPU, less than the distance
-transform (0.5 s), instead of 1.7 s with one ``cv2.circle`` per centre. The graph steps
-follow the C++'s sequential order and cost a few microseconds of Python per
-flat zone (robot maps and clean rectangular rooms have one flat zone per 10 to
-20 free pixels, mostly fragments in room corners); fusions in the ripple step
-are batched so contacts are updated in few array passes.
+transform (0.5 s), instead of 1.7 s with one ``cv2.circle`` per centre. The
+graph steps follow the C++'s sequential order at a fraction of a microsecond
+per flat zone; ripple merging, which updates contact counts around every
+fusion, is the slowest step (about half the time on large maps, see the
+README's speed table).
 
 Examples
 --------
@@ -505,10 +505,10 @@ class ZoneGraph:
     a compiled step converts them back.
 
     Contacts (contour pixels of a zone having another zone in their 3x3
-    neighbourhood) are computed for the whole image when first needed, then
-    updated locally around each fused zone. Steps that fuse many zones without
-    needing contacts (the watershed) drop them instead and only record the
-    fusions; the label image is rewritten once, when next needed.
+    neighbourhood) are counted for the whole image by compiled code when first
+    queried, and dropped by the next fusion; the compiled steps that need them
+    while fusing track them incrementally themselves. Fusions in dict form
+    are only recorded; the label image is rewritten once, when next needed.
 
     Parameters
     ----------

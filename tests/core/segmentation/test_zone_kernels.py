@@ -1,8 +1,9 @@
 """The compiled zone-graph steps against plain-Python replays of the same rules.
 
 The replays run on the dict form of :class:`ZoneGraph` through its public
-mutations (``fuse``, ``remove``) and its incrementally maintained contacts, so
-they share no code with ``_zone_kernels``. They are slow, hence small maps.
+mutations (``fuse``, ``remove``), with contact percentages counted here from
+masks, so they share no code with ``_zone_kernels``. They are slow, hence
+small maps.
 """
 
 from __future__ import annotations
@@ -18,10 +19,26 @@ from ursim_core.segmentation.maoris import (
     ZoneGraph,
     flat_zones,
     inscribed_circle_image,
+    mark_unbreakable_edges,
     merge_ripples,
     quantize,
+    remove_doors,
     remove_small_zones,
+    watershed_merge,
 )
+
+_SQUARE = np.ones((3, 3), np.uint8)
+
+
+def mask_contact_percent(labels: np.ndarray, zone: int, other: int) -> int:
+    """Percentage of ``zone``'s contour pixels (a 4-neighbour outside the zone,
+    the image border counting as outside) with ``other`` in their 3x3 neighbourhood."""
+    inside = np.pad(labels == zone, 1)
+    all_four_inside = inside[:-2, 1:-1] & inside[2:, 1:-1] & inside[1:-1, :-2] & inside[1:-1, 2:]
+    contour = (labels == zone) & ~all_four_inside
+    near_other = cv2.dilate((labels == other).view(np.uint8), _SQUARE).astype(bool)
+    size = int(contour.sum())
+    return int((contour & near_other).sum()) * 100 // size if size else 0
 
 
 def replay_remove_small_zones(graph: ZoneGraph, min_size: int) -> None:
@@ -45,12 +62,26 @@ def replay_merge_ripples(graph: ZoneGraph, ripples: float) -> None:
         candidates = [
             other
             for other in graph.neighbours(zone)
-            if not graph.edge(zone, other).unbreakable and graph.contact_percent(zone, other) >= ripples
+            if not graph.edge(zone, other).unbreakable and mask_contact_percent(graph.labels, zone, other) >= ripples
         ]
         if candidates:
             gaps = [abs(graph.value(other) - graph.value(zone)) for other in candidates]
             queue.extend(graph.neighbours(zone))
             graph.fuse(zone, candidates[gaps.index(min(gaps))])
+
+
+def replay_remove_doors(graph: ZoneGraph, doors: float) -> None:
+    def contact_sum(zone: int) -> int:
+        return sum(mask_contact_percent(graph.labels, zone, other) for other in graph.neighbours(zone))
+
+    sums = {zone: contact_sum(zone) for zone in graph.vertices()}
+    for zone in graph.vertices():
+        if zone not in graph or sums[zone] <= doors or not graph.neighbours(zone):
+            continue
+        below = [other for other in graph.neighbours(zone) if sums[other] < doors]
+        target = below[-1] if below else graph.neighbours(zone)[0]
+        graph.fuse(zone, target)
+        sums[target] = contact_sum(target)
 
 
 def graph_state(graph: ZoneGraph) -> tuple:
@@ -118,6 +149,34 @@ def test_compiled_ripple_merging_equals_the_replay(seed):
     merge_ripples(compiled, ripples=PRESETS["default"].ripples)
     replay_merge_ripples(replayed, PRESETS["default"].ripples)
     assert graph_state(compiled) == graph_state(replayed)
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("doors", [20, 40, 60])
+def test_compiled_door_removal_equals_the_replay(seed, doors):
+    values = random_values(seed, shape=(56, 64))
+    graphs = []
+    for _ in range(2):
+        graph = ZoneGraph(flat_zones(values), values)
+        remove_small_zones(graph, min_size=10)
+        merge_ripples(graph, ripples=40)
+        mark_unbreakable_edges(graph, threshold=0.25)
+        watershed_merge(graph, threshold=0.25, margin=0.10)
+        graphs.append(graph)
+    before = len(graphs[1])
+    remove_doors(graphs[0], doors=doors)
+    replay_remove_doors(graphs[1], doors)
+    assert graph_state(graphs[0]) == graph_state(graphs[1])
+    if doors == 20:
+        assert len(graphs[1]) < before  # the maps do have doors to remove
+
+
+def test_mask_contact_percent_matches_the_graph_contacts():
+    values = random_values(4)
+    graph = remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=10)
+    for zone in graph.vertices()[:20]:
+        for other in graph.neighbours(zone):
+            assert graph.contact_percent(zone, other) == mask_contact_percent(graph.labels, zone, other)
 
 
 def test_a_graph_changed_in_dict_form_goes_back_to_the_compiled_steps():
