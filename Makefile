@@ -20,7 +20,7 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 # numba compiles the segmentation kernels on first use and caches them beside the module: do it
 # once here rather than inside the first segmentation (or in both test workers at once).
 $(VENV)/.kernels: ursim_core/segmentation/_zone_kernels.py ursim_core/segmentation/_disc_kernels.py | $(BIN)/python
-	@echo "Compiling the segmentation kernels (once, about half a minute)..."
+	@echo "Compiling the segmentation kernels (once, under a minute)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; compile_kernels()"
 	touch $@
 

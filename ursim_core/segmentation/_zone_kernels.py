@@ -24,7 +24,7 @@ work is bound by memory latency, not arithmetic):
 :class:`ursim_core.segmentation.maoris.ZoneGraph` owns the arrays; the
 functions here only mutate them. Semantics are those documented on
 ``flat_zones``, ``remove_small_zones``, ``merge_ripples``, ``remove_doors``
-and ``ZoneGraph.fuse``. Compilation takes about half a minute the first time,
+and ``ZoneGraph.fuse``. Compilation takes about 45 s the first time,
 and numba caches it: functions marked ``inline="always"`` are inlined before
 typing, which is fast to run and slow to compile, so only small hot helpers
 are, each from few places.

@@ -1015,7 +1015,7 @@ def compile_kernels() -> float:
     """Compile (or load from numba's cache) the compiled steps; return the seconds it took.
 
     The first segmentation in a new environment otherwise pays this (about
-    half a minute; a fraction of a second once cached). Benchmarks call it
+    45 s; a fraction of a second once cached). Benchmarks call it
     so that their timings exclude it.
 
     Examples
