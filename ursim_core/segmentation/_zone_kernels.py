@@ -152,6 +152,18 @@ def _contacts_in_order(zones, last_partner, records, nodes, count_only):
 
 
 @njit(cache=True)
+def _isolated_zones(value):
+    """Zone records without neighbours, zone z of value ``value[z]``."""
+    records = np.empty((len(value), 4), np.int32)
+    for zone in range(len(value)):
+        records[zone, HEAD] = -1
+        records[zone, TAIL] = -1
+        records[zone, DEGREE] = 0
+        records[zone, VALUE] = value[zone]
+    return records
+
+
+@njit(cache=True)
 def build_adjacency(zones, value):
     """Zone graph of the 4-adjacency of a zone image (0 = no zone): ``(records, nodes)``.
 
@@ -160,12 +172,7 @@ def build_adjacency(zones, value):
     first bounds the number of edges, so the node records never move.
     """
     count = len(value)
-    records = np.empty((count, 4), np.int32)
-    for zone in range(count):
-        records[zone, HEAD] = -1
-        records[zone, TAIL] = -1
-        records[zone, DEGREE] = 0
-        records[zone, VALUE] = value[zone]
+    records = _isolated_zones(value)
     last_partner = np.zeros(count, np.int32)
     bound = _contacts_in_order(zones, last_partner, records, np.empty((2, 4), np.int32), True)
     for zone in range(count):
@@ -193,12 +200,7 @@ def adjacency_from_entries(zone, other, minimum, unbreakable, value):
     zone's in list order: the inverse of :func:`adjacency_entries`. Every edge
     must appear in both directions, with the same attributes."""
     count = len(value)
-    records = np.empty((count, 4), np.int32)
-    for z in range(count):
-        records[z, HEAD] = -1
-        records[z, TAIL] = -1
-        records[z, DEGREE] = 0
-        records[z, VALUE] = value[z]
+    records = _isolated_zones(value)
     # Entry i of an edge (low -> high) owns the node pair 2i, 2i + 1; the
     # reversed entry finds it by key.
     keys = zone.astype(np.int64) * count + other

@@ -591,7 +591,7 @@ class ZoneGraph:
         return self._compact
 
     def _run_compiled(self) -> tuple:
-        """Prepare for a compiled step: labels flushed, contacts and boxes dropped."""
+        """Prepare for a compiled step: labels flushed, contacts dropped."""
         self._flush()
         self._contacts = None
         return self._compact_adjacency()
