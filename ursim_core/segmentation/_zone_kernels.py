@@ -741,24 +741,30 @@ def _contacts_start(labels, width, n):
 
 
 @njit(cache=True, inline="always")
-def _mark(pixel, here, labels, stamp, affected, n_affected):
+def _mark(pixel, labels, seen, bits, affected, used, n_affected):
     """Append ``pixel`` to ``affected`` unless it has no zone (no counts) or
-    is already marked for this fusion."""
-    if labels[pixel] != 0 and stamp[pixel] != here:
-        stamp[pixel] = here
-        affected[n_affected] = pixel
-        n_affected += 1
-    return n_affected
+    is already in ``seen`` (a hash set of this fusion's pixels)."""
+    if labels[pixel] == 0:
+        return n_affected
+    slot = _probe(seen, np.int64(pixel), bits)
+    if seen[slot] == pixel:
+        return n_affected
+    seen[slot] = pixel
+    affected[n_affected] = pixel
+    used[n_affected] = slot
+    return n_affected + 1
 
 
 @njit(cache=True)
-def _contacts_fuse(here, into, labels, width, state, stamp, affected):
+def _contacts_fuse(here, into, labels, width, state, seen, affected, used):
     """Fuse compact zone ``here`` into ``into`` in the contact state; returns
-    the state (its table may have grown) and the scratch list ``affected``.
+    the state (its table may have grown) and the scratch arrays, grown if needed.
 
     Only the pixels around ``here`` are visited: its border candidates (those
-    now inside are dropped for good) and their 8-neighbours; ``stamp`` (one
-    entry per pixel, never equal to ``here`` before) marks them once.
+    now inside are dropped for good) and their 8-neighbours, each once.
+    ``seen`` is a small hash set of the pixels met in this fusion (empty
+    between fusions; ``used`` records their slots to clear them): a flag per
+    pixel would cost a cold cache line for each row a fusion touches.
     """
     parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
     base = np.int64(len(parent))
@@ -766,6 +772,9 @@ def _contacts_fuse(here, into, labels, width, state, stamp, affected):
     partners = np.empty(9, np.int32)
     signs = np.empty(9, np.int64)
     n_affected = 0
+    bits = 0
+    while (1 << bits) < len(seen):
+        bits += 1
     kept_head, kept_tail = -1, -1
     candidate = head[here]
     while candidate != -1:
@@ -780,23 +789,31 @@ def _contacts_fuse(here, into, labels, width, state, stamp, affected):
             kept_tail = candidate
             if n_affected + 9 > len(affected):
                 affected = _grown(affected, 2 * len(affected), 0)
-            # The 3x3 neighbourhood, written out (numba compiles loops over
-            # tuples of offsets into slow code).
+                used = _grown(used, 2 * len(used), 0)
+            if 4 * (n_affected + 9) > len(seen):
+                # Grow the set: re-insert this fusion's pixels so far.
+                seen = _filled(4 * len(seen), -1, np.int64)
+                bits += 2
+                for k in range(n_affected):
+                    slot = _probe(seen, np.int64(affected[k]), bits)
+                    seen[slot] = affected[k]
+                    used[k] = slot
             up, down = pixel - width, pixel + width
-            n_affected = _mark(up - 1, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(up, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(up + 1, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(pixel - 1, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(pixel, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(pixel + 1, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(down - 1, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(down, here, labels, stamp, affected, n_affected)
-            n_affected = _mark(down + 1, here, labels, stamp, affected, n_affected)
+            n_affected = _mark(up - 1, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(up, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(up + 1, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(pixel - 1, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(pixel, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(pixel + 1, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(down - 1, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(down, labels, seen, bits, affected, used, n_affected)
+            n_affected = _mark(down + 1, labels, seen, bits, affected, used, n_affected)
         candidate = next_candidate
     keys, counts = _table_reserve(keys, counts, meta, 8 * n_affected)
     for k in range(n_affected):
         _neighbourhood(labels, parent, affected[k], width, around)
         _recount(around, here, into, partners, signs, slots, keys, counts, meta, total, base)
+        seen[used[k]] = -1
     parent[here] = into
     if kept_head != -1:
         if tail[into] == -1:
@@ -805,7 +822,7 @@ def _contacts_fuse(here, into, labels, width, state, stamp, affected):
             following[tail[into]] = kept_head
         tail[into] = kept_tail
     head[here] = tail[here] = -1
-    return (parent, pixels, following, head, tail, keys, counts, meta, slots, total), affected
+    return (parent, pixels, following, head, tail, keys, counts, meta, slots, total), seen, affected, used
 
 
 @njit(cache=True, inline="always")
@@ -831,8 +848,9 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
     records, nodes = graph
     original, compact_of, n = _compact_labels(labels, alive)
     state = _contacts_start(labels, width, n)
-    stamp = np.zeros(labels.size, np.int32)
+    seen = _filled(4096, -1, np.int64)
     affected = np.empty(1024, np.int32)
+    used = np.empty(1024, np.int64)
     queue = np.empty(max(2 * len(order), 16), np.int32)
     for i in range(len(order)):
         queue[i] = order[i]
@@ -866,8 +884,8 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
             queue[end] = nodes[node, NEIGHBOUR]
             end += 1
             node = nodes[node, NEXT]
-        state, affected = _contacts_fuse(
-            np.int64(here), np.int64(compact_of[best]), labels, width, state, stamp, affected
+        state, seen, affected, used = _contacts_fuse(
+            np.int64(here), np.int64(compact_of[best]), labels, width, state, seen, affected, used
         )
         alive[zone] = False
         size[best] += size[zone]
@@ -899,8 +917,9 @@ def remove_doors(doors, labels, width, size, alive, graph):
     records, nodes = graph
     original, compact_of, n = _compact_labels(labels, alive)
     state = _contacts_start(labels, width, n)
-    stamp = np.zeros(labels.size, np.int32)
+    seen = _filled(4096, -1, np.int64)
     affected = np.empty(1024, np.int32)
+    used = np.empty(1024, np.int64)
     sums = np.zeros(len(records), np.int64)
     for k in range(len(original)):
         zone = original[k]
@@ -915,8 +934,8 @@ def remove_doors(doors, labels, width, size, alive, graph):
             if sums[nodes[node, NEIGHBOUR]] < doors:
                 target = nodes[node, NEIGHBOUR]
             node = nodes[node, NEXT]
-        state, affected = _contacts_fuse(
-            np.int64(k + 1), np.int64(compact_of[target]), labels, width, state, stamp, affected
+        state, seen, affected, used = _contacts_fuse(
+            np.int64(k + 1), np.int64(compact_of[target]), labels, width, state, seen, affected, used
         )
         alive[zone] = False
         size[target] += size[zone]
