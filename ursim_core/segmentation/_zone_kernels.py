@@ -756,9 +756,10 @@ def _mark(pixel, labels, seen, bits, affected, used, n_affected):
 
 
 @njit(cache=True)
-def _contacts_fuse(here, into, labels, width, state, seen, affected, used):
+def _contacts_fuse(here, into, labels, width, state, scratch):
     """Fuse compact zone ``here`` into ``into`` in the contact state; returns
-    the state (its table may have grown) and the scratch arrays, grown if needed.
+    the state (its table may have grown) and the scratch arrays ``(seen,
+    affected, used)``, grown if needed.
 
     Only the pixels around ``here`` are visited: its border candidates (those
     now inside are dropped for good) and their 8-neighbours, each once.
@@ -767,6 +768,7 @@ def _contacts_fuse(here, into, labels, width, state, seen, affected, used):
     pixel would cost a cold cache line for each row a fusion touches.
     """
     parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
+    seen, affected, used = scratch
     base = np.int64(len(parent))
     around = np.empty(9, np.int32)
     partners = np.empty(9, np.int32)
@@ -822,7 +824,17 @@ def _contacts_fuse(here, into, labels, width, state, seen, affected, used):
             following[tail[into]] = kept_head
         tail[into] = kept_tail
     head[here] = tail[here] = -1
-    return (parent, pixels, following, head, tail, keys, counts, meta, slots, total), seen, affected, used
+    return (parent, pixels, following, head, tail, keys, counts, meta, slots, total), (seen, affected, used)
+
+
+@njit(cache=True)
+def _start_tracking(labels, width, alive):
+    """Compact the labels (:func:`_compact_labels`) and start tracking contacts:
+    ``(original, compact_of, state, scratch)`` for :func:`_contacts_fuse`."""
+    original, compact_of, n = _compact_labels(labels, alive)
+    state = _contacts_start(labels, width, n)
+    scratch = (_filled(4096, -1, np.int64), np.empty(1024, np.int32), np.empty(1024, np.int64))
+    return original, compact_of, state, scratch
 
 
 @njit(cache=True, inline="always")
@@ -846,11 +858,7 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
     cache) as union-find sets of the labels, relabelled once at the end.
     """
     records, nodes = graph
-    original, compact_of, n = _compact_labels(labels, alive)
-    state = _contacts_start(labels, width, n)
-    seen = _filled(4096, -1, np.int64)
-    affected = np.empty(1024, np.int32)
-    used = np.empty(1024, np.int64)
+    original, compact_of, state, scratch = _start_tracking(labels, width, alive)
     queue = np.empty(max(2 * len(order), 16), np.int32)
     for i in range(len(order)):
         queue[i] = order[i]
@@ -884,9 +892,7 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
             queue[end] = nodes[node, NEIGHBOUR]
             end += 1
             node = nodes[node, NEXT]
-        state, seen, affected, used = _contacts_fuse(
-            np.int64(here), np.int64(compact_of[best]), labels, width, state, seen, affected, used
-        )
+        state, scratch = _contacts_fuse(np.int64(here), np.int64(compact_of[best]), labels, width, state, scratch)
         alive[zone] = False
         size[best] += size[zone]
         fuse_edges(np.int64(zone), np.int64(best), graph)
@@ -915,11 +921,7 @@ def remove_doors(doors, labels, width, size, alive, graph):
     the start otherwise.
     """
     records, nodes = graph
-    original, compact_of, n = _compact_labels(labels, alive)
-    state = _contacts_start(labels, width, n)
-    seen = _filled(4096, -1, np.int64)
-    affected = np.empty(1024, np.int32)
-    used = np.empty(1024, np.int64)
+    original, compact_of, state, scratch = _start_tracking(labels, width, alive)
     sums = np.zeros(len(records), np.int64)
     for k in range(len(original)):
         zone = original[k]
@@ -934,9 +936,7 @@ def remove_doors(doors, labels, width, size, alive, graph):
             if sums[nodes[node, NEIGHBOUR]] < doors:
                 target = nodes[node, NEIGHBOUR]
             node = nodes[node, NEXT]
-        state, seen, affected, used = _contacts_fuse(
-            np.int64(k + 1), np.int64(compact_of[target]), labels, width, state, seen, affected, used
-        )
+        state, scratch = _contacts_fuse(np.int64(k + 1), np.int64(compact_of[target]), labels, width, state, scratch)
         alive[zone] = False
         size[target] += size[zone]
         fuse_edges(np.int64(zone), np.int64(target), graph)
