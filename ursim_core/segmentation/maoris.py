@@ -705,10 +705,6 @@ class ZoneGraph:
             self._contacts = dict(zip(codes.tolist(), table[:, 2].tolist()))
         return self._contacts
 
-    def invalidate_contacts(self) -> None:
-        """Drop the contact counts; the next query recomputes them for the whole image."""
-        self._contacts = None
-
     # -- mutations -------------------------------------------------------
 
     def fuse(self, zone: int, into: int) -> None:
@@ -905,7 +901,6 @@ def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10)
                 stack.append(iter(taken))
         if members:
             groups.append((top, members))
-    graph.invalidate_contacts()
     for top, members in groups:
         for member in members:
             graph.fuse(member, top)
@@ -948,7 +943,6 @@ def remove_isolated_zones(graph: ZoneGraph) -> ZoneGraph:
     [2, 3]
     """
     if len(graph) > 1:
-        graph.invalidate_contacts()
         for zone in graph.vertices():
             if not graph.adj[zone]:
                 graph.remove(zone)
