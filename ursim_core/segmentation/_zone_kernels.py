@@ -33,9 +33,34 @@ are, each from few places.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 NO_MINIMUM = -1
+
+
+@intrinsic
+def _prefetch(typingctx, array, index):
+    """Ask the CPU to start loading the cache line of ``array[index]`` (no
+    bounds check; a hint only, never faults). A fusion's border pixels lie on
+    distinct rows of a label image far larger than the cache: loading a few
+    pixels ahead overlaps their memory latencies."""
+    signature = types.void(array, index)
+
+    def codegen(context, builder, signature, args):
+        array_type = signature.args[0]
+        array_value = context.make_array(array_type)(context, builder, args[0])
+        pointer = cgutils.get_item_pointer(context, builder, array_type, array_value, [args[1]], wraparound=False)
+        i32 = ir.IntType(32)
+        prefetch = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.VoidType(), [pointer.type, i32, i32, i32]), "llvm.prefetch.p0"
+        )
+        builder.call(prefetch, [pointer, i32(0), i32(3), i32(1)])  # read, keep in all levels, data
+        return context.get_dummy_value()
+
+    return signature, codegen
 
 @njit(cache=True)
 def label_flat_zones(values):
@@ -564,30 +589,35 @@ def _distinct_others(around, partners, n):
 
 
 @njit(cache=True, inline="always")
-def _count(around, partners, slots, keys, counts, meta, total, base):
-    """Add the contact counts of a pixel whose 3x3 zones are ``around``.
+def _count(around, partners, total):
+    """Contacts of a pixel whose 3x3 zones are ``around``: returns n, the
+    count (``around[4]``, ``partners[i]``) growing by one for i < n (its
+    contour size in ``total`` is counted here).
 
     A contour pixel counts once in its zone's contour size and once for every
     distinct other zone in its 3x3 neighbourhood.
     """
     if not _is_contour(around):
-        return
-    own = around[4]
-    total[own] += 1
-    n = _distinct_others(around, partners, 0)
-    for i in range(n):
-        _contact_add(slots, keys, counts, meta, base, own, partners[i], 1)
+        return 0
+    total[around[4]] += 1
+    return _distinct_others(around, partners, 0)
+
+
+@njit(cache=True)
+def _add_contact(slots, keys, counts, meta, base, a, b, delta):
+    """:func:`_contact_add`, not inlined: every caller goes through here."""
+    _contact_add(slots, keys, counts, meta, base, a, b, delta)
 
 
 @njit(cache=True, inline="always")
-def _recount(around, here, into, partners, signs, slots, keys, counts, meta, total, base):
-    """Update the contact counts of a pixel whose 3x3 zones are ``around`` for
-    the fusion of zone ``here`` into ``into``; ``around`` is rewritten to after.
+def _recount(around, here, into, partners, signs, total):
+    """Changes of the contact counts of a pixel whose 3x3 zones are ``around``
+    for the fusion of zone ``here`` into ``into``: returns ``(own, n)``, the
+    count (own, ``partners[i]``) changing by ``signs[i]`` for i < n (contour
+    sizes in ``total`` are updated here). ``around`` is rewritten to after.
 
-    Only the changes are applied: the counts of ``here`` itself are left as
-    they are, since a fused zone is never queried again. The changes are
-    gathered first so that the table is updated from one place (each inlined
-    update costs compilation time).
+    The counts of ``here`` itself are left as they are, since a fused zone is
+    never queried again.
     """
     own = around[4]
     was_contour = _is_contour(around)
@@ -598,7 +628,7 @@ def _recount(around, here, into, partners, signs, slots, keys, counts, meta, tot
             if around[k] == here:
                 around[k] = into
         if not _is_contour(around):
-            return
+            return own, 0
         own = into
         total[own] += 1
         n = _distinct_others(around, partners, 0)
@@ -606,14 +636,14 @@ def _recount(around, here, into, partners, signs, slots, keys, counts, meta, tot
             signs[i] = 1
     elif own == into:
         if not was_contour:
-            return
+            return own, 0
         had_here = False
         for k in range(9):
             if around[k] == here:
                 had_here = True
                 around[k] = into
         if not had_here:
-            return
+            return own, 0
         partners[0], signs[0] = here, -1
         n = 1
         if not _is_contour(around):
@@ -630,14 +660,13 @@ def _recount(around, here, into, partners, signs, slots, keys, counts, meta, tot
             elif around[k] == into:
                 had_into = True
         if not had_here:
-            return
+            return own, 0
         partners[0], signs[0] = here, -1
         n = 1
         if not had_into:
             partners[1], signs[1] = into, 1
             n = 2
-    for i in range(n):
-        _contact_add(slots, keys, counts, meta, base, own, partners[i], signs[i])
+    return own, n
 
 
 @njit(cache=True, inline="always")
@@ -716,6 +745,11 @@ def _contacts_start(labels, width, n):
     total = np.zeros(n, np.int64)
     around = np.empty(9, np.int32)
     partners = np.empty(9, np.int32)
+    # Counts are gathered in a small cache of pairs first: a boundary repeats
+    # its pair on every pixel, while the zones' counts are far apart in memory.
+    pending_keys = _filled(1 << _PENDING_BITS, _EMPTY, np.int64)
+    pending_counts = np.zeros(1 << _PENDING_BITS, np.int64)
+    base = np.int64(n)
     n_candidates = 0
     for pixel in range(labels.size):
         zone = labels[pixel]
@@ -733,11 +767,44 @@ def _contacts_start(labels, width, n):
             following[tail[zone]] = n_candidates
         tail[zone] = n_candidates
         n_candidates += 1
-        if 2 * (meta[0] + 8) > len(keys):
-            keys, counts = _table_reserve(keys, counts, meta, 8)
         _raw_neighbourhood(labels, pixel, width, around)
-        _count(around, partners, slots, keys, counts, meta, total, np.int64(n))
+        own = around[4]
+        for i in range(_count(around, partners, total)):
+            key = own * base + partners[i]
+            index = np.int64((np.uint64(key) * _GOLDEN) >> np.uint64(64 - _PENDING_BITS))
+            if pending_keys[index] == key:
+                pending_counts[index] += 1
+                continue
+            if pending_keys[index] != _EMPTY:
+                if 2 * (meta[0] + 1) > len(keys):
+                    keys, counts = _table_reserve(keys, counts, meta, 1)
+                evicted = pending_keys[index]
+                _add_contact(slots, keys, counts, meta, base, evicted // base, evicted % base, pending_counts[index])
+            pending_keys[index] = key
+            pending_counts[index] = 1
+    keys, counts = _table_reserve(keys, counts, meta, len(pending_keys))
+    for index in range(len(pending_keys)):
+        if pending_keys[index] != _EMPTY:
+            key = pending_keys[index]
+            _add_contact(slots, keys, counts, meta, base, key // base, key % base, pending_counts[index])
     return parent, pixels, following, head, tail, keys, counts, meta, slots, total
+
+
+@njit(cache=True, inline="always")
+def _bits(size):
+    """log2 of a power of two."""
+    bits = 0
+    while (1 << bits) < size:
+        bits += 1
+    return bits
+
+
+@njit(cache=True, inline="always")
+def _prefetch_rows(labels, pixel, width):
+    """Start loading the three rows of ``pixel``'s 3x3 neighbourhood."""
+    _prefetch(labels, pixel - width - 1)
+    _prefetch(labels, pixel - 1)
+    _prefetch(labels, pixel + width - 1)
 
 
 @njit(cache=True, inline="always")
@@ -755,67 +822,110 @@ def _mark(pixel, labels, seen, bits, affected, used, n_affected):
     return n_affected + 1
 
 
+# Size of the cache of pending counts when counting from scratch (_contacts_start).
+_PENDING_BITS = 14
+
+# Border pixels of a fusion are loaded this many candidates ahead (_prefetch).
+_AHEAD = 6
+
+
 @njit(cache=True)
 def _contacts_fuse(here, into, labels, width, state, scratch):
     """Fuse compact zone ``here`` into ``into`` in the contact state; returns
-    the state (its table may have grown) and the scratch arrays ``(seen,
-    affected, used)``, grown if needed.
+    the state (its table may have grown) and the scratch arrays, grown if needed.
 
     Only the pixels around ``here`` are visited: its border candidates (those
-    now inside are dropped for good) and their 8-neighbours, each once.
-    ``seen`` is a small hash set of the pixels met in this fusion (empty
-    between fusions; ``used`` records their slots to clear them): a flag per
-    pixel would cost a cold cache line for each row a fusion touches.
+    now inside are dropped for good) and their 8-neighbours, each once. The
+    scratch arrays are empty between fusions:
+
+    * ``walk``: the candidates, gathered first so that their rows of the label
+      image can be loaded a few candidates ahead;
+    * ``seen``: a small hash set of the pixels met (``affected`` lists them,
+      ``used`` their slots, to clear them): a flag per pixel would cost a cold
+      cache line for each row a fusion touches;
+    * ``change_keys`` / ``change_counts``: the count changes summed per pair
+      (``changed`` lists their slots), so that each pair's count, in a table
+      far larger than the cache, is updated once per fusion.
     """
     parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
-    seen, affected, used = scratch
+    walk, seen, affected, used, change_keys, change_counts, changed = scratch
     base = np.int64(len(parent))
     around = np.empty(9, np.int32)
     partners = np.empty(9, np.int32)
     signs = np.empty(9, np.int64)
-    n_affected = 0
-    bits = 0
-    while (1 << bits) < len(seen):
-        bits += 1
-    kept_head, kept_tail = -1, -1
+    n_walk = 0
     candidate = head[here]
     while candidate != -1:
-        next_candidate = following[candidate]
+        if n_walk == len(walk):
+            walk = _grown(walk, 2 * n_walk, 0)
+        walk[n_walk] = candidate
+        n_walk += 1
+        candidate = following[candidate]
+    if 4 * 9 * n_walk > len(seen):
+        size = len(seen)
+        while 4 * 9 * n_walk > size:
+            size *= 2
+        seen = _filled(size, _EMPTY, np.int64)
+        affected = np.empty(size // 4, np.int32)
+        used = np.empty(size // 4, np.int64)
+    seen_bits = _bits(len(seen))
+    for i in range(min(n_walk, _AHEAD)):
+        _prefetch_rows(labels, pixels[walk[i]], width)
+    n_affected = 0
+    kept_head, kept_tail = -1, -1
+    for i in range(n_walk):
+        if i + _AHEAD < n_walk:
+            _prefetch_rows(labels, pixels[walk[i + _AHEAD]], width)
+        candidate = walk[i]
         pixel = pixels[candidate]
-        if not _is_inner(labels, parent, pixel, width, here):
-            following[candidate] = -1
-            if kept_tail == -1:
-                kept_head = candidate
-            else:
-                following[kept_tail] = candidate
-            kept_tail = candidate
-            if n_affected + 9 > len(affected):
-                affected = _grown(affected, 2 * len(affected), 0)
-                used = _grown(used, 2 * len(used), 0)
-            if 4 * (n_affected + 9) > len(seen):
-                # Grow the set: re-insert this fusion's pixels so far.
-                seen = _filled(4 * len(seen), -1, np.int64)
-                bits += 2
-                for k in range(n_affected):
-                    slot = _probe(seen, np.int64(affected[k]), bits)
-                    seen[slot] = affected[k]
-                    used[k] = slot
-            up, down = pixel - width, pixel + width
-            n_affected = _mark(up - 1, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(up, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(up + 1, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(pixel - 1, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(pixel, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(pixel + 1, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(down - 1, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(down, labels, seen, bits, affected, used, n_affected)
-            n_affected = _mark(down + 1, labels, seen, bits, affected, used, n_affected)
-        candidate = next_candidate
-    keys, counts = _table_reserve(keys, counts, meta, 8 * n_affected)
+        if _is_inner(labels, parent, pixel, width, here):
+            continue
+        following[candidate] = -1
+        if kept_tail == -1:
+            kept_head = candidate
+        else:
+            following[kept_tail] = candidate
+        kept_tail = candidate
+        up, down = pixel - width, pixel + width
+        n_affected = _mark(up - 1, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(up, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(up + 1, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(pixel - 1, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(pixel, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(pixel + 1, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(down - 1, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(down, labels, seen, seen_bits, affected, used, n_affected)
+        n_affected = _mark(down + 1, labels, seen, seen_bits, affected, used, n_affected)
+    # At most 9 count changes per affected pixel; the table stays at most half full.
+    if 2 * 9 * n_affected > len(change_keys):
+        size = len(change_keys)
+        while 2 * 9 * n_affected > size:
+            size *= 2
+        change_keys = _filled(size, _EMPTY, np.int64)
+        change_counts = np.zeros(size, np.int64)
+        changed = np.empty(size // 2, np.int64)
+    change_bits = _bits(len(change_keys))
+    n_changed = 0
     for k in range(n_affected):
         _neighbourhood(labels, parent, affected[k], width, around)
-        _recount(around, here, into, partners, signs, slots, keys, counts, meta, total, base)
-        seen[used[k]] = -1
+        own, n = _recount(around, here, into, partners, signs, total)
+        for i in range(n):
+            key = own * base + partners[i]
+            slot = _probe(change_keys, key, change_bits)
+            if change_keys[slot] == _EMPTY:
+                change_keys[slot] = key
+                change_counts[slot] = 0
+                changed[n_changed] = slot
+                n_changed += 1
+            change_counts[slot] += signs[i]
+        seen[used[k]] = _EMPTY
+    keys, counts = _table_reserve(keys, counts, meta, n_changed)
+    for k in range(n_changed):
+        slot = changed[k]
+        if change_counts[slot] != 0:
+            key = change_keys[slot]
+            _add_contact(slots, keys, counts, meta, base, key // base, key % base, change_counts[slot])
+        change_keys[slot] = _EMPTY
     parent[here] = into
     if kept_head != -1:
         if tail[into] == -1:
@@ -824,7 +934,8 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
             following[tail[into]] = kept_head
         tail[into] = kept_tail
     head[here] = tail[here] = -1
-    return (parent, pixels, following, head, tail, keys, counts, meta, slots, total), (seen, affected, used)
+    state = (parent, pixels, following, head, tail, keys, counts, meta, slots, total)
+    return state, (walk, seen, affected, used, change_keys, change_counts, changed)
 
 
 @njit(cache=True)
@@ -833,7 +944,11 @@ def _start_tracking(labels, width, alive):
     ``(original, compact_of, state, scratch)`` for :func:`_contacts_fuse`."""
     original, compact_of, n = _compact_labels(labels, alive)
     state = _contacts_start(labels, width, n)
-    scratch = (_filled(4096, -1, np.int64), np.empty(1024, np.int32), np.empty(1024, np.int64))
+    scratch = (
+        np.empty(1024, np.int32), _filled(4096, _EMPTY, np.int64), np.empty(1024, np.int32),
+        np.empty(1024, np.int64), _filled(4096, _EMPTY, np.int64), np.zeros(4096, np.int64),
+        np.empty(2048, np.int64),
+    )
     return original, compact_of, state, scratch
 
 
