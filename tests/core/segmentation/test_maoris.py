@@ -191,6 +191,22 @@ def test_quantize_normalises_first():
     assert quantize(values).tolist() == [[0, 130, 255]]  # 127.5 -> 128 -> 130
 
 
+@pytest.mark.parametrize("dtype", [np.uint8, np.int16, np.uint16, np.int32, np.int64])
+@pytest.mark.parametrize(("lo", "hi"), [(0, 0), (0, 1), (0, 70), (3, 200), (0, 255), (0, 256), (17, 900), (-5, 40)])
+def test_normalisation_of_integer_images_matches_opencv_on_floats(dtype, lo, hi):
+    # Integer images go through a lookup table; it must be cv2.normalize of the float image, bit for bit.
+    if np.iinfo(dtype).min > lo or np.iinfo(dtype).max < hi:
+        pytest.skip("range does not fit the type")
+    values = np.random.default_rng(hi).integers(lo, hi + 1, size=(23, 29)).astype(dtype)
+    values[0, 0], values[-1, -1] = lo, hi
+    as_float = values.astype(np.float32)
+    expected = cv2.normalize(as_float, None, 0, 255, cv2.NORM_MINMAX, cv2.CV_8U)
+    for quantum in (1, 5, 7):
+        rounded = np.minimum(-(-expected.astype(np.int32) // quantum) * quantum, 255)
+        np.testing.assert_array_equal(quantize(values, quantum=quantum), rounded)
+        np.testing.assert_array_equal(quantize(as_float, quantum=quantum), rounded)
+
+
 def test_quantize_rejects_bad_quantum():
     with pytest.raises(ParameterError, match="quantum"):
         quantize(np.zeros((2, 2), np.uint8), quantum=0)
