@@ -32,6 +32,9 @@ are, each from few places.
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 from llvmlite import ir
 from numba import njit, types
@@ -722,18 +725,19 @@ def _restore_labels(labels, parent, original):
     relabel(labels, lookup)
 
 
-@njit(cache=True)
-def _contacts_start(labels, width, n):
-    """Contact counts of every zone of a compact, padded, flattened label image.
+@njit(cache=True, nogil=True)
+def count_contacts(labels, width, n, start, stop):
+    """Contact counts of the pixels ``start..stop - 1`` of a compact, padded,
+    flattened label image (``n`` zones; every label its own zone).
 
-    Returns the tracking state ``(parent, pixels, following, head, tail,
-    keys, counts, meta, slots, total)``: union-find parents of the labels; the
-    border candidates of each zone as linked lists over the candidate arrays
-    (``pixels[k]`` a pixel, ``following[k]`` the next candidate or -1, ``head``
-    / ``tail`` per zone); the contact counts (per-zone slots, the shared table,
-    ``total`` = contour sizes).
+    Returns ``(pixels, following, head, tail, used, keys, counts, meta, slots,
+    total)``: the border candidates of each zone as linked lists over the
+    candidate arrays, in raster order (``pixels[k]`` a pixel, ``following[k]``
+    the next candidate or -1, ``head`` / ``tail`` per zone, ``used`` entries
+    in use); the contact counts (per-zone slots, the shared table, ``total`` =
+    contour sizes). The pixels outside the range are only read, so bands of
+    rows can be counted at the same time (:func:`start_tracking`).
     """
-    parent = np.arange(n).astype(np.int32)
     pixels = np.empty(1024, np.int32)
     following = np.empty(1024, np.int32)
     head = _filled(n, -1, np.int32)
@@ -751,7 +755,7 @@ def _contacts_start(labels, width, n):
     pending_counts = np.zeros(1 << _PENDING_BITS, np.int64)
     base = np.int64(n)
     n_candidates = 0
-    for pixel in range(labels.size):
+    for pixel in range(start, stop):
         zone = labels[pixel]
         # No fusion yet: every label is its own zone.
         if zone == 0 or _same_labels_around(labels, pixel, width):
@@ -787,7 +791,41 @@ def _contacts_start(labels, width, n):
         if pending_keys[index] != _EMPTY:
             key = pending_keys[index]
             _add_contact(slots, keys, counts, meta, base, key // base, key % base, pending_counts[index])
-    return parent, pixels, following, head, tail, keys, counts, meta, slots, total
+    return pixels, following, head, tail, n_candidates, keys, counts, meta, slots, total
+
+
+@njit(cache=True)
+def join_counts(first, second):
+    """The counts of two bands of rows (:func:`count_contacts`), ``second``
+    below ``first``, as one: ``first``'s arrays, extended."""
+    pixels, following, head, tail, used, keys, counts, meta, slots, total = first
+    pixels_b, following_b, head_b, tail_b, used_b, keys_b, counts_b, meta_b, slots_b, total_b = second
+    n = len(head)
+    if used + used_b > len(pixels):
+        pixels = _grown(pixels, used + used_b, 0)
+        following = _grown(following, used + used_b, 0)
+    for k in range(used_b):
+        pixels[used + k] = pixels_b[k]
+        following[used + k] = following_b[k] + used if following_b[k] != -1 else -1
+    for zone in range(n):
+        if head_b[zone] == -1:
+            continue
+        if tail[zone] == -1:
+            head[zone] = head_b[zone] + used
+        else:
+            following[tail[zone]] = head_b[zone] + used
+        tail[zone] = tail_b[zone] + used
+        total[zone] += total_b[zone]
+    base = np.int64(n)
+    keys, counts = _table_reserve(keys, counts, meta, n * (_SLOTS - 1) + meta_b[0])
+    for zone in range(n):
+        for k in range(zone * _SLOTS + 1, zone * _SLOTS + _SLOTS):
+            if slots_b[k] >= 0:
+                _add_contact(slots, keys, counts, meta, base, zone, slots_b[k] >> 32, slots_b[k] & _COUNT)
+    for slot in range(len(keys_b)):
+        if keys_b[slot] != _EMPTY and counts_b[slot] != 0:
+            _add_contact(slots, keys, counts, meta, base, keys_b[slot] // base, keys_b[slot] % base, counts_b[slot])
+    return pixels, following, head, tail, used + used_b, keys, counts, meta, slots, total
 
 
 @njit(cache=True, inline="always")
@@ -822,7 +860,7 @@ def _mark(pixel, labels, seen, bits, affected, used, n_affected):
     return n_affected + 1
 
 
-# Size of the cache of pending counts when counting from scratch (_contacts_start).
+# Size of the cache of pending counts when counting from scratch (count_contacts).
 _PENDING_BITS = 14
 
 # Border pixels of a fusion are loaded this many candidates ahead (_prefetch).
@@ -848,7 +886,7 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
       far larger than the cache, is updated once per fusion.
     """
     parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
-    walk, seen, affected, used, change_keys, change_counts, changed = scratch
+    walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed = scratch
     base = np.int64(len(parent))
     around = np.empty(9, np.int32)
     partners = np.empty(9, np.int32)
@@ -858,7 +896,9 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
     while candidate != -1:
         if n_walk == len(walk):
             walk = _grown(walk, 2 * n_walk, 0)
+            walk_pixels = _grown(walk_pixels, 2 * n_walk, 0)
         walk[n_walk] = candidate
+        walk_pixels[n_walk] = pixels[candidate]
         n_walk += 1
         candidate = following[candidate]
     if 4 * 9 * n_walk > len(seen):
@@ -870,14 +910,14 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
         used = np.empty(size // 4, np.int64)
     seen_bits = _bits(len(seen))
     for i in range(min(n_walk, _AHEAD)):
-        _prefetch_rows(labels, pixels[walk[i]], width)
+        _prefetch_rows(labels, walk_pixels[i], width)
     n_affected = 0
     kept_head, kept_tail = -1, -1
     for i in range(n_walk):
         if i + _AHEAD < n_walk:
-            _prefetch_rows(labels, pixels[walk[i + _AHEAD]], width)
+            _prefetch_rows(labels, walk_pixels[i + _AHEAD], width)
         candidate = walk[i]
-        pixel = pixels[candidate]
+        pixel = walk_pixels[i]
         if _is_inner(labels, parent, pixel, width, here):
             continue
         following[candidate] = -1
@@ -935,21 +975,49 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
         tail[into] = kept_tail
     head[here] = tail[here] = -1
     state = (parent, pixels, following, head, tail, keys, counts, meta, slots, total)
-    return state, (walk, seen, affected, used, change_keys, change_counts, changed)
+    return state, (walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed)
+
+
+def start_tracking(labels, width, alive, *, bands=None):
+    """Compact the labels of a padded, flattened label image in place
+    (:func:`_compact_labels`) and count their contacts: ``(original,
+    compact_of, state)`` for the compiled steps that track contacts.
+
+    The state is ``(parent, pixels, following, head, tail, keys, counts,
+    meta, slots, total)``: union-find parents of the labels, then the arrays
+    of :func:`count_contacts`. Large images are counted in ``bands`` of rows
+    at the same time (default: one per CPU, at most 4), each on a thread.
+    """
+    original, compact_of, n = _compact_labels(labels, alive)
+    if bands is None:
+        bands = min(os.cpu_count() or 1, 4) if labels.size >= _BAND_PIXELS else 1
+    rows = labels.size // width
+    edges = [row * width for row in np.linspace(0, rows, bands + 1).astype(int)]
+    if bands == 1:
+        counted = [count_contacts(labels, width, n, 0, labels.size)]
+    else:
+        with ThreadPoolExecutor(bands) as pool:
+            counted = list(pool.map(lambda k: count_contacts(labels, width, n, edges[k], edges[k + 1]), range(bands)))
+    joined = counted[0]
+    for band in counted[1:]:
+        joined = join_counts(joined, band)
+    pixels, following, head, tail, _, keys, counts, meta, slots, total = joined
+    parent = np.arange(n, dtype=np.int32)
+    return original, compact_of, (parent, pixels, following, head, tail, keys, counts, meta, slots, total)
+
+
+# Smaller images are counted on one thread: starting threads costs more.
+_BAND_PIXELS = 1 << 20
 
 
 @njit(cache=True)
-def _start_tracking(labels, width, alive):
-    """Compact the labels (:func:`_compact_labels`) and start tracking contacts:
-    ``(original, compact_of, state, scratch)`` for :func:`_contacts_fuse`."""
-    original, compact_of, n = _compact_labels(labels, alive)
-    state = _contacts_start(labels, width, n)
-    scratch = (
-        np.empty(1024, np.int32), _filled(4096, _EMPTY, np.int64), np.empty(1024, np.int32),
+def _new_scratch():
+    """Empty scratch arrays of :func:`_contacts_fuse`."""
+    return (
+        np.empty(1024, np.int32), np.empty(1024, np.int32), _filled(4096, _EMPTY, np.int64), np.empty(1024, np.int32),
         np.empty(1024, np.int64), _filled(4096, _EMPTY, np.int64), np.zeros(4096, np.int64),
         np.empty(2048, np.int64),
     )
-    return original, compact_of, state, scratch
 
 
 @njit(cache=True, inline="always")
@@ -962,7 +1030,7 @@ def _contact_percent(state, zone, other):
 
 
 @njit(cache=True)
-def merge_ripples(order, ripples, labels, width, size, alive, graph):
+def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
     """Ripple merging (``removeRiplesv3``) on a padded flat label image.
 
     ``order`` is the initial work list (decreasing value, smaller size first,
@@ -973,7 +1041,8 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph):
     cache) as union-find sets of the labels, relabelled once at the end.
     """
     records, nodes = graph
-    original, compact_of, state, scratch = _start_tracking(labels, width, alive)
+    original, compact_of, state = tracking
+    scratch = _new_scratch()
     queue = np.empty(max(2 * len(order), 16), np.int32)
     for i in range(len(order)):
         queue[i] = order[i]
@@ -1027,7 +1096,7 @@ def _contact_sum(state, zone, here, compact_of, graph):
 
 
 @njit(cache=True)
-def remove_doors(doors, labels, width, size, alive, graph):
+def remove_doors(doors, labels, width, size, alive, graph, tracking):
     """Door removal (``removeDoors``) on a padded flat label image, relabelled in place.
 
     Zones in id order: one whose contact sum exceeds ``doors`` is fused into
@@ -1036,7 +1105,8 @@ def remove_doors(doors, labels, width, size, alive, graph):
     the start otherwise.
     """
     records, nodes = graph
-    original, compact_of, state, scratch = _start_tracking(labels, width, alive)
+    original, compact_of, state = tracking
+    scratch = _new_scratch()
     sums = np.zeros(len(records), np.int64)
     for k in range(len(original)):
         zone = original[k]
@@ -1065,7 +1135,7 @@ def contact_table(labels, width, alive):
     count)`` rows in original ids (other = 0: the zone's contour size)."""
     work = labels.copy()
     original, compact_of, n = _compact_labels(work, alive)
-    parent, pixels, following, head, tail, keys, counts, meta, slots, total = _contacts_start(work, width, n)
+    pixels, following, head, tail, used, keys, counts, meta, slots, total = count_contacts(work, width, n, 0, work.size)
     rows = 0
     for zone in range(1, n):
         if total[zone] > 0:

@@ -831,9 +831,9 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
     compact = graph._run_compiled()
     zones = np.flatnonzero(graph._alive)
     order = zones[np.lexsort((graph._size[zones], -graph._value_array[zones]))].astype(np.int32)
-    _kernels.merge_ripples(
-        order, float(ripples), graph._labels.ravel(), graph._labels.shape[1], graph._size, graph._alive, compact
-    )
+    labels, width = graph._labels.ravel(), graph._labels.shape[1]
+    tracking = _kernels.start_tracking(labels, width, graph._alive)
+    _kernels.merge_ripples(order, float(ripples), labels, width, graph._size, graph._alive, compact, tracking)
     return graph
 
 
@@ -954,9 +954,9 @@ def remove_doors(graph: ZoneGraph, *, doors: float = 40) -> ZoneGraph:
     (100, [1, 2])
     """
     compact = graph._run_compiled()
-    _kernels.remove_doors(
-        float(doors), graph._labels.ravel(), graph._labels.shape[1], graph._size, graph._alive, compact
-    )
+    labels, width = graph._labels.ravel(), graph._labels.shape[1]
+    tracking = _kernels.start_tracking(labels, width, graph._alive)
+    _kernels.remove_doors(float(doors), labels, width, graph._size, graph._alive, compact, tracking)
     return graph
 
 
@@ -1050,5 +1050,9 @@ def compile_kernels() -> float:
     start = time.perf_counter()
     free = np.zeros((40, 60), bool)
     free[3:37, 3:28] = free[3:37, 31:57] = free[15:22, 28:31] = True  # two rooms and a door
-    maoris_labels(free, PRESETS["default"])
+    labels = maoris_labels(free, PRESETS["default"])
+    # Large images count contacts in bands of rows, which this small one does not.
+    padded = np.pad(labels, _PAD)
+    alive = np.arange(int(labels.max()) + 1) > 0
+    _kernels.start_tracking(padded.ravel(), padded.shape[1], alive, bands=2)
     return time.perf_counter() - start

@@ -203,3 +203,55 @@ def test_vertices_and_membership_agree_in_both_forms():
     graph.adj  # to the dict form
     assert graph.vertices() == compact_vertices and len(graph) == compact_length
     assert absent not in graph and compact_vertices[0] in graph
+
+
+def _tracked_contacts(tracking) -> tuple[dict[tuple[int, int], int], list[list[int]]]:
+    """Every non-zero contact count of a tracking state, and each zone's candidate list."""
+    original, compact_of, state = tracking
+    parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
+    n = len(parent)
+    found: dict[tuple[int, int], int] = {(zone, 0): int(total[zone]) for zone in range(n) if total[zone]}
+    for zone, row in enumerate(slots.reshape(n, -1)):
+        for entry in row[1:]:
+            if entry >= 0:
+                found[(zone, int(entry >> 32))] = int(entry & 0xFFFFFFFF)
+    for key, count in zip(keys.tolist(), counts.tolist()):
+        if key != -1 and count:
+            found[divmod(key, n)] = count
+    lists = []
+    for zone in range(n):
+        walk, candidate = [], head[zone]
+        while candidate != -1:
+            walk.append(int(pixels[candidate]))
+            candidate = following[candidate]
+        lists.append(walk)
+    return found, lists
+
+
+@pytest.mark.parametrize("bands", [2, 3, 7])
+def test_contacts_counted_in_bands_of_rows_equal_one_pass(bands):
+    from ursim_core.segmentation import _zone_kernels
+    from ursim_core.synth import make_large_building
+
+    values = quantize(inscribed_circle_image(make_large_building(400, seed=bands).free), quantum=5)
+    graph = ZoneGraph(flat_zones(values), values)
+    remove_small_zones(graph, min_size=10)
+    graph._run_compiled()
+    results = []
+    for count in (1, bands):
+        labels = graph._labels.ravel().copy()
+        results.append(_tracked_contacts(_zone_kernels.start_tracking(labels, graph._labels.shape[1], graph._alive, bands=count)))
+    assert len(results[0][0]) > 1000
+    assert results[0] == results[1]
+
+
+def test_segmentation_is_the_same_with_contacts_counted_in_bands(monkeypatch):
+    from ursim_core.segmentation import _zone_kernels
+    from ursim_core.segmentation.maoris import maoris_labels
+    from ursim_core.synth import make_large_building
+
+    free = make_large_building(600, seed=2).free
+    expected = maoris_labels(free, PRESETS["robot"])
+    monkeypatch.setattr(_zone_kernels, "_BAND_PIXELS", 0)
+    monkeypatch.setattr(_zone_kernels.os, "cpu_count", lambda: 3)
+    np.testing.assert_array_equal(maoris_labels(free, PRESETS["robot"]), expected)
