@@ -40,6 +40,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ursim_core.segmentation._loop_helpers import loop_helper
+
 # Columns of the shape table returned by :func:`centre_rectangles`.
 TOP, BOTTOM, LEFT, RIGHT, RADIUS, DIAGONALS = range(6)
 # Bits of the DIAGONALS column: the diagonal neighbours (row step, column step)
@@ -140,7 +142,7 @@ def centre_rectangles(dist, max_radius):
     return shapes[:count]
 
 
-@njit(cache=True)
+@loop_helper
 def _load_radii(dist, row, max_radius, into):
     for col in range(dist.shape[1]):
         value = dist[row, col]
@@ -228,7 +230,7 @@ def paint_discs(dist, shapes, out):
 _TRIMMED_REACH_LIMIT = 512
 
 
-@njit(cache=True)
+@loop_helper
 def _raise_span(out, row, first_col, last_col, radius):
     for col in range(max(first_col, 0), min(last_col, out.shape[1] - 1) + 1):
         out[row, col] = max(out[row, col], radius)

@@ -25,9 +25,8 @@ work is bound by memory latency, not arithmetic):
 functions here only mutate them. Semantics are those documented on
 ``flat_zones``, ``remove_small_zones``, ``merge_ripples``, ``remove_doors``
 and ``ZoneGraph.fuse``. Compilation takes about 45 s the first time,
-and numba caches it: functions marked ``inline="always"`` are inlined before
-typing, which is fast to run and slow to compile, so only small hot helpers
-are, each from few places.
+and numba caches it. The small helpers of the loops are ``loop_helper``
+functions: compiled without reference counting, inlined by LLVM.
 """
 
 from __future__ import annotations
@@ -41,7 +40,10 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from ursim_core.segmentation._loop_helpers import loop_helper
+
 NO_MINIMUM = -1
+
 
 
 @intrinsic
@@ -212,7 +214,7 @@ def build_adjacency(zones, value):
     return records, nodes
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _link_pair(records, nodes, node, a, b, minimum, unbreakable):
     """Append the edge (a, b) to both lists as the twin nodes ``node`` (a -> b,
     ``node`` even) and ``node + 1``."""
@@ -273,7 +275,7 @@ def adjacency_entries(alive, graph):
     return out
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _append(records, nodes, zone, node, other):
     nodes[node, NEIGHBOUR] = other
     nodes[node, NEXT] = -1
@@ -287,7 +289,7 @@ def _append(records, nodes, zone, node, other):
     records[zone, DEGREE] += 1
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _unlink(records, nodes, zone, node):
     before, after = nodes[node, PREVIOUS], nodes[node, NEXT]
     if before == -1:
@@ -301,7 +303,7 @@ def _unlink(records, nodes, zone, node):
     records[zone, DEGREE] -= 1
 
 
-@njit(cache=True)
+@loop_helper
 def _find(records, nodes, a, b):
     """Node (a -> b), or -1; walks the shorter of the two lists."""
     if records[a, DEGREE] <= records[b, DEGREE]:
@@ -319,7 +321,7 @@ def _find(records, nodes, a, b):
     return -1
 
 
-@njit(cache=True)
+@loop_helper
 def fuse_edges(zone, into, graph):
     """Transfer the edges of ``zone`` to ``into`` (``ZoneGraph.fuse``, edges only).
 
@@ -421,7 +423,7 @@ def _new_table(bits):
     return _filled(1 << bits, _EMPTY, np.int64), np.zeros(1 << bits, np.int64), meta
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _probe(keys, key, bits):
     mask = len(keys) - 1
     slot = np.int64((np.uint64(key) * _GOLDEN) >> np.uint64(64 - bits))
@@ -430,7 +432,7 @@ def _probe(keys, key, bits):
     return slot
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _slot(keys, meta, key):
     memo = 2 + (key & (_MEMO - 1))
     if meta[memo] == key:
@@ -442,14 +444,14 @@ def _slot(keys, meta, key):
     return slot
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def table_get(keys, counts, meta, key):
     """Count under ``key`` (0 when absent)."""
     slot = _slot(keys, meta, key)
     return counts[slot] if keys[slot] == key else 0
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _table_add(keys, counts, meta, key, delta):
     slot = _slot(keys, meta, key)
     if keys[slot] == key:
@@ -487,7 +489,7 @@ _SLOTS = 8
 _COUNT = np.int64(0xFFFFFFFF)
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def contact_get(slots, keys, counts, meta, base, a, b):
     """Contact count (a, b): from a's own row, else from the shared table."""
     start = a * _SLOTS
@@ -500,7 +502,7 @@ def contact_get(slots, keys, counts, meta, base, a, b):
     return 0
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _contact_add(slots, keys, counts, meta, base, a, b, delta):
     start = a * _SLOTS
     free = -1
@@ -527,7 +529,7 @@ def _contact_add(slots, keys, counts, meta, base, a, b, delta):
     _table_add(keys, counts, meta, a * base + b, delta)
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _zone_of(label, parent):
     """Current zone of an original label (union-find root, with path halving)."""
     while parent[label] != label:
@@ -536,7 +538,7 @@ def _zone_of(label, parent):
     return label
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _neighbourhood(labels, parent, pixel, width, around):
     """Write the zones of a pixel's 3x3 neighbourhood, row by row, into
     ``around`` (index 4: the pixel)."""
@@ -553,7 +555,7 @@ def _neighbourhood(labels, parent, pixel, width, around):
     around[8] = _zone_of(labels[down + 1], parent)
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _raw_neighbourhood(labels, pixel, width, around):
     """:func:`_neighbourhood` before any fusion (every label its own zone)."""
     up, down = pixel - width, pixel + width
@@ -562,7 +564,7 @@ def _raw_neighbourhood(labels, pixel, width, around):
     around[6], around[7], around[8] = labels[down - 1], labels[down], labels[down + 1]
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _is_contour(around):
     """Whether the pixel whose 3x3 zones are ``around`` is a contour pixel: in a
     zone, with a 4-neighbour in another zone (or none)."""
@@ -570,7 +572,7 @@ def _is_contour(around):
     return own != 0 and not (around[1] == own and around[3] == own and around[5] == own and around[7] == own)
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _distinct_others(around, partners, n):
     """Append the distinct zones of ``around`` other than 0 and the pixel's own
     to ``partners[n:]``; returns the new length."""
@@ -591,7 +593,7 @@ def _distinct_others(around, partners, n):
     return n
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _count(around, partners, total):
     """Contacts of a pixel whose 3x3 zones are ``around``: returns n, the
     count (``around[4]``, ``partners[i]``) growing by one for i < n (its
@@ -606,13 +608,7 @@ def _count(around, partners, total):
     return _distinct_others(around, partners, 0)
 
 
-@njit(cache=True)
-def _add_contact(slots, keys, counts, meta, base, a, b, delta):
-    """:func:`_contact_add`, not inlined: every caller goes through here."""
-    _contact_add(slots, keys, counts, meta, base, a, b, delta)
-
-
-@njit(cache=True, inline="always")
+@loop_helper
 def _recount(around, here, into, partners, signs, total):
     """Changes of the contact counts of a pixel whose 3x3 zones are ``around``
     for the fusion of zone ``here`` into ``into``: returns ``(own, n)``, the
@@ -672,7 +668,7 @@ def _recount(around, here, into, partners, signs, total):
     return own, n
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _same_labels_around(labels, pixel, width):
     """Whether all 8 neighbours of ``pixel`` carry its own label."""
     raw = labels[pixel]
@@ -684,7 +680,7 @@ def _same_labels_around(labels, pixel, width):
     )  # fmt: skip
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _is_inner(labels, parent, pixel, width, own):
     """Whether all 8 neighbours of ``pixel`` are in zone ``own``."""
     if _same_labels_around(labels, pixel, width):
@@ -783,14 +779,14 @@ def count_contacts(labels, width, n, start, stop):
                 if 2 * (meta[0] + 1) > len(keys):
                     keys, counts = _table_reserve(keys, counts, meta, 1)
                 evicted = pending_keys[index]
-                _add_contact(slots, keys, counts, meta, base, evicted // base, evicted % base, pending_counts[index])
+                _contact_add(slots, keys, counts, meta, base, evicted // base, evicted % base, pending_counts[index])
             pending_keys[index] = key
             pending_counts[index] = 1
     keys, counts = _table_reserve(keys, counts, meta, len(pending_keys))
     for index in range(len(pending_keys)):
         if pending_keys[index] != _EMPTY:
             key = pending_keys[index]
-            _add_contact(slots, keys, counts, meta, base, key // base, key % base, pending_counts[index])
+            _contact_add(slots, keys, counts, meta, base, key // base, key % base, pending_counts[index])
     return pixels, following, head, tail, n_candidates, keys, counts, meta, slots, total
 
 
@@ -821,14 +817,14 @@ def join_counts(first, second):
     for zone in range(n):
         for k in range(zone * _SLOTS + 1, zone * _SLOTS + _SLOTS):
             if slots_b[k] >= 0:
-                _add_contact(slots, keys, counts, meta, base, zone, slots_b[k] >> 32, slots_b[k] & _COUNT)
+                _contact_add(slots, keys, counts, meta, base, zone, slots_b[k] >> 32, slots_b[k] & _COUNT)
     for slot in range(len(keys_b)):
         if keys_b[slot] != _EMPTY and counts_b[slot] != 0:
-            _add_contact(slots, keys, counts, meta, base, keys_b[slot] // base, keys_b[slot] % base, counts_b[slot])
+            _contact_add(slots, keys, counts, meta, base, keys_b[slot] // base, keys_b[slot] % base, counts_b[slot])
     return pixels, following, head, tail, used + used_b, keys, counts, meta, slots, total
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _bits(size):
     """log2 of a power of two."""
     bits = 0
@@ -837,7 +833,7 @@ def _bits(size):
     return bits
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _prefetch_rows(labels, pixel, width):
     """Start loading the three rows of ``pixel``'s 3x3 neighbourhood."""
     _prefetch(labels, pixel - width - 1)
@@ -845,7 +841,7 @@ def _prefetch_rows(labels, pixel, width):
     _prefetch(labels, pixel + width - 1)
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _mark(pixel, labels, seen, bits, affected, used, n_affected):
     """Append ``pixel`` to ``affected`` unless it has no zone (no counts) or
     is already in ``seen`` (a hash set of this fusion's pixels)."""
@@ -964,7 +960,7 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
         slot = changed[k]
         if change_counts[slot] != 0:
             key = change_keys[slot]
-            _add_contact(slots, keys, counts, meta, base, key // base, key % base, change_counts[slot])
+            _contact_add(slots, keys, counts, meta, base, key // base, key % base, change_counts[slot])
         change_keys[slot] = _EMPTY
     parent[here] = into
     if kept_head != -1:
@@ -1020,7 +1016,7 @@ def _new_scratch():
     )
 
 
-@njit(cache=True, inline="always")
+@loop_helper
 def _contact_percent(state, zone, other):
     """Integer percentage of compact ``zone``'s contour pixels having ``other`` in their 3x3."""
     parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
@@ -1083,7 +1079,7 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
     _restore_labels(labels, state[0], original)
 
 
-@njit(cache=True)
+@loop_helper
 def _contact_sum(state, zone, here, compact_of, graph):
     """Sum of contact percentages of ``zone`` (compact id ``here``) over its neighbours."""
     records, nodes = graph
