@@ -24,7 +24,7 @@ work is bound by memory latency, not arithmetic):
 :class:`ursim_core.segmentation.maoris.ZoneGraph` owns the arrays; the
 functions here only mutate them. Semantics are those documented on
 ``flat_zones``, ``remove_small_zones``, ``merge_ripples``, ``remove_doors``
-and ``ZoneGraph.fuse``. Compilation takes about 45 s the first time,
+and ``ZoneGraph.fuse``. Compilation takes about 43 s the first time,
 and numba caches it. The small helpers of the loops are ``loop_helper``
 functions: compiled without reference counting, inlined by LLVM.
 """
@@ -872,8 +872,9 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
     now inside are dropped for good) and their 8-neighbours, each once. The
     scratch arrays are empty between fusions:
 
-    * ``walk``: the candidates, gathered first so that their rows of the label
-      image can be loaded a few candidates ahead;
+    * ``walk`` / ``walk_pixels``: the candidates and their pixels, gathered
+      first so that their rows of the label image can be loaded a few
+      candidates ahead;
     * ``seen``: a small hash set of the pixels met (``affected`` lists them,
       ``used`` their slots, to clear them): a flag per pixel would cost a cold
       cache line for each row a fusion touches;
@@ -1034,7 +1035,8 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
     pixels of 0 and ``width`` wide, relabelled in place.
 
     Contacts are tracked on compact zone ids (the per-zone arrays stay in
-    cache) as union-find sets of the labels, relabelled once at the end.
+    cache) as union-find sets of the labels, relabelled once at the end;
+    ``tracking`` is :func:`start_tracking` of the labels (which compacts them).
     """
     records, nodes = graph
     original, compact_of, state = tracking
@@ -1098,7 +1100,7 @@ def remove_doors(doors, labels, width, size, alive, graph, tracking):
     Zones in id order: one whose contact sum exceeds ``doors`` is fused into
     the last neighbour whose sum is below ``doors``, else into its first
     neighbour; the receiver's sum is then recomputed. Sums are taken once at
-    the start otherwise.
+    the start otherwise. ``tracking`` as for :func:`merge_ripples`.
     """
     records, nodes = graph
     original, compact_of, state = tracking

@@ -23,7 +23,8 @@ Speed: a 4000 x 4000 map starts with about 1.5 million flat zones, visited
 one by one in an order that decides ties, so the graph steps cannot be
 vectorised; steps 3, 4 and 6 run as compiled code (numba, ``_zone_kernels``)
 on an array form of the zone graph, and step 1 paints its discs with compiled
-code too (``_disc_kernels``). The kernels compile on first use, about 40 s,
+code too (``_disc_kernels``). The contacts of large maps are counted in bands
+of rows on one thread per CPU. The kernels compile on first use, about 40 s,
 once: numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
@@ -1037,7 +1038,7 @@ def compile_kernels() -> float:
     """Compile (or load from numba's cache) the compiled steps; return the seconds it took.
 
     The first segmentation in a new environment otherwise pays this (about
-    45 s; a fraction of a second once cached). Benchmarks call it
+    43 s; under a second once cached). Benchmarks call it
     so that their timings exclude it.
 
     Examples
