@@ -45,7 +45,6 @@ from ursim_core.segmentation._loop_helpers import loop_helper
 NO_MINIMUM = -1
 
 
-
 @intrinsic
 def _prefetch(typingctx, array, index):
     """Ask the CPU to start loading the cache line of ``array[index]`` (no
@@ -66,6 +65,7 @@ def _prefetch(typingctx, array, index):
         return context.get_dummy_value()
 
     return signature, codegen
+
 
 @njit(cache=True)
 def label_flat_zones(values):
@@ -987,7 +987,7 @@ def start_tracking(labels, width, alive, *, bands=None):
     """
     original, compact_of, n = _compact_labels(labels, alive)
     if bands is None:
-        bands = min(os.cpu_count() or 1, 4) if labels.size >= _BAND_PIXELS else 1
+        bands = min(_usable_cpus(), 4) if labels.size >= _BAND_PIXELS else 1
     rows = labels.size // width
     edges = [row * width for row in np.linspace(0, rows, bands + 1).astype(int)]
     if bands == 1:
@@ -1005,6 +1005,11 @@ def start_tracking(labels, width, alive, *, bands=None):
 
 # Smaller images are counted on one thread: starting threads costs more.
 _BAND_PIXELS = 1 << 20
+
+
+def _usable_cpus() -> int:
+    """CPUs this process may run on (a container or taskset may allow fewer than the machine has)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 @njit(cache=True)
