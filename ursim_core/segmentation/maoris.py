@@ -24,7 +24,7 @@ one by one in an order that decides ties, so the graph steps cannot be
 vectorised; steps 3, 4 and 6 run as compiled code (numba, ``_zone_kernels``)
 on an array form of the zone graph, and step 1 paints its discs with compiled
 code too (``_disc_kernels``). The contacts of large maps are counted in bands
-of rows on one thread per CPU. The kernels compile on first use, about 40 s,
+of rows on one thread per CPU. The kernels compile on first use, about 43 s,
 once: numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
