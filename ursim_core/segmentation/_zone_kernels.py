@@ -813,7 +813,12 @@ def join_counts(first, second):
         tail[zone] = tail_b[zone] + used
         total[zone] += total_b[zone]
     base = np.int64(n)
-    keys, counts = _table_reserve(keys, counts, meta, n * (_SLOTS - 1) + meta_b[0])
+    # Room for every count of the second band, wherever each one lands.
+    more = meta_b[0]
+    for k in range(len(slots_b)):
+        if k % _SLOTS != 0 and slots_b[k] >= 0:
+            more += 1
+    keys, counts = _table_reserve(keys, counts, meta, more)
     for zone in range(n):
         for k in range(zone * _SLOTS + 1, zone * _SLOTS + _SLOTS):
             if slots_b[k] >= 0:
