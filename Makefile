@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PIP := $(BIN)/python -m pip
 
-.PHONY: run test bench clean
+.PHONY: run test lint bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -19,7 +19,7 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 
 # numba compiles the segmentation kernels on first use and caches them beside the module: do it
 # once here rather than inside the first segmentation (or in both test workers at once).
-$(VENV)/.kernels: ursim_core/segmentation/_zone_kernels.py ursim_core/segmentation/_disc_kernels.py | $(BIN)/python
+$(VENV)/.kernels: $(shell find ursim_core/segmentation -name '*.py') | $(BIN)/python
 	@echo "Compiling the segmentation kernels (once, under a minute)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; compile_kernels()"
 	touch $@
@@ -27,7 +27,13 @@ $(VENV)/.kernels: ursim_core/segmentation/_zone_kernels.py ursim_core/segmentati
 run: $(VENV)/.installed-gui $(VENV)/.kernels
 	$(BIN)/ursim-gui $(ARGS)
 
-test: $(VENV)/.installed-dev $(VENV)/.kernels
+# Lint, format and the import contracts of pyproject.toml first: they take seconds and say most.
+lint: $(VENV)/.installed-dev
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/lint-imports
+
+test: lint $(VENV)/.kernels
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -n 2 -q
 
 bench: $(VENV)/.installed-dev $(VENV)/.kernels

@@ -16,10 +16,10 @@ from pathlib import Path
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
-from PySide6.QtWidgets import QApplication  # noqa: E402
+from PySide6.QtWidgets import QApplication
 
-from ursim_gui.app import EXAMPLE_DIR  # noqa: E402
-from ursim_gui.main_window import MainWindow  # noqa: E402
+from ursim_gui.app import EXAMPLE_DIR
+from ursim_gui.main_window import MainWindow
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "images"
 

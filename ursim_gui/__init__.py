@@ -13,4 +13,3 @@ def main(argv: list[str] | None = None) -> int:
     from ursim_gui.app import main as run
 
     return run(argv)
-

@@ -18,15 +18,21 @@ __all__ = ["main", "parse_args", "user_data_dir", "configure_logging", "install_
 
 APP_NAME = "ursim-studio"
 #: The bundled example pair opened when the app starts without inputs.
-EXAMPLE_DIR = Path(__file__).resolve().parent.parent / "resources" / "example"
+EXAMPLE_DIR = Path(__file__).resolve().parents[1] / "resources" / "example"
 _log = logging.getLogger("ursim_gui")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(prog="ursim-gui", description="Annotate and inspect sketch-to-metric map matches (URSIM).")
+    parser = argparse.ArgumentParser(
+        prog="ursim-gui", description="Annotate and inspect sketch-to-metric map matches (URSIM)."
+    )
     parser.add_argument("maps", nargs="*", metavar="MAP", help="SKETCH METRIC: the two maps (image or ROS YAML)")
-    parser.add_argument("--correspondences", "-c", metavar="FILE", help="open a correspondence JSON (and the maps it names)")
-    parser.add_argument("--screenshot", metavar="PATH", help="load, segment and match, save a PNG of the window to PATH and exit")
+    parser.add_argument(
+        "--correspondences", "-c", metavar="FILE", help="open a correspondence JSON (and the maps it names)"
+    )
+    parser.add_argument(
+        "--screenshot", metavar="PATH", help="load, segment and match, save a PNG of the window to PATH and exit"
+    )
     parser.add_argument("--no-example", action="store_true", help="start empty instead of opening the bundled example")
     args = parser.parse_args(argv)
     if len(args.maps) not in (0, 2):
@@ -82,7 +88,9 @@ def install_excepthook(parent_getter=lambda: None) -> None:
         if QApplication.instance() is not None:
             from ursim_gui.dialogs import show_error
 
-            show_error(parent_getter(), "Unexpected error", f"{kind.__name__}: {value}\n\nThe details are in the log file.")
+            show_error(
+                parent_getter(), "Unexpected error", f"{kind.__name__}: {value}\n\nThe details are in the log file."
+            )
 
     sys.excepthook = hook
 

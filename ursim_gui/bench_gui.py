@@ -54,9 +54,9 @@ def bench_open(app, data_dir: Path, size: int) -> tuple[float, float]:
     The segmentation is computed beforehand (the budget starts after segmentation);
     both steps go through the session, the binding and one painted frame.
     """
-    from ursim_core.graph import region_graph
-    from ursim_core.maps import map_from_array
+    from ursim_core.io.maps import map_from_array
     from ursim_core.segmentation import Segmentation
+    from ursim_core.segmentation.graph import region_graph
     from ursim_gui.main_window import MainWindow
 
     labels = room_grid_labels(size, size, 100)
@@ -82,9 +82,9 @@ def bench_hover_and_edit(app, data_dir) -> tuple[list[float], list[float]]:
     """Hover and edit timings in a real main window on a KTH-size pair (1870x924)."""
     from types import SimpleNamespace
 
-    from ursim_core.graph import region_graph
-    from ursim_core.maps import map_from_array
+    from ursim_core.io.maps import map_from_array
     from ursim_core.segmentation import Segmentation
+    from ursim_core.segmentation.graph import region_graph
     from ursim_gui.main_window import MainWindow
 
     labels = room_grid_labels(924, 1870, 90)
@@ -97,9 +97,11 @@ def bench_hover_and_edit(app, data_dir) -> tuple[list[float], list[float]]:
         session.set_map(side, map_from_array(np.where(labels > 0, 255, 0).astype(np.uint8)))
         session.set_segmentation(side, segmentation)
     n = int(labels.max())
-    session.apply_match(SimpleNamespace(pairs=[(i, n + 1 - i) for i in range(1, n + 1)], anchors=[(1, n)], m=0.1, cost=0.0, reason=""))
+    session.apply_match(
+        SimpleNamespace(pairs=[(i, n + 1 - i) for i in range(1, n + 1)], anchors=[(1, n)], m=0.1, cost=0.0, reason="")
+    )
     app.processEvents()
-    sketch, metric = window.views["sketch"], window.views["metric"]
+    _sketch, _metric = window.views["sketch"], window.views["metric"]
     hover = []
     for region in range(1, n + 1, 3):
         start = time.perf_counter()
@@ -147,7 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     from PySide6.QtWidgets import QApplication
 
-    from ursim_core.maps import map_from_array
+    from ursim_core.io.maps import map_from_array
     from ursim_core.segmentation import segment
     from ursim_gui.model.jobs import MatchJob, SegmentJob
 
@@ -156,12 +158,18 @@ def main(argv: list[str] | None = None) -> int:
 
     with tempfile.TemporaryDirectory() as data_dir:
         shown, overlay = bench_open(app, Path(data_dir), args.size)
-        print(f"{args.size}x{args.size} map: show map {_ms(shown)}, then segmentation overlay {_ms(overlay)}   (budget 1000 ms)")
+        print(
+            f"{args.size}x{args.size} map: show map {_ms(shown)}, then segmentation overlay {_ms(overlay)}   (budget 1000 ms)"
+        )
         hover, edit = bench_hover_and_edit(app, Path(data_dir))
-    print(f"hover highlight 1870x924, median / max: {_ms(statistics.median(hover))} / {_ms(max(hover))}   (budget 16 ms, {len(hover)} regions)")
+    print(
+        f"hover highlight 1870x924, median / max: {_ms(statistics.median(hover))} / {_ms(max(hover))}   (budget 16 ms, {len(hover)} regions)"
+    )
     print(f"edit (status) + redraw, median / max: {_ms(statistics.median(edit))} / {_ms(max(edit))}   (budget 16 ms)")
     free = room_grid_labels(924, 1870, 150) > 0
-    gap, wall = bench_blocking(app, SegmentJob(map_from_array(np.where(free, 255, 0).astype(np.uint8)), "robot", side="metric"))
+    gap, wall = bench_blocking(
+        app, SegmentJob(map_from_array(np.where(free, 255, 0).astype(np.uint8)), "robot", side="metric")
+    )
     print(f"segmentation in worker: longest UI gap {_ms(gap)} over {wall:.2f} s   (budget 100 ms)")
     seg = segment(free, preset="robot")
     gap, wall = bench_blocking(app, MatchJob(seg, seg))

@@ -101,7 +101,9 @@ class DocumentController(QObject):
 
     def save_as(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(self.window, "Save correspondences", "correspondences.json", JSON_FILTER)
+            chosen, _ = QFileDialog.getSaveFileName(
+                self.window, "Save correspondences", "correspondences.json", JSON_FILTER
+            )
             if not chosen:
                 return False
             path = Path(chosen)

@@ -12,7 +12,7 @@ from pathlib import Path
 from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QFont, QFontMetricsF, QImage, QPainter, QPen
 
-from ursim_core.atomic import atomic_write_bytes
+from ursim_core.io.atomic import atomic_write_bytes
 
 __all__ = ["render_figure", "export_figure"]
 
@@ -34,7 +34,12 @@ def _legend_lines(session) -> list[tuple[QColor | None, str]]:
         regions = f"sketch {', '.join(map(str, clique.sketch_regions)) or '–'}  ↔  metric {', '.join(map(str, clique.metric_regions)) or '–'}"
         status = session.clique_status(clique.id)
         mark = f"  [{status.upper()}]" if status else ""
-        lines.append((QColor(*session.color_of_clique(clique.id)), f"{clique.id}: {regions}  ({clique.source}, {clique.effective_status}){mark}"))
+        lines.append(
+            (
+                QColor(*session.color_of_clique(clique.id)),
+                f"{clique.id}: {regions}  ({clique.source}, {clique.effective_status}){mark}",
+            )
+        )
     if not lines:
         lines.append((None, "no correspondences"))
     return lines
@@ -85,7 +90,11 @@ def render_figure(sketch_view, metric_view, session, *, map_height: int = 600, c
     for view, rect, side in ((sketch_view, left, "sketch"), (metric_view, right, "metric")):
         title = session.map(side).name if session.map(side) is not None else "(none)"
         painter.setPen(QColor(30, 30, 30))
-        painter.drawText(QRectF(rect.x(), _MARGIN, rect.width(), _TITLE_H), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter, f"{side.capitalize()}: {title}")
+        painter.drawText(
+            QRectF(rect.x(), _MARGIN, rect.width(), _TITLE_H),
+            Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter,
+            f"{side.capitalize()}: {title}",
+        )
         if not view.sceneRect().isEmpty():
             with view.layers.hidden("selection", "highlight"):
                 view.scene().render(painter, rect, view.sceneRect(), Qt.AspectRatioMode.KeepAspectRatio)

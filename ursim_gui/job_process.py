@@ -36,7 +36,7 @@ class JobFailed(Exception):
 def serve(connection) -> None:
     """Child main loop: run each job received, answer with its outcome."""
     # Pay the heavy imports while the user is still looking at the maps.
-    import ursim_core.matching  # noqa: F401
+    import ursim_core.matching
     import ursim_core.segmentation  # noqa: F401
 
     def progress(fraction: float, message: str = "") -> None:

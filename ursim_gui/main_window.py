@@ -32,7 +32,24 @@ from ursim_gui.window_tools import WindowTools
 __all__ = ["MainWindow"]
 
 _log = logging.getLogger(__name__)
-_TOOLBAR = ("open_sketch", "open_metric", "open_correspondences", "save", None, "undo", "redo", None, "link", "unlink", "accept", "reject", None, "fit", "link_zoom", "connectors")
+_TOOLBAR = (
+    "open_sketch",
+    "open_metric",
+    "open_correspondences",
+    "save",
+    None,
+    "undo",
+    "redo",
+    None,
+    "link",
+    "unlink",
+    "accept",
+    "reject",
+    None,
+    "fit",
+    "link_zoom",
+    "connectors",
+)
 _DISPLAY = ("outlines", "region_ids", "graph")
 
 
@@ -114,7 +131,9 @@ class MainWindow(QMainWindow):
         # The right column runs to the bottom: the panels get the full height.
         self.setCorner(Qt.Corner.BottomRightCorner, right)
         self.docks = {
-            "segmentation": self._dock("Segmentation", self.segmentation_panel, right, "dock_segmentation", scroll=True),
+            "segmentation": self._dock(
+                "Segmentation", self.segmentation_panel, right, "dock_segmentation", scroll=True
+            ),
             "matching": self._dock("Matching", self.matching_panel, right, "dock_matching"),
             "table": self._dock("Correspondences", self.table, bottom, "dock_table"),
             "evaluation": self._dock("Evaluation", self.evaluation, bottom, "dock_evaluation"),
@@ -168,14 +187,18 @@ class MainWindow(QMainWindow):
         a["outlines"].toggled.connect(lambda on: [v.set_outlines_visible(on) for v in self.views.values()])
         a["region_ids"].toggled.connect(lambda on: [v.set_ids_visible(on) for v in self.views.values()])
         a["graph"].toggled.connect(lambda on: [v.set_graph_visible(on) for v in self.views.values()])
-        self.segmentation_panel.opacity_changed.connect(lambda value: [v.set_overlay_opacity(value) for v in self.views.values()])
+        self.segmentation_panel.opacity_changed.connect(
+            lambda value: [v.set_overlay_opacity(value) for v in self.views.values()]
+        )
         for side, view in self.views.items():
             view.files_dropped.connect(lambda paths, side=side: docs.open_dropped(side, paths))
             view.cursor_moved.connect(lambda row, col, side=side: self.tools.show_cursor(side, row, col))
             view.zoom_changed.connect(lambda factor, side=side: self._zoom_changed(side, factor))
             box = self.segmentation_panel.boxes[side]
             box.preset.setCurrentText(self.session.segmentation_preset(side))
-            box.preset.currentTextChanged.connect(lambda preset, side=side: self.session.set_segmentation_preset(side, preset))
+            box.preset.currentTextChanged.connect(
+                lambda preset, side=side: self.session.set_segmentation_preset(side, preset)
+            )
             box.segment_requested.connect(lambda s, preset, params: self.jobs.segment(s, preset, params))
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
@@ -184,7 +207,9 @@ class MainWindow(QMainWindow):
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
         self.session.segmentation_changed.connect(self._show_summary)
         self.session.map_changed.connect(self._show_map_title)
-        self.session.correspondences_changed.connect(lambda *_: self.matching_panel.show_result(self.session.last_match))
+        self.session.correspondences_changed.connect(
+            lambda *_: self.matching_panel.show_result(self.session.last_match)
+        )
         self.tools = WindowTools(self)
         self._update_ready()
 
@@ -210,12 +235,18 @@ class MainWindow(QMainWindow):
 
     def _show_summary(self, side: str) -> None:
         segmentation = self.session.segmentation(side)
-        text = "no segmentation" if segmentation is None else f"{segmentation.n_regions} regions ({segmentation.method})"
+        text = (
+            "no segmentation" if segmentation is None else f"{segmentation.n_regions} regions ({segmentation.method})"
+        )
         self.segmentation_panel.boxes[side].set_summary(text)
 
     def _show_map_title(self, side: str) -> None:
         map_ = self.session.map(side)
-        text = side.capitalize() if map_ is None else f"{side.capitalize()}: {map_.name}  ({map_.shape[0]}×{map_.shape[1]} px)"
+        text = (
+            side.capitalize()
+            if map_ is None
+            else f"{side.capitalize()}: {map_.name}  ({map_.shape[0]}×{map_.shape[1]} px)"
+        )
         self.view_titles[side].setText(text)
         self._update_ready()
 
@@ -225,7 +256,9 @@ class MainWindow(QMainWindow):
         return sheet
 
     # ---- inputs and closing ----------------------------------------------------------------------
-    def open_inputs(self, sketch=None, metric=None, correspondences=None, *, example: bool = False, wait: bool = False) -> bool:
+    def open_inputs(
+        self, sketch=None, metric=None, correspondences=None, *, example: bool = False, wait: bool = False
+    ) -> bool:
         """Open maps and/or correspondences given on the command line (see ``WindowTools``)."""
         return self.tools.open_inputs(sketch, metric, correspondences, example=example, wait=wait)
 

@@ -14,7 +14,16 @@ from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem
 
 from ursim_gui.overlay import region_mask
 
-__all__ = ["ImageItem", "LabelItem", "grey_to_qimage", "pack_premultiplied", "argb_qimage", "lut_qimage", "mask_qimage", "region_outline_path"]
+__all__ = [
+    "ImageItem",
+    "LabelItem",
+    "grey_to_qimage",
+    "pack_premultiplied",
+    "argb_qimage",
+    "lut_qimage",
+    "mask_qimage",
+    "region_outline_path",
+]
 
 
 def grey_to_qimage(grey: np.ndarray) -> tuple[QImage, np.ndarray]:

@@ -229,7 +229,9 @@ class MapView(QGraphicsView):
     def mouseReleaseEvent(self, event) -> None:
         if self._press_pos is not None and not self._panning and event.button() == Qt.MouseButton.LeftButton:
             row, col = self._pixel_at(event.position())
-            additive = bool(event.modifiers() & (Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier))
+            additive = bool(
+                event.modifiers() & (Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+            )
             self.region_clicked.emit(self.region_at(row, col), additive)
         self._press_pos = None
         self._panning = False

@@ -130,7 +130,7 @@ def outline_mask(labels: np.ndarray) -> np.ndarray:
 def region_label_positions(graph) -> dict[int, tuple[float, float]]:
     """Where to print each region id: its interior point (row, col), else its centroid.
 
-    ``graph`` is a region graph of :func:`ursim_core.graph.region_graph`; the interior
+    ``graph`` is a region graph of :func:`ursim_core.segmentation.graph.region_graph`; the interior
     point is the distance-transform maximum, so the text sits inside even concave rooms.
     """
     positions: dict[int, tuple[float, float]] = {}
@@ -141,7 +141,9 @@ def region_label_positions(graph) -> dict[int, tuple[float, float]]:
     return positions
 
 
-def region_mask(labels: np.ndarray, region: int, bbox: Iterable[int] | None = None) -> tuple[np.ndarray, tuple[int, int]]:
+def region_mask(
+    labels: np.ndarray, region: int, bbox: Iterable[int] | None = None
+) -> tuple[np.ndarray, tuple[int, int]]:
     """Boolean mask of one region cropped to its bounding box, and the box's (row, col).
 
     Parameters

@@ -204,7 +204,9 @@ class RegionLayers:
             self._ids.append(item)
 
     def set_badges(self, badges: dict[int, tuple[str, QColor]]) -> None:
-        if {region: text for region, (text, _colour) in badges.items() if region in self.positions} == self.badge_texts():
+        if {
+            region: text for region, (text, _colour) in badges.items() if region in self.positions
+        } == self.badge_texts():
             return
         for item in self._badges.values():
             self.scene.removeItem(item)
@@ -227,7 +229,11 @@ def _graph_path(graph, shape) -> QPainterPath:
     path = QPainterPath()
     if graph is None:
         return path
-    centre = {n: (a["centroid"][1] + 0.5, a["centroid"][0] + 0.5) for n, a in graph.nodes(data=True) if a.get("centroid") is not None}
+    centre = {
+        n: (a["centroid"][1] + 0.5, a["centroid"][0] + 0.5)
+        for n, a in graph.nodes(data=True)
+        if a.get("centroid") is not None
+    }
     for a, b in graph.edges():
         if a in centre and b in centre:
             path.moveTo(*centre[a])

@@ -124,7 +124,9 @@ class ViewBinding:
         view = self.views[side]
         if segmentation is not None:
             max_label = max(segmentation.graph.nodes, default=0)
-            table = side_colour_table(self.session.correspondences, side, segmentation.labels, self._colour_of, max_label=max_label)
+            table = side_colour_table(
+                self.session.correspondences, side, segmentation.labels, self._colour_of, max_label=max_label
+            )
             view.set_region_colours(table)
             index = SIDES.index(side)
             view.set_anchors({pair[index] for pair in self.session.anchors})

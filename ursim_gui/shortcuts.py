@@ -31,16 +31,26 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("new_sketch", "&New sketch…", ("Ctrl+N",), "Draw a sketch on a blank canvas", "File"),
     ActionSpec("open_sketch", "Open &sketch…", (), "Open the sketch map (image or ROS YAML)", "File"),
     ActionSpec("open_metric", "Open &metric map…", (), "Open the metric map (image or ROS YAML)", "File"),
-    ActionSpec("open_correspondences", "&Open correspondences…", ("Ctrl+O",), "Open a correspondence JSON and its maps", "File"),
+    ActionSpec(
+        "open_correspondences", "&Open correspondences…", ("Ctrl+O",), "Open a correspondence JSON and its maps", "File"
+    ),
     ActionSpec("save", "&Save", ("Ctrl+S",), "Save the correspondences", "File"),
     ActionSpec("save_as", "Save &as…", ("Ctrl+Shift+S",), "Save the correspondences to a new file", "File"),
     ActionSpec("import_dat", "&Import .dat…", (), "Replace the correspondences by a legacy .dat file", "File"),
     ActionSpec("export_dat", "&Export .dat…", (), "Write the correspondences as a legacy .dat file", "File"),
-    ActionSpec("export_figure", "Export &figure…", ("Ctrl+E",), "PNG of both maps with the matches and a legend", "File"),
+    ActionSpec(
+        "export_figure", "Export &figure…", ("Ctrl+E",), "PNG of both maps with the matches and a legend", "File"
+    ),
     ActionSpec("quit", "&Quit", ("Ctrl+Q",), "Close the window (asks to save changes)", "File"),
     ActionSpec("undo", "&Undo", ("Ctrl+Z",), "Undo the last edit", "Edit"),
     ActionSpec("redo", "&Redo", ("Ctrl+Shift+Z", "Ctrl+Y"), "Redo the last undone edit", "Edit"),
-    ActionSpec("link", "&Link selected regions", ("L",), "New clique of the selected regions (or add them to the selected clique)", "Edit"),
+    ActionSpec(
+        "link",
+        "&Link selected regions",
+        ("L",),
+        "New clique of the selected regions (or add them to the selected clique)",
+        "Edit",
+    ),
     ActionSpec("unlink", "U&nlink region", ("U",), "Remove the selected region(s) from their cliques", "Edit"),
     ActionSpec("delete_clique", "&Delete clique", ("Delete",), "Delete the selected clique", "Edit"),
     ActionSpec("accept", "&Accept clique", ("A",), "Mark the selected clique accepted", "Edit"),
@@ -90,7 +100,15 @@ class ShortcutSheet(QDialog):
         super().__init__(parent)
         self.setWindowTitle("Keyboard shortcuts")
         self.setObjectName("shortcut_sheet")
-        rows = [(s.group, " or ".join(QKeySequence(k).toString(QKeySequence.SequenceFormat.NativeText) for k in s.keys), s.description) for s in SHORTCUTS if s.keys]
+        rows = [
+            (
+                s.group,
+                " or ".join(QKeySequence(k).toString(QKeySequence.SequenceFormat.NativeText) for k in s.keys),
+                s.description,
+            )
+            for s in SHORTCUTS
+            if s.keys
+        ]
         rows += [("Mouse", gesture, what) for gesture, what in MOUSE_GESTURES]
         self.table = QTableWidget(len(rows), 3, self)
         self.table.setHorizontalHeaderLabels(["Group", "Keys", "Action"])

@@ -6,7 +6,6 @@ document owns the pixels, the tools and the undo stack.
 
 from __future__ import annotations
 
-import numpy as np
 from PySide6.QtCore import QPoint, QRect, Qt, Signal
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QPainter
 from PySide6.QtWidgets import (
@@ -147,8 +146,12 @@ class SketchWindow(QMainWindow):
         commands = self.addToolBar("Document")
         commands.setObjectName("sketch_commands")
         toolbar = commands
-        self.undo_action = self._command(toolbar, "Undo", QKeySequence.StandardKey.Undo, self.document.undo, "sketch_undo")
-        self.redo_action = self._command(toolbar, "Redo", QKeySequence.StandardKey.Redo, self.document.redo, "sketch_redo")
+        self.undo_action = self._command(
+            toolbar, "Undo", QKeySequence.StandardKey.Undo, self.document.undo, "sketch_undo"
+        )
+        self.redo_action = self._command(
+            toolbar, "Redo", QKeySequence.StandardKey.Redo, self.document.redo, "sketch_redo"
+        )
         self._command(toolbar, "Clear", None, self.document.clear, "sketch_clear")
         toolbar.addSeparator()
         self._command(toolbar, "Save PNG…", QKeySequence.StandardKey.Save, self.save_dialog, "sketch_save")

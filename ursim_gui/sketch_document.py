@@ -1,6 +1,6 @@
 """Qt-free drawing document behind the sketch canvas: a grey image, tools and undo.
 
-Walls are black (0) on white (255) paper, the convention ``ursim_core.maps`` reads as
+Walls are black (0) on white (255) paper, the convention ``ursim_core.io.maps`` reads as
 obstacle / free. Each finished stroke or shape is one undo step; the image before it is
 kept as a snapshot (a sketch is small, and snapshots make undo exact).
 """
@@ -12,7 +12,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ursim_core.atomic import atomic_write_bytes
+from ursim_core.io.atomic import atomic_write_bytes
 from ursim_gui.model.signals import Signal
 
 __all__ = ["SketchDocument", "TOOLS", "INK", "PAPER"]

@@ -16,7 +16,13 @@ __all__ = ["side_colour_table", "first_regions", "eval_badges"]
 
 
 def side_colour_table(
-    correspondences, side: str, labels: np.ndarray, colour_of: Callable[[int], Colour], *, alpha: int = 255, max_label: int | None = None
+    correspondences,
+    side: str,
+    labels: np.ndarray,
+    colour_of: Callable[[int], Colour],
+    *,
+    alpha: int = 255,
+    max_label: int | None = None,
 ) -> np.ndarray:
     """Colour lookup table of one side's label image.
 

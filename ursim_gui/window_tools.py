@@ -54,7 +54,7 @@ class WindowTools:
         return sketch
 
     def use_as_sketch(self, image) -> None:
-        from ursim_core.maps import map_from_array
+        from ursim_core.io.maps import map_from_array
 
         try:
             self.session.set_map("sketch", map_from_array(image))
@@ -71,7 +71,9 @@ class WindowTools:
             dialogs.show_error(self.window, "No map", f"Open the {side} map before its label image.")
             return False
         if path is None:
-            chosen, _ = QFileDialog.getOpenFileName(self.window, f"Load {side} label image", "", "Label images (*.png *.tif *.tiff)")
+            chosen, _ = QFileDialog.getOpenFileName(
+                self.window, f"Load {side} label image", "", "Label images (*.png *.tif *.tiff)"
+            )
             if not chosen:
                 return False
             path = Path(chosen)
@@ -91,7 +93,13 @@ class WindowTools:
             path = Path(chosen)
         views = self.window.views
         try:
-            export_figure(path, views["sketch"], views["metric"], self.session, connectors=self.window.actions["connectors"].isChecked())
+            export_figure(
+                path,
+                views["sketch"],
+                views["metric"],
+                self.session,
+                connectors=self.window.actions["connectors"].isChecked(),
+            )
         except OSError as error:
             dialogs.show_error(self.window, "Export failed", str(error))
             return False
@@ -102,7 +110,7 @@ class WindowTools:
         map_ = self.session.map(side)
         world = None
         if row >= 0 and map_ is not None and map_.resolution is not None and map_.origin is not None:
-            from ursim_core.maps import pixel_to_world
+            from ursim_core.io.maps import pixel_to_world
 
             x, y = pixel_to_world(map_, row, col)
             world = (float(x), float(y))
@@ -110,7 +118,9 @@ class WindowTools:
         self.window.status.show_cursor(side, row, col, world, region)
 
     # ---- command-line inputs ------------------------------------------------------------------------
-    def open_inputs(self, sketch=None, metric=None, correspondences=None, *, example: bool = False, wait: bool = False) -> bool:
+    def open_inputs(
+        self, sketch=None, metric=None, correspondences=None, *, example: bool = False, wait: bool = False
+    ) -> bool:
         """Open what the command line named; with ``example``, the bundled pair.
 
         Two maps are segmented with the default presets and matched (in the worker, or
@@ -153,7 +163,9 @@ class WindowTools:
             return True
         for side in ("sketch", "metric"):
             box = panel.boxes[side]
-            if not jobs.run_now(SegmentJob(self.session.map(side), box.preset.currentText(), box.overrides(), side=side)):
+            if not jobs.run_now(
+                SegmentJob(self.session.map(side), box.preset.currentText(), box.overrides(), side=side)
+            ):
                 return False
         self.session.match_config = config
         return jobs.run_now(MatchRequest(config))

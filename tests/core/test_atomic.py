@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from ursim_core.atomic import atomic_write_bytes, atomic_write_text
+from ursim_core.io.atomic import atomic_write_bytes, atomic_write_text
 
 posix_only = pytest.mark.skipif(sys.platform == "win32", reason="POSIX permission bits and symlinks")
 
@@ -42,7 +42,7 @@ def test_accepts_any_bytes_like_object(tmp_path):
 def test_text_is_written_without_newline_translation(tmp_path):
     target = tmp_path / "t.txt"
     atomic_write_text(target, "é\nline\n")
-    assert target.read_bytes() == "é\nline\n".encode("utf-8")
+    assert target.read_bytes() == "é\nline\n".encode()
     atomic_write_text(target, "é", encoding="latin-1")
     assert target.read_bytes() == b"\xe9"
 

@@ -9,8 +9,18 @@ from ursim_core.cli import main
 
 def test_evaluate_prints_tables_and_writes_the_report(synthetic_dataset, tmp_path, capsys):  # noqa: F811
     report = tmp_path / "report"
-    args = ["evaluate", str(synthetic_dataset), "--matchers", "planar", "--variants", "T4", "--workers", "1",
-            "-o", str(report)]
+    args = [
+        "evaluate",
+        str(synthetic_dataset),
+        "--matchers",
+        "planar",
+        "--variants",
+        "T4",
+        "--workers",
+        "1",
+        "-o",
+        str(report),
+    ]
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "F1, oracle m" in out and "F1, automatic m" in out and "Human vs human" in out

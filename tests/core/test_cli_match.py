@@ -9,22 +9,22 @@ import numpy as np
 import pytest
 
 from ursim_core.cli import main
-from ursim_core.correspondences import load_correspondences, load_dat
+from ursim_core.correspondences.codec import load_correspondences, load_dat
 
 
 def building(scale: float = 1.0) -> np.ndarray:
     """A corridor with four rooms of different sizes above and below it."""
-    s = lambda v: int(round(v * scale))  # noqa: E731
+    s = lambda v: int(round(v * scale))
     image = np.zeros((s(260), s(420)), np.uint8)
-    image[s(110):s(150), s(10):s(410)] = 255  # corridor
+    image[s(110) : s(150), s(10) : s(410)] = 255  # corridor
     rooms = [(10, 100, 10, 140), (10, 100, 150, 400), (160, 250, 10, 250), (160, 250, 260, 330)]
     for r0, r1, c0, c1 in rooms:
-        image[s(r0):s(r1), s(c0):s(c1)] = 255
+        image[s(r0) : s(r1), s(c0) : s(c1)] = 255
         door = (c0 + c1) // 2
         if r1 <= 110:
-            image[s(r1):s(110), s(door - 5):s(door + 5)] = 255
+            image[s(r1) : s(110), s(door - 5) : s(door + 5)] = 255
         else:
-            image[s(150):s(r0), s(door - 5):s(door + 5)] = 255
+            image[s(150) : s(r0), s(door - 5) : s(door + 5)] = 255
     return image
 
 
@@ -56,7 +56,7 @@ def test_match_writes_all_outputs(tmp_path, pair):
 
 
 def test_match_scaled_copy_is_mostly_right(tmp_path, pair):
-    from ursim_core.graph import region_graph
+    from ursim_core.segmentation.graph import region_graph
 
     out = tmp_path / "out"
     assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out)]) == 0
@@ -84,7 +84,9 @@ def test_match_bad_m_is_an_input_error(tmp_path, pair, capsys):
 
 def test_convert_round_trip(tmp_path, pair):
     dat = tmp_path / "gt.dat"
-    dat.write_text("# sketch.png metric.png\n# 0match set\n# map1\n30 60\n# map2\n25 50\n\n# 1match set\n# map1\n# map2\n")
+    dat.write_text(
+        "# sketch.png metric.png\n# 0match set\n# map1\n30 60\n# map2\n25 50\n\n# 1match set\n# map1\n# map2\n"
+    )
     json_path, back = tmp_path / "gt.json", tmp_path / "back.dat"
     assert main(["convert", str(dat), str(json_path), "--sketch", str(pair[0]), "--metric", str(pair[1])]) == 0
     corr = load_correspondences(json_path)

@@ -12,8 +12,8 @@ import jsonschema
 import numpy as np
 import pytest
 
-from ursim_core import correspondences as corr_module
-from ursim_core.correspondences import (
+from ursim_core.correspondences import codec as corr_module
+from ursim_core.correspondences.codec import (
     Clique,
     Correspondences,
     MapRef,
@@ -90,10 +90,10 @@ def _full_correspondences(folder):
         ),
         metric=MapRef(path=folder / "metric.pgm", size=(30, 30)),
         cliques=(
-            Clique(id=2, sketch_points=[(1, 2), (3, 4)], metric_points=[(5, 6)], sketch_regions=[7, 8],
-                   metric_regions=[9]),
-            Clique(id=7, metric_points=[(0, 0)], source="auto", score=-1.5e-07, note="Zoë's \"room\"",
-                   status="pending"),
+            Clique(
+                id=2, sketch_points=[(1, 2), (3, 4)], metric_points=[(5, 6)], sketch_regions=[7, 8], metric_regions=[9]
+            ),
+            Clique(id=7, metric_points=[(0, 0)], source="auto", score=-1.5e-07, note='Zoë\'s "room"', status="pending"),
         ),
         annotator="Zoë",
     )
@@ -240,7 +240,12 @@ def test_layout_is_indented_ordered_and_keeps_points_on_one_line(tmp_path):
     document = json.loads(text)
     assert list(document) == ["format", "version", "annotator", "created", "modified", "maps", "cliques"]
     assert list(document["cliques"][0]) == [
-        "id", "sketch_points", "metric_points", "sketch_regions", "metric_regions", "source",
+        "id",
+        "sketch_points",
+        "metric_points",
+        "sketch_regions",
+        "metric_regions",
+        "source",
     ]
     assert list(document["cliques"][1])[-3:] == ["score", "note", "status"]
     assert text.startswith('{\n  "format": "ursim-correspondences",\n')
@@ -331,7 +336,11 @@ def test_loaded_values_match_the_file(tmp_path):
     assert loaded.metric.segmentation_method is None and loaded.metric.size is None
     second = loaded.cliques[1]
     assert (second.id, second.source, second.score, second.note, second.status) == (
-        5, "auto", 0.12, "corridor", "rejected",
+        5,
+        "auto",
+        0.12,
+        "corridor",
+        "rejected",
     )
     assert loaded.cliques[0].metric_points == ((5, 6), (7, 8))
 
@@ -412,39 +421,89 @@ BAD_DOCUMENTS = [
     ("cliques-object", _mutated(lambda d: d.update(cliques={})), "cliques", "expected array, got object"),
     ("annotator-number", _mutated(lambda d: d.update(annotator=3)), "annotator", "expected string, got integer"),
     ("bad-created", _mutated(lambda d: d.update(created="last tuesday")), "created", "ISO-8601"),
-    ("map-path-number", _mutated(lambda d: d["maps"]["sketch"].update(path=5)), "maps.sketch.path",
-     "got integer 5"),
-    ("bad-sha", _mutated(lambda d: d["maps"]["sketch"].update(sha256="abc")), "maps.sketch.sha256",
-     "64 hexadecimal digits"),
-    ("bad-size", _mutated(lambda d: d["maps"]["sketch"].update(size=[10])), "maps.sketch.size",
-     "exactly 2 items"),
-    ("params-list", _mutated(lambda d: d["maps"]["sketch"]["segmentation"].update(params=[])),
-     "maps.sketch.segmentation.params", "expected object, got array"),
+    ("map-path-number", _mutated(lambda d: d["maps"]["sketch"].update(path=5)), "maps.sketch.path", "got integer 5"),
+    (
+        "bad-sha",
+        _mutated(lambda d: d["maps"]["sketch"].update(sha256="abc")),
+        "maps.sketch.sha256",
+        "64 hexadecimal digits",
+    ),
+    ("bad-size", _mutated(lambda d: d["maps"]["sketch"].update(size=[10])), "maps.sketch.size", "exactly 2 items"),
+    (
+        "params-list",
+        _mutated(lambda d: d["maps"]["sketch"]["segmentation"].update(params=[])),
+        "maps.sketch.segmentation.params",
+        "expected object, got array",
+    ),
     ("clique-no-id", _mutated(lambda d: d["cliques"][1].pop("id")), "cliques[1].id", "required field is missing"),
-    ("clique-no-points", _mutated(lambda d: d["cliques"][0].pop("metric_points")), "cliques[0].metric_points",
-     "required field is missing"),
+    (
+        "clique-no-points",
+        _mutated(lambda d: d["cliques"][0].pop("metric_points")),
+        "cliques[0].metric_points",
+        "required field is missing",
+    ),
     ("id-string", _mutated(lambda d: d["cliques"][1].update(id="5")), "cliques[1].id", 'got string "5"'),
     ("id-zero", _mutated(lambda d: d["cliques"][0].update(id=0)), "cliques[0].id", "got 0"),
-    ("point-one-value", _mutated(lambda d: d["cliques"][1].update(sketch_points=[[1]])),
-     "cliques[1].sketch_points[0]", "[row, col] pair of non-negative integers (exactly 2 items), got 1 item"),
-    ("point-three-values", _mutated(lambda d: d["cliques"][0]["metric_points"].append([1, 2, 3])),
-     "cliques[0].metric_points[2]", "got 3 items"),
-    ("point-float", _mutated(lambda d: d["cliques"][0].update(sketch_points=[[1.5, 2]])),
-     "cliques[0].sketch_points[0][0]", "expected integer, got number 1.5"),
-    ("point-negative", _mutated(lambda d: d["cliques"][0].update(sketch_points=[[1, -2]])),
-     "cliques[0].sketch_points[0][1]", "got -2"),
-    ("point-not-list", _mutated(lambda d: d["cliques"][0].update(sketch_points=[{"row": 1, "col": 2}])),
-     "cliques[0].sketch_points[0]", "expected [row, col] pair"),
-    ("region-zero", _mutated(lambda d: d["cliques"][0].update(metric_regions=[2, 0])),
-     "cliques[0].metric_regions[1]", "region id"),
-    ("bad-source", _mutated(lambda d: d["cliques"][0].update(source="robot")), "cliques[0].source",
-     'one of "manual", "auto"'),
-    ("bad-status", _mutated(lambda d: d["cliques"][1].update(status="done")), "cliques[1].status",
-     '"accepted", "rejected", "pending"'),
-    ("score-string", _mutated(lambda d: d["cliques"][1].update(score="high")), "cliques[1].score",
-     "expected number or null"),
-    ("duplicate-ids", _mutated(lambda d: d["cliques"][1].update(id=1)), "cliques[1].id",
-     "duplicate clique id 1 (also used by cliques[0])"),
+    (
+        "point-one-value",
+        _mutated(lambda d: d["cliques"][1].update(sketch_points=[[1]])),
+        "cliques[1].sketch_points[0]",
+        "[row, col] pair of non-negative integers (exactly 2 items), got 1 item",
+    ),
+    (
+        "point-three-values",
+        _mutated(lambda d: d["cliques"][0]["metric_points"].append([1, 2, 3])),
+        "cliques[0].metric_points[2]",
+        "got 3 items",
+    ),
+    (
+        "point-float",
+        _mutated(lambda d: d["cliques"][0].update(sketch_points=[[1.5, 2]])),
+        "cliques[0].sketch_points[0][0]",
+        "expected integer, got number 1.5",
+    ),
+    (
+        "point-negative",
+        _mutated(lambda d: d["cliques"][0].update(sketch_points=[[1, -2]])),
+        "cliques[0].sketch_points[0][1]",
+        "got -2",
+    ),
+    (
+        "point-not-list",
+        _mutated(lambda d: d["cliques"][0].update(sketch_points=[{"row": 1, "col": 2}])),
+        "cliques[0].sketch_points[0]",
+        "expected [row, col] pair",
+    ),
+    (
+        "region-zero",
+        _mutated(lambda d: d["cliques"][0].update(metric_regions=[2, 0])),
+        "cliques[0].metric_regions[1]",
+        "region id",
+    ),
+    (
+        "bad-source",
+        _mutated(lambda d: d["cliques"][0].update(source="robot")),
+        "cliques[0].source",
+        'one of "manual", "auto"',
+    ),
+    (
+        "bad-status",
+        _mutated(lambda d: d["cliques"][1].update(status="done")),
+        "cliques[1].status",
+        '"accepted", "rejected", "pending"',
+    ),
+    (
+        "score-string",
+        _mutated(lambda d: d["cliques"][1].update(score="high")),
+        "cliques[1].score",
+        "expected number or null",
+    ),
+    (
+        "duplicate-ids",
+        _mutated(lambda d: d["cliques"][1].update(id=1)),
+        "cliques[1].id",
+        "duplicate clique id 1 (also used by cliques[0])",
+    ),
 ]
 
 

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from ursim_core import datasets
-from ursim_core.correspondences import Clique, Correspondences, MapRef, load_dat, save_dat
+from ursim_core.correspondences.codec import Clique, Correspondences, MapRef, load_dat, save_dat
 from ursim_core.errors import FormatError
+from ursim_core.evaluation import datasets
 
 SAMPLE = """\
 # /home/a/sketches/00.png ../../model_simple.png
@@ -85,9 +85,7 @@ def test_writing_gives_the_original_layout(tmp_path):
     target = tmp_path / "out.dat"
     save_dat(corr, target)
     assert target.read_bytes() == (
-        b"# /maps/s.png m.png\n"
-        b"# 0match set\n# map1\n1 2\n3 4\n# map2\n5 6\n\n"
-        b"# 1match set\n# map1\n# map2\n\n"
+        b"# /maps/s.png m.png\n# 0match set\n# map1\n1 2\n3 4\n# map2\n5 6\n\n# 1match set\n# map1\n# map2\n\n"
     )
 
 
@@ -161,7 +159,11 @@ MALFORMED = [
     ("map2-first", "# a b\n# 0match set\n# map2\n", "line 3: expected '# map1', got '# map2'"),
     ("map1-twice", "# a b\n# 0match set\n# map1\n# map1\n", "line 4: expected '# map2', got '# map1'"),
     ("map1-after-map2", "# a b\n# 0match set\n# map1\n# map2\n# map1\n", "line 5: '# map1' after '# map2'"),
-    ("set-without-map2", "# a b\n# 0match set\n# map1\n1 2\n\n# 1match set\n", "line 6: the match set started on line 2 has no '# map2'"),
+    (
+        "set-without-map2",
+        "# a b\n# 0match set\n# map1\n1 2\n\n# 1match set\n",
+        "line 6: the match set started on line 2 has no '# map2'",
+    ),
     ("truncated", "# a b\n# 0match set\n# map1\n1 2\n", "line 5: the match set started on line 2 has no '# map2'"),
     ("empty-set-header", "# a b\n# 0match set\n", "has no '# map1' and '# map2'"),
     ("float", "# a b\n# 0match set\n# map1\n1.5 2\n# map2\n", "line 4: expected 'ROW COL'"),

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ursim_core.dataset_layout import Experiment, discover
 from ursim_core.errors import FormatError, ParameterError, UrsimError
+from ursim_core.evaluation.layouts import Experiment, discover
 
 DAT = "# {map1} {map2}\n# 0match set\n# map1\n5 5\n# map2\n6 6\n\n# 1match set\n# map1\n# map2\n"
 
@@ -42,7 +42,10 @@ def _kth(root: Path, sketches=("00", "01", "02"), gt=None) -> Path:
 def _halmstad(root: Path) -> Path:
     for name in ("E5_01", "E5_02", "E5_08", "E5_10"):
         _png(root / f"{name}.png")
-    for annotator, model, maps in (("Malcolm", "E5_08", ("E5_01", "E5_10")), ("Vasiliki", "E5_10", ("E5_01", "E5_02", "E5_08"))):
+    for annotator, _model, maps in (
+        ("Malcolm", "E5_08", ("E5_01", "E5_10")),
+        ("Vasiliki", "E5_10", ("E5_01", "E5_02", "E5_08")),
+    ):
         _png(root / "GT" / annotator / "model_simple.png")
         for name in maps:
             _dat(root / "GT" / annotator / f"gt_{name}_model_simple.dat")
@@ -173,7 +176,7 @@ def test_annotators_differing_only_by_case_are_refused(tmp_path):
 
 @pytest.mark.dataset
 def test_real_datasets_are_discovered():
-    from ursim_core.datasets import MISSING_REASON, dataset_root
+    from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 
     root = dataset_root()
     if root is None:

@@ -1,4 +1,4 @@
-"""Tests of ursim_core.descriptors: standardisation, uniqueness, anchors, Laplacian, signatures."""
+"""Tests of ursim_core.matching.descriptors: standardisation, uniqueness, anchors, Laplacian, signatures."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from ursim_core import descriptors as d
+from ursim_core.matching import descriptors as d
 
 
 def _graph(sizes, pcas, edges):
@@ -60,8 +60,13 @@ def test_anchor_disparities_and_hungarian_pairs():
     cost = d.disparity_matrix(z_sketch, z_metric)
     assert cost[0, 1] == pytest.approx((0.2 + 0.1) / 2)
     assert d.anchor_pairs(cost) == [(0, 1), (1, 0)]
-    released = d.disparity_matrix(z_sketch, z_metric, disparity="released",
-                                  raw_pca_first=np.array([0.5, 0.9]), raw_pca_second=np.array([0.88, 0.51, 0.1]))
+    released = d.disparity_matrix(
+        z_sketch,
+        z_metric,
+        disparity="released",
+        raw_pca_first=np.array([0.5, 0.9]),
+        raw_pca_second=np.array([0.88, 0.51, 0.1]),
+    )
     # (|2 - (-1.2)| + |0.5 - 0.88|) / 2 = 1.79 -> clipped at 1; (0.2 + 0.01) / 2 = 0.105 -> 0.10
     assert released[0, 0] == 1.0
     assert released[0, 1] == pytest.approx(0.10)
@@ -102,12 +107,16 @@ def test_dense_and_expm_signatures_agree(anchors):
     weights = np.random.default_rng(3).uniform(0.1, 2.0, 40)
     laplacian = d.weighted_laplacian(graph, weights)
     dense = d.heat_kernel_signatures(laplacian, anchors=anchors, method="eigh")
-    sparse_path = d.heat_kernel_signatures(d.weighted_laplacian(graph, weights, dense=False), anchors=anchors,
-                                           method="expm", block=16)
+    sparse_path = d.heat_kernel_signatures(
+        d.weighted_laplacian(graph, weights, dense=False), anchors=anchors, method="expm", block=16
+    )
     assert np.allclose(dense, sparse_path, atol=1e-9)
     uneven = (0.0, 0.3, 1.7)
-    assert np.allclose(d.heat_kernel_signatures(laplacian, anchors=anchors, times=uneven, method="eigh"),
-                       d.heat_kernel_signatures(laplacian, anchors=anchors, times=uneven, method="expm"), atol=1e-9)
+    assert np.allclose(
+        d.heat_kernel_signatures(laplacian, anchors=anchors, times=uneven, method="eigh"),
+        d.heat_kernel_signatures(laplacian, anchors=anchors, times=uneven, method="expm"),
+        atol=1e-9,
+    )
 
 
 def test_anchor_signature_at_time_zero_is_the_indicator():

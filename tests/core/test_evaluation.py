@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation import (
+from ursim_core.evaluation.runner import (
     DEFAULT_M_GRID,
     POOLED,
     EvaluationResult,
@@ -27,9 +27,22 @@ def _row(name, m, f1, *, annotator="malcolm", matcher="planar", variant="T4", pr
     label = "auto" if m == "auto" else m_label(m)
     value = auto_m if m == "auto" else float(m)
     return RunRow(
-        map=name, annotator=annotator, matcher=matcher, variant=variant, m_label=label, m_value=value,
-        tp=0, fp=0, fn=0, precision=f1 if precision is None else precision, recall=f1 if recall is None else recall,
-        f1=f1, seeds=0, n_sketch_regions=3, n_metric_regions=3, time_s=0.0,
+        map=name,
+        annotator=annotator,
+        matcher=matcher,
+        variant=variant,
+        m_label=label,
+        m_value=value,
+        tp=0,
+        fp=0,
+        fn=0,
+        precision=f1 if precision is None else precision,
+        recall=f1 if recall is None else recall,
+        f1=f1,
+        seeds=0,
+        n_sketch_regions=3,
+        n_metric_regions=3,
+        time_s=0.0,
     )
 
 
@@ -173,11 +186,11 @@ def _plan(scale: float) -> np.ndarray:
         return int(round(value * scale))
 
     free = np.zeros((s(70), s(190)), bool)
-    free[s(5):s(65), s(5):s(55)] = True
-    free[s(15):s(55), s(65):s(105)] = True
-    free[s(5):s(45), s(115):s(185)] = True
-    free[s(30):s(38), s(55):s(65)] = True
-    free[s(20):s(28), s(105):s(115)] = True
+    free[s(5) : s(65), s(5) : s(55)] = True
+    free[s(15) : s(55), s(65) : s(105)] = True
+    free[s(5) : s(45), s(115) : s(185)] = True
+    free[s(30) : s(38), s(55) : s(65)] = True
+    free[s(20) : s(28), s(105) : s(115)] = True
     return np.where(free, 255, 0).astype(np.uint8)
 
 
@@ -185,8 +198,12 @@ def _dat_text(sketch_scale: float, model_scale: float, rooms: int) -> str:
     lines = ["# sketch.png model_simple.png"]
     for index, (row, col) in enumerate(ROOM_CENTRES[:rooms]):
         lines += [
-            f"# {index}match set", "# map1", f"{round(row * sketch_scale)} {round(col * sketch_scale)}",
-            "# map2", f"{round(row * model_scale)} {round(col * model_scale)}", "",
+            f"# {index}match set",
+            "# map1",
+            f"{round(row * sketch_scale)} {round(col * sketch_scale)}",
+            "# map2",
+            f"{round(row * model_scale)} {round(col * model_scale)}",
+            "",
         ]
     # The published files end with an empty match set; the legacy fnfix scorer counts it.
     lines += [f"# {rooms}match set", "# map1", "# map2", ""]
@@ -219,8 +236,13 @@ GRID = (0.0, 0.1, 0.2)
 @pytest.fixture(scope="module")
 def synthetic_result(synthetic_dataset) -> EvaluationResult:
     return run_evaluation(
-        synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "baseline"], m_grid=GRID,
-        preset="robot", metric_preset="robot", workers=1,
+        synthetic_dataset,
+        matchers=["planar", "hungarian"],
+        variants=["T4", "baseline"],
+        m_grid=GRID,
+        preset="robot",
+        metric_preset="robot",
+        workers=1,
     )
 
 
@@ -244,8 +266,11 @@ def test_runner_matches_an_identical_map_perfectly(synthetic_result):
     # The "copy" sketch is the model itself: the oracle m must recover every room.
     oracle = synthetic_result.summary("malcolm", "planar", "T4", "oracle")
     assert dict(zip(oracle.maps, oracle.f1))["copy"] == 1.0
-    copy_rows = [r for r in synthetic_result.rows if r.map == "copy" and r.annotator == "malcolm" and r.matcher == "planar"
-                 and r.variant == "T4" and r.f1 == 1.0]
+    copy_rows = [
+        r
+        for r in synthetic_result.rows
+        if r.map == "copy" and r.annotator == "malcolm" and r.matcher == "planar" and r.variant == "T4" and r.f1 == 1.0
+    ]
     assert all((r.tp, r.fp, r.fn) == (3, 0, 0) for r in copy_rows)
 
 
@@ -253,8 +278,10 @@ def test_human_vs_human_has_the_known_answer(synthetic_result):
     # vasiliki's two cliques are two of malcolm's three: scored against malcolm, P = 1, R = 2/3;
     # malcolm's against vasiliki's, P = 2/3, R = 1. F1 = 0.8 both ways, on both maps.
     human = {(r.map, r.annotator, r.variant): r for r in synthetic_result.human_rows}
-    assert set(human) == {(m, a, b) for m in SKETCH_SCALES for a, b in (("malcolm", "vasiliki"), ("vasiliki", "malcolm"))}
-    for (name, reference, scored), row in human.items():
+    assert set(human) == {
+        (m, a, b) for m in SKETCH_SCALES for a, b in (("malcolm", "vasiliki"), ("vasiliki", "malcolm"))
+    }
+    for (_name, reference, _scored), row in human.items():
         assert row.f1 == pytest.approx(0.8)
         if reference == "malcolm":
             assert (row.tp, row.fp, row.fn) == (2, 0, 1)
@@ -275,12 +302,29 @@ def test_runner_settings_and_timings(synthetic_result, synthetic_dataset):
 
 
 def test_legacy_scoring_modes(synthetic_dataset):
-    as_built = run_evaluation(synthetic_dataset, matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot",
-                              workers=1, legacy_scoring=True, human=False, auto_m=False)
+    as_built = run_evaluation(
+        synthetic_dataset,
+        matchers=["planar"],
+        variants=["T4"],
+        m_grid=(0.1,),
+        preset="robot",
+        workers=1,
+        legacy_scoring=True,
+        human=False,
+        auto_m=False,
+    )
     assert {r.scoring for r in as_built.rows} == {"as-built"} and {r.fn for r in as_built.rows} == {0}
     assert as_built.human_rows == ()
-    fnfix = run_evaluation(synthetic_dataset, matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot",
-                           workers=1, legacy_scoring="fnfix", auto_m=False)
+    fnfix = run_evaluation(
+        synthetic_dataset,
+        matchers=["planar"],
+        variants=["T4"],
+        m_grid=(0.1,),
+        preset="robot",
+        workers=1,
+        legacy_scoring="fnfix",
+        auto_m=False,
+    )
     # The trailing empty match set can never be hit: at least one FN everywhere.
     assert all(r.fn >= 1 for r in fnfix.rows)
     assert {r.m_label for r in fnfix.rows} == {"0.1"}
@@ -289,9 +333,19 @@ def test_legacy_scoring_modes(synthetic_dataset):
 def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_path):
     calls = []
     cache: dict = {}
-    options = dict(matchers=["hungarian"], variants=["T1", "T2"], m_grid=(0.1,), preset="robot", metric_preset="robot", workers=1,
-                   segmentation_cache=cache, cache_dir=tmp_path / "segcache")
-    first = run_evaluation(synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options)
+    options = dict(
+        matchers=["hungarian"],
+        variants=["T1", "T2"],
+        m_grid=(0.1,),
+        preset="robot",
+        metric_preset="robot",
+        workers=1,
+        segmentation_cache=cache,
+        cache_dir=tmp_path / "segcache",
+    )
+    first = run_evaluation(
+        synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options
+    )
     total = 2 + 2 * 2 + 1  # distinct maps + (experiment x variant) tasks + human vs human
     assert [c[0] for c in calls] == list(range(1, total + 1)) and {c[1] for c in calls} == {total}
     assert any(text.startswith("segment") for _, _, text in calls) and calls[-1][2] == "human vs human"
@@ -306,21 +360,36 @@ def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_p
 
 
 def test_two_worker_processes_give_the_same_rows(synthetic_dataset, synthetic_result):
-    parallel = run_evaluation(synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "baseline"],
-                              m_grid=GRID, preset="robot", workers=2)
+    parallel = run_evaluation(
+        synthetic_dataset,
+        matchers=["planar", "hungarian"],
+        variants=["T4", "baseline"],
+        m_grid=GRID,
+        preset="robot",
+        workers=2,
+    )
     strip = lambda rows: [(r.map, r.annotator, r.matcher, r.variant, r.m_label, r.tp, r.fp, r.fn, r.f1) for r in rows]
     assert strip(parallel.rows) == strip(synthetic_result.rows)
 
 
 def test_map_selection_and_experiment_list(synthetic_dataset):
-    from ursim_core.dataset_layout import discover
+    from ursim_core.evaluation.layouts import discover
 
-    only_copy = run_evaluation(synthetic_dataset, matchers=["hungarian"], variants=["T1"], m_grid=(0.1,),
-                               preset="robot", workers=1, maps=["copy"], auto_m=False)
+    only_copy = run_evaluation(
+        synthetic_dataset,
+        matchers=["hungarian"],
+        variants=["T1"],
+        m_grid=(0.1,),
+        preset="robot",
+        workers=1,
+        maps=["copy"],
+        auto_m=False,
+    )
     assert {r.map for r in only_copy.rows} == {"copy"}
     experiments = [e for e in discover(synthetic_dataset) if e.name == "small"]
-    given = run_evaluation(experiments, matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot",
-                           workers=1, auto_m=False)
+    given = run_evaluation(
+        experiments, matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot", workers=1, auto_m=False
+    )
     assert {r.map for r in given.rows} == {"small"}
 
 
@@ -353,8 +422,9 @@ def test_unknown_preset_is_reported_before_any_work(synthetic_dataset):
 
 
 def test_config_overrides_reach_the_matcher(synthetic_dataset):
-    options = dict(matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot", workers=1, auto_m=False,
-                   human=False)
+    options = dict(
+        matchers=["planar"], variants=["T4"], m_grid=(0.1,), preset="robot", workers=1, auto_m=False, human=False
+    )
     plain = run_evaluation(synthetic_dataset, **options)
     assert any(row.seeds > 1 for row in plain.rows)
     capped = run_evaluation(synthetic_dataset, config_overrides={"max_seeds": 1}, **options)
@@ -367,14 +437,17 @@ def test_config_overrides_reach_the_matcher(synthetic_dataset):
 
 @pytest.mark.dataset
 def test_three_kth_sketches_end_to_end():
-    from ursim_core.datasets import MISSING_REASON, dataset_root
+    from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 
     root = dataset_root()
     if root is None:
         pytest.skip(MISSING_REASON)
     result = run_evaluation(
-        root / "ursim_kth_sketches", matchers=["planar", "hungarian"], variants=["T4", "baseline"],
-        maps=["01", "03", "11"], workers=1,
+        root / "ursim_kth_sketches",
+        matchers=["planar", "hungarian"],
+        variants=["T4", "baseline"],
+        maps=["01", "03", "11"],
+        workers=1,
     )
     assert {r.map for r in result.rows} == {"01", "03", "11"}
     assert len(result.rows) == 3 * 2 * 2 * 2 * (len(DEFAULT_M_GRID) + 1)
@@ -400,8 +473,17 @@ def test_disk_cache_misses_when_a_map_changes(synthetic_dataset, tmp_path):
 
     dataset = tmp_path / "dataset"
     shutil.copytree(synthetic_dataset, dataset)
-    options = dict(matchers=["hungarian"], variants=["T1"], m_grid=(0.1,), preset="robot", metric_preset="robot", workers=1,
-                   cache_dir=tmp_path / "segcache", auto_m=False, human=False)
+    options = dict(
+        matchers=["hungarian"],
+        variants=["T1"],
+        m_grid=(0.1,),
+        preset="robot",
+        metric_preset="robot",
+        workers=1,
+        cache_dir=tmp_path / "segcache",
+        auto_m=False,
+        human=False,
+    )
     run_evaluation(dataset, **options)
     Image.fromarray(_plan(1.2)).save(dataset / "sketches" / "small.png")
     again = run_evaluation(dataset, **options)
@@ -417,5 +499,12 @@ def test_an_exception_in_progress_stops_the_worker_pool(synthetic_dataset):
             raise Cancelled(text)
 
     with pytest.raises(Cancelled):
-        run_evaluation(synthetic_dataset, matchers=["planar", "hungarian"], variants=["T4", "T1"], m_grid=GRID,
-                       preset="robot", workers=2, progress=cancel_when_matching)
+        run_evaluation(
+            synthetic_dataset,
+            matchers=["planar", "hungarian"],
+            variants=["T4", "T1"],
+            m_grid=GRID,
+            preset="robot",
+            workers=2,
+            progress=cancel_when_matching,
+        )

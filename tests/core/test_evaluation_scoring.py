@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from ursim_core.correspondences import Clique, Correspondences
+from ursim_core.correspondences.codec import Clique, Correspondences
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation_scoring import MatchScore, score_cliques, score_matches
+from ursim_core.evaluation.scoring import MatchScore, score_cliques, score_matches
 
 # Three one-to-one cliques.
 SIMPLE = [({1}, {10}), ({2}, {20}), ({3}, {30})]
@@ -164,10 +164,14 @@ def test_an_annotation_scored_against_itself_is_perfect():
 
 
 def test_score_cliques_between_two_annotators():
-    annotator_a = [Clique(id=1, sketch_regions=[1], metric_regions=[10]),
-                   Clique(id=2, sketch_regions=[2, 3], metric_regions=[20])]
-    annotator_b = [Clique(id=7, sketch_regions=[1, 2], metric_regions=[10]),
-                   Clique(id=8, sketch_regions=[3], metric_regions=[20, 21])]
+    annotator_a = [
+        Clique(id=1, sketch_regions=[1], metric_regions=[10]),
+        Clique(id=2, sketch_regions=[2, 3], metric_regions=[20]),
+    ]
+    annotator_b = [
+        Clique(id=7, sketch_regions=[1, 2], metric_regions=[10]),
+        Clique(id=8, sketch_regions=[3], metric_regions=[20, 21]),
+    ]
     score = score_cliques(annotator_b, annotator_a)
     # B's pairs: (1,10) tp, (2,10) fp, (3,20) tp, (3,21) fp; both of A's cliques are hit.
     assert score.pairs == ((1, 10), (2, 10), (3, 20), (3, 21))

@@ -1,4 +1,4 @@
-"""Tests of ursim_core.maps: image and ROS YAML loading, errors, pixel/world conversion."""
+"""Tests of ursim_core.io.maps: image and ROS YAML loading, errors, pixel/world conversion."""
 
 from __future__ import annotations
 
@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 from PIL import Image, ImageFile, PngImagePlugin
 
-from ursim_core.datasets import MISSING_REASON, dataset_root
 from ursim_core.errors import MapError, ParameterError
-from ursim_core.maps import (
+from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
+from ursim_core.io.maps import (
     DEFAULT_MAX_PIXELS,
     OCCUPANCY_FREE,
     OCCUPANCY_OCCUPIED,
@@ -488,7 +488,9 @@ def test_32_bit_values_beyond_16_bit_are_unsupported(tmp_path):
 # ROS map_server YAML
 
 
-def write_ros_map(folder: Path, pixels: np.ndarray, yaml_text: str, *, image_name: str = "map.png", yaml_name: str = "map.yaml") -> Path:
+def write_ros_map(
+    folder: Path, pixels: np.ndarray, yaml_text: str, *, image_name: str = "map.png", yaml_name: str = "map.yaml"
+) -> Path:
     image_path = folder / image_name
     image_path.parent.mkdir(parents=True, exist_ok=True)
     mode = "LA" if pixels.ndim == 3 and pixels.shape[2] == 2 else None
@@ -512,7 +514,9 @@ def test_ros_yaml_trinary(tmp_path):
     )
     loaded = load_map(yaml_path)
     occupied, free, unknown = OCCUPANCY_OCCUPIED, OCCUPANCY_FREE, OCCUPANCY_UNKNOWN
-    np.testing.assert_array_equal(loaded.occupancy, [[occupied, occupied, unknown, unknown], [unknown, free, free, free]])
+    np.testing.assert_array_equal(
+        loaded.occupancy, [[occupied, occupied, unknown, unknown], [unknown, free, free, free]]
+    )
     assert loaded.occupancy.dtype == np.int8
     np.testing.assert_array_equal(loaded.free, loaded.occupancy == 0)
     np.testing.assert_array_equal(loaded.image, ROS_GREY)
@@ -566,7 +570,9 @@ def test_ros_yaml_trinary_averages_alpha_in(tmp_path):
 
 def test_ros_yaml_raw_mode(tmp_path):
     grey = np.array([[0, 50, 100, 101, 255]], np.uint8)
-    yaml_path = write_ros_map(tmp_path, grey, "image: map.png\nresolution: 0.1\norigin: [0, 0, 0]\nmode: raw\nnegate: 1\n")
+    yaml_path = write_ros_map(
+        tmp_path, grey, "image: map.png\nresolution: 0.1\norigin: [0, 0, 0]\nmode: raw\nnegate: 1\n"
+    )
     loaded = load_map(yaml_path)
     np.testing.assert_array_equal(loaded.occupancy, [[0, 50, 100, -1, -1]])
     np.testing.assert_array_equal(loaded.free, [[True, False, False, False, False]])
@@ -575,7 +581,9 @@ def test_ros_yaml_raw_mode(tmp_path):
 def test_ros_yaml_16_bit_image(tmp_path):
     # A 16-bit pixel of 257 * p has exactly the shade of the 8-bit pixel p.
     words = (ROS_GREY.astype(np.uint16) * 257).astype(np.uint16)
-    yaml_path = write_ros_map(tmp_path, words, "image: map.png\nresolution: 0.1\norigin: [0, 0, 0]\nfree_thresh: 0.196\n")
+    yaml_path = write_ros_map(
+        tmp_path, words, "image: map.png\nresolution: 0.1\norigin: [0, 0, 0]\nfree_thresh: 0.196\n"
+    )
     np.testing.assert_array_equal(load_map(yaml_path).occupancy, [[100, 100, -1, -1], [-1, 0, 0, 0]])
 
 
@@ -823,7 +831,7 @@ def test_geometry_needs_a_resolution(tmp_path):
 
 
 def test_import_does_not_load_pillow_or_yaml():
-    code = "import sys, ursim_core.maps; print('PIL' in sys.modules, 'yaml' in sys.modules)"
+    code = "import sys, ursim_core.io.maps; print('PIL' in sys.modules, 'yaml' in sys.modules)"
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.split() == ["False", "False"]
 

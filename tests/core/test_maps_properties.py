@@ -1,4 +1,4 @@
-"""Property tests of ursim_core.maps on random inputs (hypothesis)."""
+"""Property tests of ursim_core.io.maps on random inputs (hypothesis)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from hypothesis.extra.numpy import arrays
 from PIL import Image
 
 from ursim_core.errors import MapError
-from ursim_core.maps import Map, load_map, map_from_array, pixel_to_world, world_to_pixel
+from ursim_core.io.maps import Map, load_map, map_from_array, pixel_to_world, world_to_pixel
 
 shapes = st.tuples(st.integers(1, 12), st.integers(1, 12))
 thresholds = st.integers(0, 254)

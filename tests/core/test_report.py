@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ursim_core.evaluation import RUN_COLUMNS, EvaluationResult, RunRow, m_label
-from ursim_core.report import (
+from ursim_core.evaluation.report import (
     PAPER_TABLE1,
     RELEASED_KTH,
     format_tables,
@@ -21,6 +20,7 @@ from ursim_core.report import (
     runs_csv,
     write_report,
 )
+from ursim_core.evaluation.runner import RUN_COLUMNS, EvaluationResult, RunRow, m_label
 
 MATCHERS = ("planar", "hungarian")
 VARIANTS = ("T4", "baseline")
@@ -44,27 +44,75 @@ def _result(*, human: bool = True) -> EvaluationResult:
                     for m in (*GRID, "auto"):
                         value = 0.1 if m == "auto" else m
                         f1 = _f1(name, annotator, matcher, variant, value)
-                        rows.append(RunRow(
-                            map=name, annotator=annotator, matcher=matcher, variant=variant,
-                            m_label="auto" if m == "auto" else m_label(m), m_value=value,
-                            tp=2, fp=1, fn=1, precision=f1, recall=f1, f1=f1, seeds=4,
-                            n_sketch_regions=5, n_metric_regions=6, time_s=0.002, model="model_simple",
-                            n_pairs=3, reason="" if value else "no seeds: no pair of regions has c <= m = 0",
-                        ))
+                        rows.append(
+                            RunRow(
+                                map=name,
+                                annotator=annotator,
+                                matcher=matcher,
+                                variant=variant,
+                                m_label="auto" if m == "auto" else m_label(m),
+                                m_value=value,
+                                tp=2,
+                                fp=1,
+                                fn=1,
+                                precision=f1,
+                                recall=f1,
+                                f1=f1,
+                                seeds=4,
+                                n_sketch_regions=5,
+                                n_metric_regions=6,
+                                time_s=0.002,
+                                model="model_simple",
+                                n_pairs=3,
+                                reason="" if value else "no seeds: no pair of regions has c <= m = 0",
+                            )
+                        )
     human_rows = []
     if human:
         for name, f1 in (("00", 1.0), ("01", 0.8), ("02", 0.6)):
             for reference, scored in (("malcolm", "vasiliki"), ("vasiliki", "malcolm")):
-                human_rows.append(RunRow(name, reference, "human", scored, "-", math.nan, 2, 0, 1, 1.0, 2 / 3, f1,
-                                         0, 5, 6, 0.0, "model_simple", 2))
+                human_rows.append(
+                    RunRow(
+                        name,
+                        reference,
+                        "human",
+                        scored,
+                        "-",
+                        math.nan,
+                        2,
+                        0,
+                        1,
+                        1.0,
+                        2 / 3,
+                        f1,
+                        0,
+                        5,
+                        6,
+                        0.0,
+                        "model_simple",
+                        2,
+                    )
+                )
     settings = {
-        "dataset": "/data/kth", "matchers": list(MATCHERS), "variants": list(VARIANTS), "m_grid": list(GRID),
-        "auto_m": True, "presets_used": ["robot", "sketch"], "scoring": "correct", "workers": 2, "n_experiments": 3,
+        "dataset": "/data/kth",
+        "matchers": list(MATCHERS),
+        "variants": list(VARIANTS),
+        "m_grid": list(GRID),
+        "auto_m": True,
+        "presets_used": ["robot", "sketch"],
+        "scoring": "correct",
+        "workers": 2,
+        "n_experiments": 3,
         "config": {"rotation_search": "min"},
     }
     timings = {"segmentation_s": 1.5, "matching_s": 2.5, "total_s": 4.0, "maps": 4, "maps_from_cache": 1}
-    return EvaluationResult(rows=tuple(rows), human_rows=tuple(human_rows), settings=settings, timings=timings,
-                            notes=("01 (malcolm): 1 ground-truth point(s) more than 10 px from any region, dropped",))
+    return EvaluationResult(
+        rows=tuple(rows),
+        human_rows=tuple(human_rows),
+        settings=settings,
+        timings=timings,
+        notes=("01 (malcolm): 1 ground-truth point(s) more than 10 px from any region, dropped",),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -76,12 +124,32 @@ def test_csv_has_the_columns_and_one_line_per_run(result):
     parsed = list(csv.DictReader(io.StringIO(runs_csv(result))))
     assert tuple(parsed[0]) == RUN_COLUMNS
     assert RUN_COLUMNS[:16] == (
-        "map", "annotator", "matcher", "variant", "m_label", "m_value", "tp", "fp", "fn", "precision", "recall", "f1",
-        "seeds", "n_sketch_regions", "n_metric_regions", "time_s",
+        "map",
+        "annotator",
+        "matcher",
+        "variant",
+        "m_label",
+        "m_value",
+        "tp",
+        "fp",
+        "fn",
+        "precision",
+        "recall",
+        "f1",
+        "seeds",
+        "n_sketch_regions",
+        "n_metric_regions",
+        "time_s",
     )
     assert len(parsed) == len(result.rows) + len(result.human_rows)
     first = parsed[0]
-    assert (first["map"], first["annotator"], first["matcher"], first["variant"], first["m_label"]) == ("00", "malcolm", "planar", "T4", "0")
+    assert (first["map"], first["annotator"], first["matcher"], first["variant"], first["m_label"]) == (
+        "00",
+        "malcolm",
+        "planar",
+        "T4",
+        "0",
+    )
     assert float(first["f1"]) == pytest.approx(0.3)
     human = [line for line in parsed if line["matcher"] == "human"]
     assert len(human) == 6 and human[0]["m_value"] == "" and human[0]["variant"] == "vasiliki"
@@ -99,10 +167,14 @@ def test_text_tables_are_table_1_style(result):
     oracle_block = text.split("F1, oracle m (best m of the grid for each map), annotator malcolm")[1].split("\n\n")[0]
     planar_mean = next(line for line in oracle_block.splitlines() if line.startswith("Planar mean"))
     assert planar_mean.split()[-3:] == ["0.60", "±", "0.20"]
-    fixed_block = text.split("F1, best single fixed m (highest mean F1 over the maps), annotator malcolm")[1].split("\n\n")[0]
+    fixed_block = text.split("F1, best single fixed m (highest mean F1 over the maps), annotator malcolm")[1].split(
+        "\n\n"
+    )[0]
     best_m = next(line for line in fixed_block.splitlines() if line.startswith("Planar best m"))
     assert best_m.split()[-1] == "0.1"
-    assert "Human vs human (vasiliki's cliques scored against malcolm's): median 0.80, mean 0.80 ± 0.20 (3 maps)" in text
+    assert (
+        "Human vs human (vasiliki's cliques scored against malcolm's): median 0.80, mean 0.80 ± 0.20 (3 maps)" in text
+    )
     assert "0.568/0.633" in text  # the released code's oracle, fnfix, malcolm (mean/median)
     assert "time: segmentation 1.5 s" in text
 
@@ -124,7 +196,10 @@ def test_markdown_summary_has_tables_human_line_published_figures_and_notes(resu
     assert "## Human vs human" in text
     assert "## Mean F1 for each fixed m" in text and "| 0.1 |" in text
     paper_planar_t4 = PAPER_TABLE1["planar"]["median"]["T4"]
-    assert f"| Planar median | {PAPER_TABLE1['planar']['median']['baseline']:.2f}" in text and f"{paper_planar_t4:.2f}" in text
+    assert (
+        f"| Planar median | {PAPER_TABLE1['planar']['median']['baseline']:.2f}" in text
+        and f"{paper_planar_t4:.2f}" in text
+    )
     assert "dropped" in text  # the notes
     assert "no seeds: no pair of regions has c <= m = ..." in text  # degenerate runs grouped
 

@@ -10,19 +10,19 @@ import pytest
 from PIL import Image
 from scipy import ndimage
 
-from ursim_core.correspondences import assign_regions, load_correspondences
+from ursim_core.correspondences.codec import assign_regions, load_correspondences
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation_scoring import score_matches
+from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import match
 from ursim_core.segmentation import segment
-from ursim_core.synth import (
+from ursim_core.synth.generator import (
+    Sketch,
     generate_floor_plan,
     ground_truth_correspondences,
     ground_truth_pairs,
     interior_points,
     make_large_building,
     make_pair,
-    Sketch,
     save_example,
     sketchify,
 )
@@ -115,12 +115,21 @@ def test_sketchify_keeps_place_labels_consistent(seed):
 
 def test_sketchify_without_distortion_is_the_plan_cropped():
     plan = generate_floor_plan(seed=1)
-    sketch = sketchify(plan, scale=1.0, scale_jitter=0.0, wobble=0.0, rotation_deg=0.0, pen_width=0.0,
-                       pen_noise=0.0, drop_corridor=False, extra_corridor=False)
+    sketch = sketchify(
+        plan,
+        scale=1.0,
+        scale_jitter=0.0,
+        wobble=0.0,
+        rotation_deg=0.0,
+        pen_width=0.0,
+        pen_noise=0.0,
+        drop_corridor=False,
+        extra_corridor=False,
+    )
     rows, cols = np.nonzero(plan.free)
-    window = plan.rooms[rows.min():rows.max() + 1, cols.min():cols.max() + 1]
+    window = plan.rooms[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
     rows, cols = np.nonzero(sketch.free)
-    assert np.array_equal(sketch.rooms[rows.min():rows.max() + 1, cols.min():cols.max() + 1], window)
+    assert np.array_equal(sketch.rooms[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1], window)
     assert sketch.dropped == sketch.extra == ()
 
 
@@ -137,9 +146,9 @@ def test_sketchify_can_drop_a_room_and_rejects_bad_options():
 
 def test_interior_points_are_the_middle_of_the_widest_part():
     labels = np.zeros((20, 40), np.int32)
-    labels[2:18, 2:12] = 1        # 16 x 10: ridge along col 6..7, middle at row 9..10
-    labels[2:18, 12:38] = 2       # 16 x 26, touching region 1 (a label change is a border)
-    labels[9:11, 1:2] = 3         # a 2-pixel region still gets one of its pixels
+    labels[2:18, 2:12] = 1  # 16 x 10: ridge along col 6..7, middle at row 9..10
+    labels[2:18, 12:38] = 2  # 16 x 26, touching region 1 (a label change is a border)
+    labels[9:11, 1:2] = 3  # a 2-pixel region still gets one of its pixels
     points = interior_points(labels)
     assert set(points) == {1, 2, 3}
     assert points[1][0] in (9, 10) and points[1][1] in (6, 7)

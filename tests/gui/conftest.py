@@ -38,8 +38,8 @@ def labels3() -> np.ndarray:
 
 @pytest.fixture
 def segmentation3(labels3):
-    from ursim_core.graph import region_graph
     from ursim_core.segmentation import Segmentation
+    from ursim_core.segmentation.graph import region_graph
 
     return Segmentation(labels=labels3, graph=region_graph(labels3), method="label-image")
 

@@ -40,21 +40,37 @@ def test_screenshot_subprocess_offscreen(map_files, tmp_path):
     shot = tmp_path / "sub.png"
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "URSIM_GUI_DATA_DIR": str(tmp_path / "data")}
     done = subprocess.run(
-        [sys.executable, "-m", "ursim_gui", str(map_files["sketch"]), str(map_files["metric"]), "--screenshot", str(shot)],
-        env=env, capture_output=True, text=True, timeout=180, cwd=Path(app.__file__).parent.parent,
+        [
+            sys.executable,
+            "-m",
+            "ursim_gui",
+            str(map_files["sketch"]),
+            str(map_files["metric"]),
+            "--screenshot",
+            str(shot),
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        cwd=Path(app.__file__).parent.parent,
     )
     assert done.returncode == 0, done.stderr
     assert shot.stat().st_size > 10_000
 
 
 def test_excepthook_logs_and_shows_instead_of_crashing(qtbot, caplog, monkeypatch):
-    monkeypatch.setattr(sys, "excepthook", sys.excepthook)   # restored after the test
+    monkeypatch.setattr(sys, "excepthook", sys.excepthook)  # restored after the test
     app.install_excepthook()
     try:
         raise RuntimeError("boom")
     except RuntimeError:
         sys.excepthook(*sys.exc_info())
-    assert any("boom" in record.getMessage() or "boom" in (record.exc_text or "") for record in caplog.records if record.levelno == logging.ERROR)
+    assert any(
+        "boom" in record.getMessage() or "boom" in (record.exc_text or "")
+        for record in caplog.records
+        if record.levelno == logging.ERROR
+    )
     from PySide6.QtWidgets import QApplication
 
     boxes = [w for w in QApplication.topLevelWidgets() if isinstance(w, QMessageBox) and w.isVisible()]

@@ -3,11 +3,11 @@ keyboard; F1 opens the shortcut sheet listing them."""
 
 from __future__ import annotations
 
+from conftest import region_point
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import QApplication
 
-from conftest import region_point
 from ursim_gui.shortcuts import SHORTCUTS, ShortcutSheet
 
 
@@ -32,9 +32,9 @@ def test_link_unlink_delete_accept_reject_undo_redo_with_keys(window, qtbot):
     assert (clique.sketch_regions, clique.metric_regions, clique.source) == ((1,), (2,), "manual")
     assert window.table.model.rowCount() == 1
 
-    click(qtbot, sketch, 1)                                     # selects the clique
+    click(qtbot, sketch, 1)  # selects the clique
     assert session.selected_clique == clique.id
-    click(qtbot, metric, 3, Qt.KeyboardModifier.ControlModifier)   # add a region to it
+    click(qtbot, metric, 3, Qt.KeyboardModifier.ControlModifier)  # add a region to it
     key(qtbot, window, Qt.Key.Key_L)
     assert session.clique(clique.id).metric_regions == (2, 3)
 

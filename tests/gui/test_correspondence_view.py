@@ -3,9 +3,8 @@ the partners, connector lines, and the table is synced with the views both ways.
 
 from __future__ import annotations
 
-from PySide6.QtCore import QPointF, Qt
-
 from conftest import region_point
+from PySide6.QtCore import QPointF, Qt
 
 
 def overlay_colour(view, region: int):
@@ -22,7 +21,7 @@ def test_matched_regions_share_the_clique_colour(window):
     sketch, metric = window.views["sketch"], window.views["metric"]
     assert overlay_colour(sketch, 1) == overlay_colour(metric, 3) == session.color_of_clique(first)
     assert overlay_colour(sketch, 2) == overlay_colour(metric, 2) == session.color_of_clique(second)
-    assert overlay_colour(sketch, 3) != overlay_colour(metric, 3)              # unmatched: neutral
+    assert overlay_colour(sketch, 3) != overlay_colour(metric, 3)  # unmatched: neutral
     row = window.table.model.row_of(first)
     swatch = window.table.model.data(window.table.model.index(row, 0), Qt.ItemDataRole.DecorationRole)
     assert (swatch.red(), swatch.green(), swatch.blue()) == session.color_of_clique(first)
@@ -37,7 +36,7 @@ def test_hover_highlights_partners_in_the_other_view(window, qtbot):
     assert metric.marked_regions("highlight") == set()
     qtbot.mouseMove(metric.viewport(), region_point(metric, 3))
     assert sketch.marked_regions("highlight") == {1}
-    window.session.unlink("sketch", 1)                       # an edit updates the hovered highlight
+    window.session.unlink("sketch", 1)  # an edit updates the hovered highlight
     assert sketch.marked_regions("highlight") == set()
 
 
@@ -69,8 +68,8 @@ def test_connector_lines_follow_the_cliques(window):
     segments = overlay.visible_segments()
     assert len(segments) == 2
     sketch_end, metric_end = segments[1]
-    assert sketch_end.x() < metric_end.x()                       # from the left view to the right one
-    window.views["metric"].set_zoom(32)                          # zoomed in: some ends leave the view
+    assert sketch_end.x() < metric_end.x()  # from the left view to the right one
+    window.views["metric"].set_zoom(32)  # zoomed in: some ends leave the view
     assert len(overlay.visible_segments()) < 2
     window.actions["connectors"].trigger()
     assert not overlay.isVisible()
@@ -97,7 +96,7 @@ def test_note_cell_edits_the_clique_note(window, qtbot):
 
     editor = window.table.view.findChild(QLineEdit)
     editor.setText("kitchen")
-    qtbot.keyClick(editor, Qt.Key.Key_Return)                # the delegate commits on the next loop
+    qtbot.keyClick(editor, Qt.Key.Key_Return)  # the delegate commits on the next loop
     qtbot.waitUntil(lambda: window.session.clique(clique).note == "kitchen")
     assert model.data(note) == "kitchen"
     window.session.undo()

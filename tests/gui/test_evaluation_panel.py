@@ -6,14 +6,17 @@ from __future__ import annotations
 import pytest
 from PySide6.QtWidgets import QFileDialog
 
-from ursim_core.correspondences import Clique, Correspondences, save_correspondences, save_dat
+from ursim_core.correspondences.codec import Clique, Correspondences, save_correspondences, save_dat
 
 
 def reference_cliques():
     # Points inside rooms 1, 2, 3 of both maps (the metric map is the sketch scaled by 2).
-    return Correspondences(cliques=tuple(
-        Clique(id=i, sketch_points=[(30, col)], metric_points=[(60, 2 * col)]) for i, col in ((1, 25), (2, 75), (3, 120))
-    ))
+    return Correspondences(
+        cliques=tuple(
+            Clique(id=i, sketch_points=[(30, col)], metric_points=[(60, 2 * col)])
+            for i, col in ((1, 25), (2, 75), (3, 120))
+        )
+    )
 
 
 @pytest.mark.parametrize("suffix", [".json", ".dat"])
@@ -35,7 +38,7 @@ def test_reference_scores_live_and_marks_cliques(window, tmp_path, monkeypatch, 
     assert window.views["sketch"].badge_texts() == {1: "TP", 2: "FP"}
     assert panel.missed.count() == 2 and panel.missed.item(0).text() == "2  ↔  2"
 
-    session.delete_clique(bad)                                   # live: every edit re-scores
+    session.delete_clique(bad)  # live: every edit re-scores
     assert panel.values["precision"].text() == "1.000"
     session.link([2], [2])
     session.link([3], [3])

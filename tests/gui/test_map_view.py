@@ -16,8 +16,16 @@ from ursim_gui.overlay import region_colour_table
 def wheel(view: MapView, position: QPoint, steps: int) -> None:
     """Send a real wheel event to the viewport (qtbot has no wheel helper)."""
     global_pos = view.viewport().mapToGlobal(position)
-    event = QWheelEvent(QPointF(position), QPointF(global_pos), QPoint(), QPoint(0, 120 * steps),
-                        Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    event = QWheelEvent(
+        QPointF(position),
+        QPointF(global_pos),
+        QPoint(),
+        QPoint(0, 120 * steps),
+        Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+        Qt.ScrollPhase.NoScrollPhase,
+        False,
+    )
     QApplication.sendEvent(view.viewport(), event)
 
 
@@ -41,7 +49,7 @@ def test_wheel_zooms_around_the_cursor_up_to_3200_percent(view):
     wheel(view, cursor, 2)
     assert view.zoom_factor() == pytest.approx(zoom * 1.25**2)
     after = view.mapToScene(cursor)
-    assert abs(after.x() - before.x()) < 1.0 and abs(after.y() - before.y()) < 1.0   # point under the cursor stays
+    assert abs(after.x() - before.x()) < 1.0 and abs(after.y() - before.y()) < 1.0  # point under the cursor stays
     for _ in range(40):
         wheel(view, cursor, 3)
     assert view.zoom_factor() == pytest.approx(MAX_ZOOM)
@@ -55,11 +63,11 @@ def test_fit_to_window_shows_the_whole_map_and_follows_resizes(view, qtbot):
     assert visible.contains(view.sceneRect().adjusted(1, 1, -1, -1))
     fitted = view.zoom_factor()
     view.resize(300, 150)
-    qtbot.waitUntil(lambda: view.zoom_factor() < fitted)           # still fitted after a resize
+    qtbot.waitUntil(lambda: view.zoom_factor() < fitted)  # still fitted after a resize
     view.set_zoom(4)
     view.resize(600, 300)
     qtbot.wait(20)
-    assert view.zoom_factor() == 4                                   # a chosen zoom is kept
+    assert view.zoom_factor() == 4  # a chosen zoom is kept
 
 
 def test_drag_pans_without_selecting(qtbot, view):
@@ -98,7 +106,9 @@ def test_pixels_are_nearest_neighbour_at_high_zoom(qtbot, view):
     view.centerOn(4, 4)
     image = view.viewport().grab().toImage()
     centre = view.mapFromScene(QPointF(4.5, 4.5))  # middle of white pixel (4, 4)
-    values = {image.pixelColor(centre.x() + dx, centre.y() + dy).red() for dx in range(-14, 15, 7) for dy in range(-14, 15, 7)}
+    values = {
+        image.pixelColor(centre.x() + dx, centre.y() + dy).red() for dx in range(-14, 15, 7) for dy in range(-14, 15, 7)
+    }
     assert values == {255}
     neighbour = view.mapFromScene(QPointF(5.5, 4.5))
     assert image.pixelColor(neighbour).red() < 250
@@ -125,7 +135,9 @@ def test_drop_reports_paths(view, tmp_path):
     view.files_dropped.connect(dropped.extend)
     data = QMimeData()
     data.setUrls([QUrl.fromLocalFile(str(tmp_path / "map.png"))])
-    event = QDropEvent(QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
+    event = QDropEvent(
+        QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+    )
     view.dropEvent(event)
     assert dropped == [tmp_path / "map.png"]
 

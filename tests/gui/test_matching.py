@@ -19,7 +19,7 @@ def test_match_button_runs_in_the_worker_and_applies_the_result(window, qtbot):
     timer.start(10)
     with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
         qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
-        assert not panel.match_button.isEnabled()                  # one job at a time
+        assert not panel.match_button.isEnabled()  # one job at a time
     timer.stop()
     session = window.session
     assert session.last_match is not None and session.last_match.config.matcher == "hungarian"
@@ -36,7 +36,7 @@ def test_cancel_drops_a_running_segmentation(window, qtbot):
     assert window.status.cancel_button.isVisible()
     with qtbot.waitSignal(window.jobs.runner.cancelled, timeout=60_000):
         qtbot.mouseClick(window.status.cancel_button, Qt.MouseButton.LeftButton)
-    assert window.session.segmentation("metric") is before              # result discarded
+    assert window.session.segmentation("metric") is before  # result discarded
     assert not window.status.cancel_button.isVisible()
     assert window.matching_panel.match_button.isEnabled()
 
@@ -53,7 +53,7 @@ def test_match_without_segmentations_explains_why(window):
 def test_a_result_for_a_replaced_map_is_dropped(window, qtbot, map_files):
     before = window.session.segmentation("sketch")
     window.segmentation_panel.boxes["sketch"].segment_button.click()
-    window.session.load_map("sketch", map_files["sketch"])           # replaced while the job runs
+    window.session.load_map("sketch", map_files["sketch"])  # replaced while the job runs
     qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
-    assert window.session.segmentation("sketch") is None               # the stale result was not applied
+    assert window.session.segmentation("sketch") is None  # the stale result was not applied
     assert before is not None and "dropped" in window.status.currentMessage()

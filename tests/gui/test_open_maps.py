@@ -6,11 +6,11 @@ from __future__ import annotations
 import json
 
 import pytest
+from conftest import error_boxes
 from PySide6.QtCore import QMimeData, QPointF, Qt, QUrl
 from PySide6.QtGui import QDropEvent
 from PySide6.QtWidgets import QFileDialog
 
-from conftest import error_boxes
 from ursim_gui.app import parse_args
 from ursim_gui.main_window import MainWindow
 
@@ -44,14 +44,20 @@ def test_drop_on_a_view_opens_that_side(empty_window, map_files):
     view = empty_window.views["metric"]
     data = QMimeData()
     data.setUrls([QUrl.fromLocalFile(str(map_files["metric"]))])
-    view.dropEvent(QDropEvent(QPointF(5, 5), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier))
+    view.dropEvent(
+        QDropEvent(
+            QPointF(5, 5), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+        )
+    )
     assert empty_window.session.map("metric").path == map_files["metric"]
     assert view.has_image()
 
 
 def test_ros_yaml_map_opens(empty_window, map_files, tmp_path, monkeypatch):
     yaml_path = tmp_path / "ros.yaml"
-    yaml_path.write_text(f"image: {map_files['metric'].name}\nresolution: 0.05\norigin: [-1.0, -2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    yaml_path.write_text(
+        f"image: {map_files['metric'].name}\nresolution: 0.05\norigin: [-1.0, -2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
     choose_file(monkeypatch, yaml_path)
     empty_window.actions["open_metric"].trigger()
     assert empty_window.session.map("metric").resolution == pytest.approx(0.05)

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-
 from conftest import three_room_labels
-from ursim_core.correspondences import Clique, Correspondences
-from ursim_core.graph import region_graph
+
+from ursim_core.correspondences.codec import Clique, Correspondences
+from ursim_core.segmentation.graph import region_graph
 from ursim_gui.overlay import (
     NEUTRAL_REGION,
     clique_colour,
@@ -50,9 +50,9 @@ def test_outline_marks_only_region_borders():
     labels[1:5, 1:3] = 1
     labels[1:5, 3:5] = 2
     mask = outline_mask(labels)
-    assert mask[2, 2] and mask[2, 3]          # the shared border
-    assert mask[1, 1]                         # border with the wall
-    assert not mask[0, 0]                     # walls stay clean
+    assert mask[2, 2] and mask[2, 3]  # the shared border
+    assert mask[1, 1]  # border with the wall
+    assert not mask[0, 0]  # walls stay clean
     labels_big = np.ones((6, 6), np.int32)
     labels_big[2:4, 2:4] = 2
     assert not outline_mask(labels_big)[0, 0]
@@ -85,7 +85,7 @@ def test_side_colours_follow_cliques_and_match_across_views():
     sketch = side_colour_table(corr, "sketch", labels, clique_colour)
     metric = side_colour_table(corr, "metric", labels, clique_colour)
     assert tuple(sketch[1, :3]) == clique_colour(1) == tuple(metric[3, :3])
-    assert tuple(sketch[2, :3]) == NEUTRAL_REGION        # rejected clique is not coloured
+    assert tuple(sketch[2, :3]) == NEUTRAL_REGION  # rejected clique is not coloured
     assert tuple(metric[1, :3]) == NEUTRAL_REGION
     plain = side_colour_table(Correspondences(), "sketch", labels, clique_colour)
     assert tuple(plain[1, :3]) == palette_colour(1)
@@ -93,7 +93,7 @@ def test_side_colours_follow_cliques_and_match_across_views():
 
 def test_connector_ends_and_badges():
     corr = Correspondences(cliques=(*_corr().cliques, Clique(id=3, sketch_regions=(3,))))
-    assert first_regions(corr) == [(1, 1, 3)]             # rejected and one-sided cliques: no line
+    assert first_regions(corr) == [(1, 1, 3)]  # rejected and one-sided cliques: no line
     marks = {1: "tp", 2: "fp"}
     assert eval_badges(corr, "sketch", marks.get) == {1: "TP", 2: "FP"}
     assert eval_badges(corr, "metric", marks.get) == {3: "TP", 2: "FP"}

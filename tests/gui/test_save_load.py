@@ -6,11 +6,11 @@ from __future__ import annotations
 import time
 
 import pytest
+from conftest import error_boxes
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
 
-from conftest import error_boxes
-from ursim_core.correspondences import load_correspondences, load_dat
+from ursim_core.correspondences.codec import load_correspondences, load_dat
 from ursim_gui import dialogs
 from ursim_gui.main_window import MainWindow
 
@@ -33,7 +33,9 @@ def test_ctrl_s_saves_and_the_title_tracks_dirty(window, qtbot, tmp_path, monkey
     assert len(load_correspondences(target).cliques) == 2 and not window.session.dirty
     other = tmp_path / "copy.json"
     save_to(monkeypatch, other)
-    qtbot.keyClick(window.views["sketch"], Qt.Key.Key_S, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+    qtbot.keyClick(
+        window.views["sketch"], Qt.Key.Key_S, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier
+    )
     assert other.is_file() and window.session.path == other
 
 
@@ -103,7 +105,7 @@ def test_the_real_close_question_has_three_answers(qtbot):
 def test_autosave_and_recovery(window, qtbot, tmp_path, monkeypatch):
     session = window.session
     session.link([1], [2])
-    window.documents.autosaver.flush_if_due(time.monotonic() + 60)      # the timer's call, made due
+    window.documents.autosaver.flush_if_due(time.monotonic() + 60)  # the timer's call, made due
     folder = window.documents.autosave_dir
     (copy,) = folder.glob("*.autosave.json")
     assert load_correspondences(copy).cliques[0].metric_regions == (2,)
@@ -118,7 +120,7 @@ def test_autosave_and_recovery(window, qtbot, tmp_path, monkeypatch):
     assert offered and offered[0] == [copy]
     (clique,) = fresh.session.correspondences.cliques
     assert clique.metric_regions == (2,) and fresh.session.dirty
-    assert fresh.session.map("sketch") is not None                      # maps reopened from the copy
+    assert fresh.session.map("sketch") is not None  # maps reopened from the copy
     assert fresh.windowTitle().endswith("*")
     assert fresh.table.model.rowCount() == 1
 

@@ -4,10 +4,9 @@ parameters, loads a label image instead, and drives the overlay display options.
 from __future__ import annotations
 
 import pytest
+from conftest import error_boxes
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QFileDialog
-
-from conftest import error_boxes
 
 
 def test_segment_button_runs_maoris_with_the_chosen_preset(window, qtbot):
@@ -17,7 +16,7 @@ def test_segment_button_runs_maoris_with_the_chosen_preset(window, qtbot):
     assert box.overrides() == {"doors": 55}
     with qtbot.waitSignal(window.session.segmentation_changed, timeout=60_000):
         qtbot.mouseClick(box.segment_button, Qt.MouseButton.LeftButton)
-        assert window.status.progress_bar.isVisible()        # job UI shows while it runs
+        assert window.status.progress_bar.isVisible()  # job UI shows while it runs
     segmentation = window.session.segmentation("sketch")
     assert segmentation.method == "maoris" and segmentation.params["doors"] == 55
     assert segmentation.n_regions >= 2
@@ -27,8 +26,10 @@ def test_segment_button_runs_maoris_with_the_chosen_preset(window, qtbot):
 
 
 def test_load_label_image_button(window, map_files, monkeypatch):
-    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["metric_labels"]), "")))
-    window.session.set_map("metric", window.session.map("metric"))          # drops the segmentation
+    monkeypatch.setattr(
+        QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["metric_labels"]), ""))
+    )
+    window.session.set_map("metric", window.session.map("metric"))  # drops the segmentation
     assert window.session.segmentation("metric") is None
     window.segmentation_panel.boxes["metric"].load_button.click()
     assert window.session.segmentation("metric").method == "label-image"
@@ -36,7 +37,9 @@ def test_load_label_image_button(window, map_files, monkeypatch):
 
 
 def test_label_image_of_the_wrong_size_is_refused(window, map_files, monkeypatch):
-    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["sketch_labels"]), "")))
+    monkeypatch.setattr(
+        QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["sketch_labels"]), ""))
+    )
     before = window.session.segmentation("metric")
     window.segmentation_panel.boxes["metric"].load_button.click()
     assert error_boxes(window)
@@ -49,7 +52,7 @@ def test_display_options_reach_both_views(window, qtbot):
     assert all(view.overlay_opacity() == pytest.approx(0.8) for view in views.values())
     panel.toggles["outlines"].setChecked(False)
     assert not views["sketch"].layers.outlines.isVisible() and not window.actions["outlines"].isChecked()
-    window.actions["region_ids"].trigger()                                   # menu and checkbox stay in sync
+    window.actions["region_ids"].trigger()  # menu and checkbox stay in sync
     assert panel.toggles["region_ids"].isChecked()
     assert views["metric"].visible_ids() == {1, 2, 3}
     panel.toggles["graph"].setChecked(True)

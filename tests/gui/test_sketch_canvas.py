@@ -17,11 +17,17 @@ def drag(qtbot, widget, start: QPoint, end: QPoint, steps: int = 5) -> None:
     for i in range(1, steps + 1):
         point = start + (end - start) * (i / steps)
         # QTest moves carry no button state; send real events with the left button held.
+        from PySide6.QtCore import QEvent, QPointF
         from PySide6.QtGui import QMouseEvent
-        from PySide6.QtCore import QPointF, QEvent
 
-        event = QMouseEvent(QEvent.Type.MouseMove, QPointF(point), QPointF(widget.mapToGlobal(point)),
-                            Qt.MouseButton.NoButton, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier)
+        event = QMouseEvent(
+            QEvent.Type.MouseMove,
+            QPointF(point),
+            QPointF(widget.mapToGlobal(point)),
+            Qt.MouseButton.NoButton,
+            Qt.MouseButton.LeftButton,
+            Qt.KeyboardModifier.NoModifier,
+        )
         QApplication.sendEvent(widget, event)
     qtbot.mouseRelease(widget, Qt.MouseButton.LeftButton, pos=end)
 
@@ -41,7 +47,7 @@ def test_new_sketch_from_the_menu_draw_undo_save_and_use(window, qtbot, tmp_path
     canvas = sketch.canvas
 
     sketch.width_spin.setValue(4)
-    drag(qtbot, canvas, QPoint(20, 30), QPoint(150, 30))               # pen stroke
+    drag(qtbot, canvas, QPoint(20, 30), QPoint(150, 30))  # pen stroke
     assert (sketch.document.image[30, 25:145] == INK).all()
     sketch.tool_actions["rectangle"].trigger()
     drag(qtbot, canvas, QPoint(40, 60), QPoint(120, 100))
@@ -54,7 +60,7 @@ def test_new_sketch_from_the_menu_draw_undo_save_and_use(window, qtbot, tmp_path
     assert (sketch.document.image[110, 12:188] == INK).all()
 
     assert sketch.undo_action.isEnabled()
-    sketch.undo_action.trigger()                                         # wall gone
+    sketch.undo_action.trigger()  # wall gone
     assert sketch.document.image[110, 100] == PAPER
     sketch.redo_action.trigger()
     assert sketch.document.image[110, 100] == INK

@@ -29,8 +29,8 @@ def test_shapes_are_redrawn_from_the_stroke_start():
     doc.tool = "rectangle"
     doc.width = 1
     doc.begin(5, 5)
-    doc.extend(50, 50)            # preview of a large rectangle...
-    doc.end(20, 20)               # ...replaced by the final one
+    doc.extend(50, 50)  # preview of a large rectangle...
+    doc.end(20, 20)  # ...replaced by the final one
     assert doc.image[5, 5] == INK and doc.image[20, 20] == INK
     assert doc.image[50, 50] == PAPER
     assert doc.image[12, 12] == PAPER  # outline only
@@ -75,11 +75,11 @@ def test_map_image_keeps_open_drawings_and_fills_outside_closed_ones():
     from ursim_gui.sketch_document import INK, PAPER, SketchDocument
 
     doc = SketchDocument(30, 40)
-    doc.image[15, 5:35] = INK                       # one wall, no outline: nothing is outside
+    doc.image[15, 5:35] = INK  # one wall, no outline: nothing is outside
     assert (doc.map_image() == doc.image).all()
     doc.image[3, 3:37] = doc.image[26, 3:37] = INK  # now a closed outline
     doc.image[3:27, 3] = doc.image[3:27, 36] = INK
     drawn = doc.map_image()
     assert drawn[0, 0] == INK and drawn[29, 39] == INK
     assert drawn[8, 20] == PAPER and drawn[20, 20] == PAPER
-    assert (doc.image[0, 0] == PAPER), "the drawing itself is not changed"
+    assert doc.image[0, 0] == PAPER, "the drawing itself is not changed"

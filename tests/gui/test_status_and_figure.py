@@ -3,11 +3,11 @@ both views with a legend can be exported."""
 
 from __future__ import annotations
 
+from conftest import error_boxes
 from PySide6.QtCore import QPointF
 from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QFileDialog
 
-from conftest import error_boxes
 from ursim_gui.status_bar import format_cursor, format_zoom
 
 
@@ -22,10 +22,12 @@ def test_status_bar_shows_pixel_region_and_zoom(window, qtbot):
 
 def test_status_bar_shows_world_coordinates_of_ros_maps(window, map_files, tmp_path, qtbot):
     yaml_path = tmp_path / "ros.yaml"
-    yaml_path.write_text(f"image: {map_files['metric'].name}\nresolution: 0.5\norigin: [10.0, 20.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    yaml_path.write_text(
+        f"image: {map_files['metric'].name}\nresolution: 0.5\norigin: [10.0, 20.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
     window.documents.open_map("metric", yaml_path)
     view = window.views["metric"]
-    qtbot.mouseMove(view.viewport(), view.mapFromScene(QPointF(0.5, 119.5)))   # the lower-left pixel
+    qtbot.mouseMove(view.viewport(), view.mapFromScene(QPointF(0.5, 119.5)))  # the lower-left pixel
     text = window.status.cursor_label.text()
     assert "px (119, 0)" in text and "world (10.25, 20.25) m" in text
 
@@ -48,12 +50,14 @@ def test_export_figure_writes_a_png_with_a_legend(window, tmp_path, monkeypatch)
     # The sketch's room 1 is drawn in clique 1's colour somewhere in the left half.
     colour = window.session.color_of_clique(1)
     found = any(
-        abs(image.pixelColor(x, y).red() - colour[0]) < 40 and abs(image.pixelColor(x, y).green() - colour[1]) < 40
+        abs(image.pixelColor(x, y).red() - colour[0]) < 40
+        and abs(image.pixelColor(x, y).green() - colour[1]) < 40
         and abs(image.pixelColor(x, y).blue() - colour[2]) < 40
-        for x in range(0, image.width() // 2, 7) for y in range(0, image.height() // 2, 7)
+        for x in range(0, image.width() // 2, 7)
+        for y in range(0, image.height() // 2, 7)
     )
     assert found
-    assert window.views["sketch"].marked_regions("selection") == {1}      # hidden only while rendering
+    assert window.views["sketch"].marked_regions("selection") == {1}  # hidden only while rendering
     assert all(item.isVisible() for item in window.views["sketch"].layers._marks["selection"])
 
 
@@ -68,7 +72,7 @@ def test_job_progress_starts_busy_and_becomes_a_percentage(qtbot):
     bar = CursorStatusBar()
     qtbot.addWidget(bar)
     bar.show_job(True)
-    assert (bar.progress_bar.minimum(), bar.progress_bar.maximum()) == (0, 0)      # busy
+    assert (bar.progress_bar.minimum(), bar.progress_bar.maximum()) == (0, 0)  # busy
     bar.show_progress(0.05, "matching")
     assert bar.progress_bar.maximum() == 0
     bar.show_progress(0.5, "matching at m = 0.225")

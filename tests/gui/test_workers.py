@@ -45,7 +45,7 @@ def test_job_runs_in_a_worker_and_the_gui_thread_stays_free(qtbot):
     timer.stop()
     assert blocker.args[0] is job
     name, pid, in_main_thread = blocker.args[1]
-    assert name == "done" and pid != os.getpid() and in_main_thread   # the child's main thread
+    assert name == "done" and pid != os.getpid() and in_main_thread  # the child's main thread
     assert progress[-1] == 1.0 and len(progress) >= 10
     gaps = [b - a for a, b in zip(ticks, ticks[1:])]
     # 0.3 s (not the 0.1 s budget) leaves room for a loaded CI machine; the GIL-holding
@@ -60,7 +60,7 @@ def test_cancel_drops_the_result(qtbot):
     finished = []
     runner.finished.connect(lambda job, result: finished.append(result))
     runner.start(SlowJob(steps=5000))
-    qtbot.waitSignal(runner.progress, timeout=60_000).wait()     # the child is working
+    qtbot.waitSignal(runner.progress, timeout=60_000).wait()  # the child is working
     with qtbot.waitSignal(runner.cancelled, timeout=5000):
         runner.cancel()
     assert finished == [] and not runner.busy

@@ -32,7 +32,7 @@ The released C++ measured on the same data: oracle .568 / .562, best fixed m .48
 
 Hyper-parameters: beta = ``position_weight`` = 2 and w = ``score_weight`` = 8 were chosen on
 data the KTH figures do not contain: generated pairs with exactly known ground truth
-(``ursim_core.synth.make_pair``, seeds 0-11). With the generator as it was then, (2, 8) scored mean
+(``ursim_core.synth.generator.make_pair``, seeds 0-11). With the generator as it was then, (2, 8) scored mean
 F1 .897 against .801 for the earlier (0.5, 4) and .967 for (2, 16); with the current generator
 (bends, crossings, dropped dead ends) .996 against .951 and .996. On KTH the three lie on a flat
 plateau (.677, .659 and .629 mean of the two annotators), so (2, 8) was kept as the setting good on
@@ -68,7 +68,7 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
     >>> [r.m for r in sweep(prepare(g, g.copy()), [0.0, 0.1])]
     [0.0, 0.1]
     """
-    from . import match_prepared
+    from ursim_core.matching.pipeline import match_prepared
 
     grid = prepared.config.m_grid if grid is None else grid
     c_matrix = prepared.c_matrix
@@ -93,7 +93,7 @@ def _rule_score(prepared, results) -> list[float]:
 
 def _rule_structure(prepared, results) -> list[float]:
     """Normalised structural cost alone."""
-    from .planar import hypothesis_cost
+    from ursim_core.matching.planar import hypothesis_cost
 
     first, second = prepared.sketch_planar, prepared.metric_planar
     total = max(1, first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges))

@@ -275,7 +275,9 @@ def aligned_pairs(alignment: Alignment) -> list[tuple]:
     return pairs
 
 
-def aligned_index_pairs(first: Sequence[int], second: Sequence[int], same: Sequence[Sequence[bool]]) -> list[tuple[int, int]]:
+def aligned_index_pairs(
+    first: Sequence[int], second: Sequence[int], same: Sequence[Sequence[bool]]
+) -> list[tuple[int, int]]:
     """Pairs aligned by :func:`levenshtein` for integer sequences and a "same" matrix.
 
     Same result as ``aligned_pairs(align(first, second, same))`` (same costs, same

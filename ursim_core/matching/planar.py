@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 
-from .edit_distance import aligned_index_pairs, aligned_pairs, cyclic_align
+from ursim_core.matching.edit_distance import aligned_index_pairs, aligned_pairs, cyclic_align
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -183,8 +183,10 @@ def hypothesis_cost(first: PlanarGraph, second: PlanarGraph, pairs: Sequence[tup
     inner_first = sum(1 for a, b in first.edges if a in matched_first and b in matched_first)
     inner_second = sum(1 for a, b in second.edges if a in matched_second and b in matched_second)
     return (
-        (first.n_vertices - len(matched_first)) + (second.n_vertices - len(matched_second))
-        + (len(first.edges) - inner_first) + (len(second.edges) - inner_second)
+        (first.n_vertices - len(matched_first))
+        + (second.n_vertices - len(matched_second))
+        + (len(first.edges) - inner_first)
+        + (len(second.edges) - inner_second)
         + abs(inner_first - inner_second)
     )
 
@@ -311,8 +313,13 @@ def planar_match(
         consumed.add(seed)
         seeds_expanded += 1
         seed_first, seed_second = seed
-        alignment = cyclic_align(first.neighbours[seed_first], second.neighbours[seed_second], same,
-                                 rotation_search=rotation_search, reflections=reflections)
+        alignment = cyclic_align(
+            first.neighbours[seed_first],
+            second.neighbours[seed_second],
+            same,
+            rotation_search=rotation_search,
+            reflections=reflections,
+        )
         first_orders = reversed_first if alignment.reflected else first.neighbours
         seen_first = {seed_first}
         seen_second = {seed_second}
@@ -328,8 +335,9 @@ def planar_match(
             vertex, partner = queue.popleft()
             pairs.append((vertex, partner))
             matched[vertex] = partner
-            for a, b in _expand_locked(first_orders[vertex], second.neighbours[partner], matched,
-                                       second_sets[partner], same, arc_cache):
+            for a, b in _expand_locked(
+                first_orders[vertex], second.neighbours[partner], matched, second_sets[partner], same, arc_cache
+            ):
                 if a not in seen_first and b not in seen_second:
                     queue.append((a, b))
                     seen_first.add(a)
@@ -339,13 +347,24 @@ def planar_match(
         inner_first = sum(1 for v in matched for n in first_sets[v] if n in matched) // 2
         matched_second = set(matched.values())
         inner_second = sum(1 for v in matched_second for n in second_sets[v] if n in matched_second) // 2
-        structure = ((n_first - len(pairs)) + (n_second - len(pairs)) + (edges_first - inner_first)
-                     + (edges_second - inner_second) + abs(inner_first - inner_second))
+        structure = (
+            (n_first - len(pairs))
+            + (n_second - len(pairs))
+            + (edges_first - inner_first)
+            + (edges_second - inner_second)
+            + abs(inner_first - inner_second)
+        )
         cost = structure + pair_term(pairs)
         if keep_alternatives:
             alternatives.append((cost, pairs))
         # A small tolerance so that float sums of pair costs do not break the earliest-wins tie rule.
         if cost < best_cost - 1e-12:
             best_cost, best_pairs, best_structure = cost, pairs, structure
-    return PlanarResult(pairs=best_pairs, cost=best_cost, hypotheses=hypotheses, seeds_expanded=seeds_expanded,
-                        alternatives=alternatives, structural_cost=best_structure)
+    return PlanarResult(
+        pairs=best_pairs,
+        cost=best_cost,
+        hypotheses=hypotheses,
+        seeds_expanded=seeds_expanded,
+        alternatives=alternatives,
+        structural_cost=best_structure,
+    )

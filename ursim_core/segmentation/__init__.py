@@ -1,196 +1,36 @@
 """Segmentation of a map into regions, behind one small interface.
 
-A segmenter is any callable ``segmenter(free: ndarray[bool], **params) -> ndarray[int32]``
-returning a label image (0 = no region, regions 1..N). :func:`segment` wraps it into a
-:class:`Segmentation` with the region adjacency graph built by
-:func:`ursim_core.graph.region_graph`.
+Owns: :class:`Segmentation` (label image + region adjacency graph), :func:`segment` and the
+``SEGMENTERS`` registry, label-image files, the region graph (:func:`region_graph`), MAORIS
+(:mod:`ursim_core.segmentation.maoris`) and the scoring of a segmentation against ground truth
+(:mod:`ursim_core.segmentation.scoring`).
+
+May import: :mod:`ursim_core.io` and :mod:`ursim_core.errors`; never matching, evaluation or
+anything above them.
+
+>>> import numpy as np
+>>> from ursim_core.segmentation import segment
+>>> free = np.zeros((100, 160), bool)
+>>> free[10:90, 10:70] = free[10:90, 90:150] = free[45:55, 70:90] = True  # two rooms, a corridor
+>>> segment(free, preset="default").n_regions
+3
 """
 
-from __future__ import annotations
+import lazy_loader as _lazy
 
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any
-
-import networkx as nx
-import numpy as np
-
-__all__ = ["Segmentation", "SEGMENTERS", "segment", "resolve_params", "read_label_array", "load_label_image", "save_label_image"]
-
-
-@dataclass(frozen=True, eq=False)
-class Segmentation:
-    """A segmented map.
-
-    Attributes
-    ----------
-    labels : ndarray of int32, shape (rows, cols)
-        0 = no region; regions are numbered 1..N consecutively.
-    graph : networkx.Graph
-        Region adjacency graph; nodes are region ids with the attributes of
-        :func:`ursim_core.graph.region_graph`.
-    method : str
-        'maoris' or 'label-image' (or another registered segmenter).
-    params : dict
-        Parameters used (JSON-serialisable).
-    source : Path or None
-        Label image path when loaded from a file.
-    """
-
-    labels: np.ndarray
-    graph: nx.Graph
-    method: str = "maoris"
-    params: dict[str, Any] = field(default_factory=dict)
-    source: Path | None = None
-
-    @property
-    def n_regions(self) -> int:
-        return self.graph.number_of_nodes()
-
-    def region_at(self, row: int, col: int) -> int:
-        """Region id under pixel (row, col), 0 when none or outside the image."""
-        r, c = int(row), int(col)
-        if 0 <= r < self.labels.shape[0] and 0 <= c < self.labels.shape[1]:
-            return int(self.labels[r, c])
-        return 0
-
-
-def _maoris(free: np.ndarray, **params: Any) -> np.ndarray:
-    from ursim_core.segmentation.maoris import MaorisParams, maoris_labels
-
-    return maoris_labels(free, MaorisParams.from_dict(params))
-
-
-#: Segmenters by name: ``callable(free, **params) -> int32 label image``.
-SEGMENTERS: dict[str, Any] = {"maoris": _maoris}
-
-
-def resolve_params(method: str = "maoris", preset: str | None = "sketch", params: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Full parameter dict of a segmenter: the preset's values updated by ``params``.
-
-    Raises :class:`~ursim_core.errors.ParameterError` for an unknown method, preset or
-    parameter name, or an invalid value.
-
-    Examples
-    --------
-    >>> resolve_params("maoris", "robot", {"doors": 60})["doors"]
-    60
-    """
-    from ursim_core.errors import ParameterError
-
-    if method not in SEGMENTERS:
-        raise ParameterError(f"unknown segmentation method '{method}' (known: {', '.join(sorted(SEGMENTERS))})")
-    if method != "maoris":
-        return dict(params or {})
-    from ursim_core.segmentation.maoris import PRESETS
-
-    if preset is None:
-        preset = "default"
-    if preset not in PRESETS:
-        raise ParameterError(f"unknown preset '{preset}' (known: {', '.join(sorted(PRESETS))})")
-    return PRESETS[preset].with_overrides(**(params or {})).to_dict()
-
-
-def segment(
-    map_or_free: Any,
-    *,
-    method: str = "maoris",
-    preset: str | None = "sketch",
-    params: dict[str, Any] | None = None,
-) -> Segmentation:
-    """Segment a map into regions and build its region adjacency graph.
-
-    Parameters
-    ----------
-    map_or_free : Map or ndarray of bool
-        The map (its ``free`` mask is used) or a free-space mask.
-    method : str
-        A key of :data:`SEGMENTERS`.
-    preset : str, optional
-        Named parameter set of the method (MAORIS: 'sketch', 'robot', 'default', ...).
-    params : dict, optional
-        Overrides of single parameters.
-
-    Examples
-    --------
-    >>> free = np.zeros((60, 130), bool)
-    >>> free[5:55, 5:60] = True; free[5:55, 70:125] = True; free[27:33, 60:70] = True
-    >>> seg = segment(free, preset="default")
-    >>> seg.n_regions, seg.graph.number_of_edges()
-    (2, 1)
-    """
-    from ursim_core.graph import region_graph
-
-    free = getattr(map_or_free, "free", map_or_free)
-    resolved = resolve_params(method, preset, params)
-    labels = np.asarray(SEGMENTERS[method](np.asarray(free, dtype=bool), **resolved), dtype=np.int32)
-    return Segmentation(labels=labels, graph=region_graph(labels), method=method, params=resolved)
-
-
-def read_label_array(path: str | Path) -> np.ndarray:
-    """Read a label image file as an int32 array of the stored ids (0 = no region).
-
-    Accepts 8- or 16-bit single-channel images, and colour images whose channels are equal.
-    Raises :class:`~ursim_core.errors.SegmentationError` naming the file otherwise.
-    """
-    import cv2
-
-    from ursim_core.errors import SegmentationError
-
-    path = Path(path)
-    if not path.is_file():
-        raise SegmentationError("label image not found", path=path)
-    labels = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if labels is None:
-        raise SegmentationError("not a readable image", path=path)
-    if labels.ndim == 3:
-        channels = labels[..., :3]
-        if not (np.array_equal(channels[..., 0], channels[..., 1]) and np.array_equal(channels[..., 0], channels[..., 2])):
-            raise SegmentationError("a label image must have one channel (grey, 8 or 16 bit), got colour", path=path)
-        labels = channels[..., 0]
-    if labels.dtype not in (np.uint8, np.uint16):
-        raise SegmentationError(f"a label image must be 8 or 16 bit, got {labels.dtype}", path=path)
-    return labels.astype(np.int32)
-
-
-def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) -> Segmentation:
-    """Load a label image (8- or 16-bit single-channel PNG, 0 = no region) as a segmentation.
-
-    Region ids are kept as stored, so ids in a correspondence file that references this
-    image stay valid.
-
-    Parameters
-    ----------
-    path : str or Path
-        The label image.
-    shape : (rows, cols), optional
-        Required size (the map's); a mismatch raises :class:`~ursim_core.errors.SegmentationError`.
-    """
-
-    from ursim_core.errors import SegmentationError
-    from ursim_core.graph import region_graph
-
-    path = Path(path)
-    labels = read_label_array(path)
-    if shape is not None and tuple(labels.shape) != tuple(shape):
-        raise SegmentationError(
-            f"label image is {labels.shape[0]}x{labels.shape[1]} (rows x cols) but the map is {shape[0]}x{shape[1]}",
-            path=path,
-        )
-    return Segmentation(labels=labels, graph=region_graph(labels), method="label-image", params={}, source=path)
-
-
-def save_label_image(segmentation: Segmentation, path: str | Path) -> None:
-    """Write the label image as a 16-bit PNG (0 = no region), atomically."""
-    import cv2
-
-    from ursim_core.atomic import atomic_write_bytes
-    from ursim_core.errors import SegmentationError
-
-    labels = segmentation.labels
-    if labels.size and int(labels.max()) > 65535:
-        raise SegmentationError(f"{int(labels.max())} regions do not fit a 16-bit label image", path=path)
-    ok, encoded = cv2.imencode(".png", labels.astype(np.uint16))
-    if not ok:
-        raise SegmentationError("could not encode the label image", path=path)
-    atomic_write_bytes(Path(path), encoded.tobytes())
+__getattr__, __dir__, __all__ = _lazy.attach(
+    __name__,
+    submodules=["interface", "graph", "scoring", "maoris"],
+    submod_attrs={
+        "interface": [
+            "Segmentation",
+            "SEGMENTERS",
+            "segment",
+            "resolve_params",
+            "read_label_array",
+            "load_label_image",
+            "save_label_image",
+        ],
+        "graph": ["region_graph", "adjacent_pairs", "contour_pca_shape"],
+    },
+)

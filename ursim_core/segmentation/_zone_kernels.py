@@ -1021,8 +1021,13 @@ def _usable_cpus() -> int:
 def _new_scratch():
     """Empty scratch arrays of :func:`_contacts_fuse`."""
     return (
-        np.empty(1024, np.int32), np.empty(1024, np.int32), _filled(4096, _EMPTY, np.int64), np.empty(1024, np.int32),
-        np.empty(1024, np.int64), _filled(4096, _EMPTY, np.int64), np.zeros(4096, np.int64),
+        np.empty(1024, np.int32),
+        np.empty(1024, np.int32),
+        _filled(4096, _EMPTY, np.int64),
+        np.empty(1024, np.int32),
+        np.empty(1024, np.int64),
+        _filled(4096, _EMPTY, np.int64),
+        np.zeros(4096, np.int64),
         np.empty(2048, np.int64),
     )
 

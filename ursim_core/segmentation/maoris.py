@@ -92,7 +92,7 @@ Measurement behind ``sketch``: the 18 sketches of
 annotators; mean over sketches of P, R, F1 (``evF1``: the C++ evaluator's
 per-predicted-region precision). ``authors`` = their label images
 ``maoris_output/NN.png`` scored the same way. Reproduce with
-``ursim_core.bench_segmentation.bench_quality``::
+``ursim_core.bench.segmentation.bench_quality``::
 
     preset          gt_lex P/R/F1      gt_ezvin P/R/F1    mean F1  evF1 lex/ezvin
     authors         .693 .901 .777     .599 .911 .713     .745     .895 .883
@@ -153,8 +153,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import cv2
 import numpy as np
@@ -237,8 +238,10 @@ class MaorisParams:
                 raise ParameterError(f"must be a number, got {value!r}", field=name)
             if kind is int and float(value) != int(value):
                 raise ParameterError(f"must be an integer, got {value!r}", field=name)
-            if not math.isfinite(float(value)) or value < low or (
-                high is not None and (value >= high if high_open else value > high)
+            if (
+                not math.isfinite(float(value))
+                or value < low
+                or (high is not None and (value >= high if high_open else value > high))
             ):
                 bound = "" if high is None else (f" and < {high}" if high_open else f" and <= {high}")
                 raise ParameterError(f"must be >= {low}{bound}, got {value!r}", field=name)
@@ -256,7 +259,7 @@ class MaorisParams:
         return dataclasses.asdict(self)
 
     @classmethod
-    def from_dict(cls, values: Mapping[str, Any]) -> "MaorisParams":
+    def from_dict(cls, values: Mapping[str, Any]) -> MaorisParams:
         """Build parameters from a dict; missing names take the defaults.
 
         Raises
@@ -271,7 +274,7 @@ class MaorisParams:
         """
         return cls().with_overrides(**dict(values))
 
-    def with_overrides(self, **overrides: Any) -> "MaorisParams":
+    def with_overrides(self, **overrides: Any) -> MaorisParams:
         """Copy with some parameters replaced, validating names and values.
 
         Examples
@@ -282,9 +285,7 @@ class MaorisParams:
         known = {f.name for f in dataclasses.fields(self)}
         for name in overrides:
             if name not in known:
-                raise ParameterError(
-                    f"unknown MAORIS parameter (known: {', '.join(sorted(known))})", field=str(name)
-                )
+                raise ParameterError(f"unknown MAORIS parameter (known: {', '.join(sorted(known))})", field=str(name))
         return dataclasses.replace(self, **overrides)
 
 
@@ -593,7 +594,9 @@ class ZoneGraph:
     def _adjacency_dicts(self) -> dict[int, dict[int, ZoneEdge | None]]:
         adj: dict[int, dict[int, ZoneEdge | None]] = {zone: {} for zone in np.flatnonzero(self._alive).tolist()}
         edges: dict[int, ZoneEdge | None] = {}  # node -> the edge object both directions share
-        for zone, other, node, twin, low, unbreakable in _kernels.adjacency_entries(self._alive, self._compact).tolist():
+        for zone, other, node, twin, low, unbreakable in _kernels.adjacency_entries(
+            self._alive, self._compact
+        ).tolist():
             edge = edges.pop(twin, _MISSING)
             if edge is _MISSING:
                 edge = None if low < 0 and not unbreakable else ZoneEdge(None if low < 0 else low, bool(unbreakable))
@@ -846,9 +849,11 @@ def mark_unbreakable_edges(graph: ZoneGraph, *, threshold: float) -> ZoneGraph:
     """
     for a in graph.vertices():
         for b, edge in graph.adj[a].items():
-            if edge is not None and edge.minimum is not None and edge.minimum <= max(
-                graph.value(a), graph.value(b)
-            ) * (1 - threshold):
+            if (
+                edge is not None
+                and edge.minimum is not None
+                and edge.minimum <= max(graph.value(a), graph.value(b)) * (1 - threshold)
+            ):
                 edge.unbreakable = True
     return graph
 
@@ -865,7 +870,11 @@ def _close_neighbour(graph: ZoneGraph, current: int, candidate: int, threshold: 
     value_current, value_candidate = graph.value(current), graph.value(candidate)
     for one, other_value, skip in ((candidate, value_current, current), (current, value_candidate, candidate)):
         for m, edge in graph.adj[one].items():
-            if m != skip and (edge is None or not edge.unbreakable) and _similar(graph.value(m), other_value, threshold):
+            if (
+                m != skip
+                and (edge is None or not edge.unbreakable)
+                and _similar(graph.value(m), other_value, threshold)
+            ):
                 return True
     return False
 

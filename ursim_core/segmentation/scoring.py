@@ -39,7 +39,7 @@ import cv2
 import numpy as np
 
 from ursim_core.errors import SegmentationError
-from ursim_core.maps import load_map, map_from_array
+from ursim_core.io.maps import load_map, map_from_array
 
 __all__ = [
     "SegmentationScore",
@@ -129,7 +129,7 @@ def gt_labels_from_separator_image(path_or_array: str | Path | np.ndarray) -> np
     """Ground-truth labels from a map drawn with grey separator lines.
 
     As the MAORIS evaluator: free = grey > 250 (transparent pixels are
-    obstacle; loaded like :func:`ursim_core.maps.load_map`), erode 1 px (3x3),
+    obstacle; loaded like :func:`ursim_core.io.maps.load_map`), erode 1 px (3x3),
     ``findContours(RETR_CCOMP)``, fill each top-level contour with its own label
     (holes inside a region are filled too, as ``drawContours(FILLED)`` does),
     then dilate 1 px (3x3; where two labels compete the larger wins). As in
@@ -141,7 +141,7 @@ def gt_labels_from_separator_image(path_or_array: str | Path | np.ndarray) -> np
     ----------
     path_or_array : str, Path or ndarray
         An image file, or an array accepted by
-        :func:`ursim_core.maps.map_from_array` (bool mask, grey, RGB(A) in RGB order).
+        :func:`ursim_core.io.maps.map_from_array` (bool mask, grey, RGB(A) in RGB order).
 
     Returns
     -------
@@ -166,7 +166,7 @@ def gt_labels_from_separator_image(path_or_array: str | Path | np.ndarray) -> np
     # float32 holds labels exactly and, unlike int32, is accepted by cv2.dilate.
     filled = np.zeros(free.shape, np.float32)
     label = 0
-    for index, contour in enumerate(contours):
+    for index, _contour in enumerate(contours):
         if hierarchy[0][index][3] == -1:  # top level: an outer boundary
             label += 1
             cv2.drawContours(filled, contours, index, float(label), thickness=cv2.FILLED)
@@ -274,6 +274,6 @@ def load_label_array(path: str | Path) -> np.ndarray:
     ...     load_label_array(path).tolist()
     [[0, 1, 2]]
     """
-    from ursim_core.segmentation import read_label_array
+    from ursim_core.segmentation.interface import read_label_array
 
     return relabel_in_raster_order(read_label_array(path))

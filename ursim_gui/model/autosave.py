@@ -27,7 +27,7 @@ import uuid
 from collections.abc import Callable
 from pathlib import Path
 
-from ursim_core.correspondences import Correspondences, load_correspondences, save_correspondences
+from ursim_core.correspondences.codec import Correspondences, load_correspondences, save_correspondences
 from ursim_gui.model.session import AUTOSAVE_ORIGIN_KEY, AnnotationSession
 
 __all__ = [

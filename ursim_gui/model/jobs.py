@@ -40,7 +40,7 @@ class SegmentJob:
 
     Parameters
     ----------
-    map : ursim_core.maps.Map or ndarray of bool
+    map : ursim_core.io.maps.Map or ndarray of bool
         The map (or its free-space mask).
     preset : str or None
         Preset name of the method ('sketch', 'robot', ...).
@@ -62,7 +62,15 @@ class SegmentJob:
     2
     """
 
-    def __init__(self, map: Any, preset: str | None, params: dict[str, Any] | None = None, *, method: str = "maoris", side: str | None = None) -> None:
+    def __init__(
+        self,
+        map: Any,
+        preset: str | None,
+        params: dict[str, Any] | None = None,
+        *,
+        method: str = "maoris",
+        side: str | None = None,
+    ) -> None:
         self.map = map
         self.preset = preset
         self.params = dict(params or {})

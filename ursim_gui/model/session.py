@@ -6,7 +6,7 @@ directly.
 
 Design
 ------
-- The correspondences are one immutable :class:`~ursim_core.correspondences.Correspondences`
+- The correspondences are one immutable :class:`~ursim_core.correspondences.codec.Correspondences`
   value. Every edit builds a new value and records ``(description, before, after)`` in a
   :class:`~ursim_gui.model.history.History`, so undo/redo restore exact values.
 - ``dirty`` is not a flag that edits set: it is ``correspondences != saved value``, so
@@ -28,7 +28,7 @@ from itertools import product
 from pathlib import Path
 from typing import Any
 
-from ursim_core.correspondences import (
+from ursim_core.correspondences.codec import (
     STATUSES,
     Clique,
     Correspondences,
@@ -109,12 +109,14 @@ def _regions_text(regions: Iterable[int]) -> str:
 def _with_side_regions(corr: Correspondences, side: str, labels) -> Correspondences:
     """Re-derive one side's region ids of every clique from its points.
 
-    Same rule as :func:`ursim_core.correspondences.assign_regions` (ids under the points,
+    Same rule as :func:`ursim_core.correspondences.codec.assign_regions` (ids under the points,
     tolerance 10, duplicates and dropped points left out, point order), for one side only,
     because the other side may not be segmented yet.
     """
     point_lists = [getattr(clique, f"{side}_points") for clique in corr.cliques]
-    found = iter(regions_at_points(labels, [p for points in point_lists for p in points], tolerance=REFERENCE_TOLERANCE))
+    found = iter(
+        regions_at_points(labels, [p for points in point_lists for p in points], tolerance=REFERENCE_TOLERANCE)
+    )
     cliques = []
     for clique, points in zip(corr.cliques, point_lists):
         ids = tuple(dict.fromkeys(region for region in (next(found) for _ in points) if region != 0))
@@ -187,7 +189,7 @@ class AnnotationSession:
 
     # ------------------------------------------------------------------ read-only state
     def map(self, side: str):
-        """The ``ursim_core.maps.Map`` of ``side``, or None."""
+        """The ``ursim_core.io.maps.Map`` of ``side``, or None."""
         return self._maps[_check_side(side)]
 
     def segmentation(self, side: str):
@@ -260,7 +262,7 @@ class AnnotationSession:
 
     @property
     def evaluation(self):
-        """``ursim_core.evaluation_scoring.MatchScore`` of the non-rejected cliques, or None."""
+        """``ursim_core.evaluation.scoring.MatchScore`` of the non-rejected cliques, or None."""
         return self._evaluation
 
     @property
@@ -340,7 +342,7 @@ class AnnotationSession:
     # ------------------------------------------------------------------ maps and segmentations
     def load_map(self, side: str, path: str | os.PathLike) -> None:
         """Load a map file for ``side`` (raises ``UrsimError``; the session is unchanged then)."""
-        from ursim_core.maps import load_map
+        from ursim_core.io.maps import load_map
 
         self.set_map(side, load_map(_absolute(path)))
 
@@ -851,7 +853,7 @@ class AnnotationSession:
             self._evaluation = None
             self._clique_marks = {}
             return
-        from ursim_core.evaluation_scoring import score_matches
+        from ursim_core.evaluation.scoring import score_matches
 
         pairs, owners = [], []
         for clique in self._corr.cliques:
@@ -909,7 +911,7 @@ class AnnotationSession:
     @staticmethod
     def _load_side(side: str, ref: MapRef, document: Path | None, warnings: list[str]):
         """(map, segmentation) of one side of a document; raises UrsimError naming both files."""
-        from ursim_core.maps import load_map
+        from ursim_core.io.maps import load_map
         from ursim_core.segmentation import SEGMENTERS, load_label_image, segment
 
         if ref.path is None:
@@ -922,7 +924,9 @@ class AnnotationSession:
             if ref.labels_path is not None and ref.labels_path.is_file():
                 segmentation = load_label_image(ref.labels_path, shape=map_.shape)
             elif ref.segmentation_method in SEGMENTERS:
-                segmentation = segment(map_, method=ref.segmentation_method, preset=None, params=ref.segmentation_params)
+                segmentation = segment(
+                    map_, method=ref.segmentation_method, preset=None, params=ref.segmentation_params
+                )
             else:
                 segmentation = None
                 if ref.labels_path is not None:

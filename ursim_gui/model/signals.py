@@ -46,7 +46,7 @@ class Signal:
     [3]
     """
 
-    __slots__ = ("name", "_slots")
+    __slots__ = ("_slots", "name")
 
     def __init__(self, name: str = "") -> None:
         self.name = name

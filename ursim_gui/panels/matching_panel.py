@@ -5,12 +5,29 @@ from __future__ import annotations
 import math
 
 from PySide6.QtCore import Signal
-from PySide6.QtWidgets import QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
 
 __all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "describe_result"]
 
 #: Descriptor variants (paper Table 1; T4 = URSIM) and matchers, as ``MatchConfig`` names them.
-VARIANTS = (("T4", "T4 – URSIM (anchors + weights)"), ("T3", "T3"), ("T2", "T2"), ("T1", "T1"), ("baseline", "baseline"))
+VARIANTS = (
+    ("T4", "T4 – URSIM (anchors + weights)"),
+    ("T3", "T3"),
+    ("T2", "T2"),
+    ("T1", "T1"),
+    ("baseline", "baseline"),
+)
 MATCHERS = (("planar", "planar expansion"), ("hungarian", "Hungarian"), ("vf2", "VF2"))
 
 

@@ -112,7 +112,9 @@ class SideSegmentationBox(QGroupBox):
         index = self.preset.findText(DEFAULT_PRESETS.get(side, "default"))
         self.preset.setCurrentIndex(max(0, index))
         self._fill_from_preset(self.preset.currentText())
-        self.segment_button.clicked.connect(lambda: self.segment_requested.emit(self.side, self.preset.currentText(), self.overrides()))
+        self.segment_button.clicked.connect(
+            lambda: self.segment_requested.emit(self.side, self.preset.currentText(), self.overrides())
+        )
         self.load_button.clicked.connect(lambda: self.load_labels_requested.emit(self.side))
 
     def overrides(self) -> dict:

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import pytest
 
-from ursim_core.bench_matching import perturbed_copy, random_region_graph
+from ursim_core.bench.matching import perturbed_copy, random_region_graph
 from ursim_core.matching import MatchConfig, match, match_prepared, prepare
 from ursim_core.matching.auto_m import choose_m, sweep
 

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ursim_core import datasets
+from ursim_core.evaluation import datasets
+from ursim_core.evaluation.kth_protocol import f1_table, kth_pairs, summarise
 from ursim_core.matching import M_GRID, MatchConfig
-from ursim_core.matching.experiments import f1_table, kth_pairs, summarise
 
 pytestmark = [pytest.mark.dataset, pytest.mark.slow]
 

@@ -8,19 +8,24 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from ursim_core.bench_matching import perturbed_copy, random_region_graph
+from ursim_core.bench.matching import perturbed_copy, random_region_graph
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation_scoring import score_matches
-from ursim_core.graph import region_graph
+from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match, match_prepared, prepare, seed_pairs
 from ursim_core.segmentation import Segmentation
+from ursim_core.segmentation.graph import region_graph
 
 
 def _region_graph(sizes, pcas, centroids, edges):
     graph = nx.Graph()
     for node, (size, pca, centroid) in enumerate(zip(sizes, pcas, centroids), start=1):
-        graph.add_node(node, size=size, pca_shape=pca, centroid=centroid,
-                       bbox=(centroid[0] - 5, centroid[1] - 5, centroid[0] + 5, centroid[1] + 5))
+        graph.add_node(
+            node,
+            size=size,
+            pca_shape=pca,
+            centroid=centroid,
+            bbox=(centroid[0] - 5, centroid[1] - 5, centroid[0] + 5, centroid[1] + 5),
+        )
     graph.add_edges_from(edges)
     return graph
 
@@ -51,9 +56,14 @@ def test_config_validation_names_the_field():
 
 def test_presets():
     released = MatchConfig.released()
-    assert (released.standardise, released.weights, released.disparity, released.rotation_search,
-            released.hypothesis_score, released.position_weight) == ("model", "uniqueness", "released", "first",
-                                                                      "structure", 0.0)
+    assert (
+        released.standardise,
+        released.weights,
+        released.disparity,
+        released.rotation_search,
+        released.hypothesis_score,
+        released.position_weight,
+    ) == ("model", "uniqueness", "released", "first", "structure", 0.0)
     paper = MatchConfig.paper()
     assert paper.effective_weights == "size" and paper.hypothesis_score == "substitutions"
     assert MatchConfig.released(m=0.3).m == 0.3
@@ -61,10 +71,18 @@ def test_presets():
     assert MatchConfig(variant="baseline").effective_weights is None
 
 
-@pytest.mark.parametrize("config", [
-    MatchConfig(m=0.01), MatchConfig.paper(m=0.01), MatchConfig.released(m=0.01), MatchConfig(),
-    MatchConfig(m=0.01, reflections=True), MatchConfig(variant="T1", m=0.01), MatchConfig(variant="T3", m=0.01),
-])
+@pytest.mark.parametrize(
+    "config",
+    [
+        MatchConfig(m=0.01),
+        MatchConfig.paper(m=0.01),
+        MatchConfig.released(m=0.01),
+        MatchConfig(),
+        MatchConfig(m=0.01, reflections=True),
+        MatchConfig(variant="T1", m=0.01),
+        MatchConfig(variant="T3", m=0.01),
+    ],
+)
 def test_graph_against_relabelled_copy_gives_identity(config):
     graph = random_region_graph(25, seed=11)
     copy, mapping = perturbed_copy(graph, seed=12, size_noise=0.0, position_noise=0.0)

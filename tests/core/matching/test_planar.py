@@ -8,7 +8,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from ursim_core.bench_matching import perturbed_copy, random_region_graph
+from ursim_core.bench.matching import perturbed_copy, random_region_graph
 from ursim_core.matching.planar import (
     PlanarGraph,
     cyclic_neighbours,
@@ -41,8 +41,9 @@ def _wheel(mirror=False, labels=None):
 
 def test_cyclic_order_is_clockwise_on_screen_from_smallest_id():
     # Centre with neighbours right (id 5), below (id 2), left (id 9), above (id 7).
-    graph = _geometric_graph({0: (0, 0), 5: (0, 1), 2: (1, 0), 9: (0, -1), 7: (-1, 0)},
-                             [(0, 5), (0, 2), (0, 9), (0, 7)])
+    graph = _geometric_graph(
+        {0: (0, 0), 5: (0, 1), 2: (1, 0), 9: (0, -1), 7: (-1, 0)}, [(0, 5), (0, 2), (0, 9), (0, 7)]
+    )
     order = cyclic_neighbours(graph, [0, 2, 5, 7, 9])[0]
     # Reference = smallest id (2, below); then increasing image angle: left, above, right.
     assert [[0, 2, 5, 7, 9][i] for i in order] == [2, 9, 7, 5]
@@ -73,8 +74,9 @@ def test_identity_recovered_on_relabelled_copy():
 
 
 def test_first_rotation_bug_loses_a_pair_that_the_minimum_search_finds():
-    star = _geometric_graph({0: (0, 0), 1: (0, 10), 2: (10, 0), 3: (0, -10), 4: (-10, 0)},
-                            [(0, 1), (0, 2), (0, 3), (0, 4)])
+    star = _geometric_graph(
+        {0: (0, 0), 1: (0, 10), 2: (10, 0), 3: (0, -10), 4: (-10, 0)}, [(0, 1), (0, 2), (0, 3), (0, 4)]
+    )
     # Same star, but ids chosen so that the smallest neighbour id sits at a different place.
     rotated = nx.relabel_nodes(star, {0: 0, 1: 4, 2: 1, 3: 2, 4: 3})
     first, second = planar_graph(star), planar_graph(rotated)

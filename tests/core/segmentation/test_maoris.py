@@ -528,7 +528,7 @@ RELEASED_COUNTS = {  # map: (ursim_t050 grey != 0, icra_t030_bin grey > 250, def
 
 @pytest.fixture(scope="module")
 def datasets() -> Path:
-    from ursim_core.datasets import MISSING_REASON, dataset_root
+    from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 
     root = dataset_root()
     if root is None or not (root / "ursim_kth_sketches").is_dir():
@@ -539,7 +539,7 @@ def datasets() -> Path:
 @pytest.mark.dataset
 @pytest.mark.slow
 def test_region_counts_close_to_the_released_cpp(datasets):
-    from ursim_core.maps import load_map
+    from ursim_core.io.maps import load_map
 
     kth = datasets / "ursim_kth_sketches"
     differences = []

@@ -46,7 +46,9 @@ def test_separator_image_transparent_pixels_are_obstacle():
 def test_separator_image_from_file(tmp_path: Path):
     path = tmp_path / "gt.png"
     cv2.imwrite(str(path), separator_image())
-    np.testing.assert_array_equal(gt_labels_from_separator_image(path), gt_labels_from_separator_image(separator_image()))
+    np.testing.assert_array_equal(
+        gt_labels_from_separator_image(path), gt_labels_from_separator_image(separator_image())
+    )
 
 
 def test_filled_top_level_contour_covers_its_holes():
@@ -127,7 +129,9 @@ def test_load_label_array_errors(tmp_path: Path):
     with pytest.raises(SegmentationError, match="label image not found"):
         load_label_array(tmp_path / "missing.png")
     colour = tmp_path / "colour.png"
-    cv2.imwrite(str(colour), np.dstack([np.full((2, 2), 1, np.uint8), np.full((2, 2), 2, np.uint8), np.zeros((2, 2), np.uint8)]))
+    cv2.imwrite(
+        str(colour), np.dstack([np.full((2, 2), 1, np.uint8), np.full((2, 2), 2, np.uint8), np.zeros((2, 2), np.uint8)])
+    )
     with pytest.raises(SegmentationError, match="got colour"):
         load_label_array(colour)
 
@@ -138,7 +142,7 @@ def test_load_label_array_errors(tmp_path: Path):
 
 @pytest.fixture(scope="module")
 def sketches() -> Path:
-    from ursim_core.datasets import MISSING_REASON, dataset_root
+    from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 
     root = dataset_root()
     if root is None or not (root / "maoris_segmentation" / "sketches").is_dir():
@@ -166,7 +170,7 @@ def test_evaluator_scores_reproduce_the_published_figures(sketches):
 @pytest.mark.dataset
 @pytest.mark.slow
 def test_sketch_preset_beats_the_authors_segmentations(sketches):
-    from ursim_core.maps import load_map
+    from ursim_core.io.maps import load_map
     from ursim_core.segmentation.maoris import PRESETS, maoris_labels
 
     ours: dict[str, list[float]] = {"gt_lex": [], "gt_ezvin": []}

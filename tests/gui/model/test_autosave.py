@@ -9,9 +9,9 @@ import cv2
 import numpy as np
 import pytest
 
-from ursim_core.correspondences import load_correspondences
-from ursim_core.graph import region_graph
+from ursim_core.correspondences.codec import load_correspondences
 from ursim_core.segmentation import Segmentation, load_label_image, save_label_image
+from ursim_core.segmentation.graph import region_graph
 from ursim_gui.model.autosave import (
     AUTOSAVE_SUFFIX,
     Autosaver,

@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ursim_core.correspondences import (
+from ursim_core.correspondences.codec import (
     Clique,
     Correspondences,
     MapRef,
@@ -20,9 +20,9 @@ from ursim_core.correspondences import (
     save_dat,
 )
 from ursim_core.errors import FormatError, MapError, SegmentationError, UrsimError
-from ursim_core.graph import region_graph
-from ursim_core.maps import map_from_array
+from ursim_core.io.maps import map_from_array
 from ursim_core.segmentation import Segmentation, load_label_image, save_label_image
+from ursim_core.segmentation.graph import region_graph
 from ursim_gui.model.jobs import JobCancelled, MatchJob, SegmentJob
 from ursim_gui.model.session import AnnotationSession, color_of_clique
 
@@ -655,14 +655,18 @@ def test_selection_rules_and_signals(session):
 def test_dat_export_then_import_round_trips_the_cliques(session, tmp_path):
     session.link([1], [1])
     session.link([2, 3], [4])
-    expected = [(c.sketch_points, c.metric_points, c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques]
+    expected = [
+        (c.sketch_points, c.metric_points, c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques
+    ]
     session.export_dat(tmp_path / "pair.dat")
     assert len(load_dat(tmp_path / "pair.dat").cliques) == 2
 
     session.delete_clique(1)
     session.delete_clique(2)
     session.import_dat(tmp_path / "pair.dat")
-    got = [(c.sketch_points, c.metric_points, c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques]
+    got = [
+        (c.sketch_points, c.metric_points, c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques
+    ]
     assert got == expected
     assert session.undo_text == "Import pair.dat"
     session.undo()
@@ -747,7 +751,8 @@ def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(sess
     config = MatchConfig(m="auto")
     reports = []
     MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
-        lambda fraction, message: reports.append((fraction, message)), lambda: False)
+        lambda fraction, message: reports.append((fraction, message)), lambda: False
+    )
     fractions = [fraction for fraction, _ in reports]
     assert fractions == sorted(fractions) and fractions[-1] == 1.0
     steps = [message for _, message in reports if message.startswith("matching at m = ")]
@@ -761,5 +766,6 @@ def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(sess
 
     with pytest.raises(JobCancelled):
         MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
-            lambda *a: None, cancel_during_the_sweep)
+            lambda *a: None, cancel_during_the_sweep
+        )
     assert len(polls) == 6

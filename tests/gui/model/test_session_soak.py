@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ursim_core.correspondences import load_correspondences
-from ursim_core.graph import region_graph
-from ursim_core.maps import map_from_array
+from ursim_core.correspondences.codec import load_correspondences
+from ursim_core.io.maps import map_from_array
 from ursim_core.segmentation import Segmentation
+from ursim_core.segmentation.graph import region_graph
 from ursim_gui.model.session import AnnotationSession
 
 N_STEPS = 1000

@@ -161,20 +161,29 @@ def _allocate(total: int, lengths: np.ndarray) -> np.ndarray:
 def _check_sizes(shape, n_rooms, corridor_width, wall_thickness, door_width, room_depth, room_width, margin) -> None:
     if len(shape) != 2 or min(shape) < 1:
         raise ParameterError(f"shape must be (rows, cols) with positive sizes, got {shape!r}", field="shape")
-    for name, value in (("corridor_width", corridor_width), ("wall_thickness", wall_thickness),
-                        ("door_width", door_width)):
+    for name, value in (
+        ("corridor_width", corridor_width),
+        ("wall_thickness", wall_thickness),
+        ("door_width", door_width),
+    ):
         if int(value) != value or value < 1:
             raise ParameterError(f"must be a positive whole number of pixels, got {value!r}", field=name)
     if margin < 0:
         raise ParameterError(f"must not be negative, got {margin!r}", field="margin")
     if door_width >= corridor_width:
-        raise ParameterError(f"doors ({door_width} px) must be narrower than corridors ({corridor_width} px) "
-                             "so that a room segmentation can tell them apart", field="door_width")
+        raise ParameterError(
+            f"doors ({door_width} px) must be narrower than corridors ({corridor_width} px) "
+            "so that a room segmentation can tell them apart",
+            field="door_width",
+        )
     smallest_room = door_width + 2 * wall_thickness + 2
     for name, (low, high) in (("room_depth", room_depth), ("room_width", room_width)):
         if not smallest_room <= low <= high:
-            raise ParameterError(f"must be (low, high) with {smallest_room} <= low <= high (a door and its jambs "
-                                 f"must fit), got {(low, high)!r}", field=name)
+            raise ParameterError(
+                f"must be (low, high) with {smallest_room} <= low <= high (a door and its jambs "
+                f"must fit), got {(low, high)!r}",
+                field=name,
+            )
     if n_rooms is not None and (int(n_rooms) != n_rooms or n_rooms < 0):
         raise ParameterError(f"must be a non-negative whole number or None, got {n_rooms!r}", field="n_rooms")
 
@@ -337,8 +346,9 @@ def generate_floor_plan(
         counts = _allocate(int(n_rooms), lengths)
         if np.any(counts * (smallest_room + wall) > lengths):
             fit = int(np.sum(lengths // (smallest_room + wall)))
-            raise ParameterError(f"{n_rooms} rooms do not fit in a {rows} x {cols} building (at most about {fit})",
-                                 field="n_rooms")
+            raise ParameterError(
+                f"{n_rooms} rooms do not fit in a {rows} x {cols} building (at most about {fit})", field="n_rooms"
+            )
     for index, (b, side, r0, r1, g, c0, c1) in enumerate(slots):
         # Each piece is a room and the wall after it; the last wall falls on the run's end.
         if n_rooms is None:
@@ -365,14 +375,14 @@ def generate_floor_plan(
             room = add("room", "room", rr0, rr1, rc0, rc1)
             door = int(rng.integers(rc0 + wall, rc1 - door_width - wall + 1))
             door_rows = (rr1, rr1 + wall) if side == "up" else (rr0 - wall, rr0)
-            labels[door_rows[0]:door_rows[1], door:door + door_width] = room
+            labels[door_rows[0] : door_rows[1], door : door + door_width] = room
             graph.add_edge(room, corridor, via="door")
             if previous is not None and rng.random() < room_door_probability:
                 other, (or0, or1) = previous
                 low, high = max(rr0, or0) + wall, min(rr1, or1) - door_width - wall
                 if high >= low:
                     door = int(rng.integers(low, high + 1))
-                    labels[door:door + door_width, rc0 - wall:rc0] = other
+                    labels[door : door + door_width, rc0 - wall : rc0] = other
                     graph.add_edge(other, room, via="door")
             previous = (room, (rr0, rr1))
 
@@ -429,8 +439,13 @@ def interior_points(labels: np.ndarray) -> dict[int, tuple[int, int]]:
     labels = np.asarray(labels)
     padded = np.pad(labels, 1)
     centre = padded[1:-1, 1:-1]
-    inside = ((centre != 0) & (centre == padded[:-2, 1:-1]) & (centre == padded[2:, 1:-1])
-              & (centre == padded[1:-1, :-2]) & (centre == padded[1:-1, 2:]))
+    inside = (
+        (centre != 0)
+        & (centre == padded[:-2, 1:-1])
+        & (centre == padded[2:, 1:-1])
+        & (centre == padded[1:-1, :-2])
+        & (centre == padded[1:-1, 2:])
+    )
     distance = cv2.distanceTransform(inside.astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
     rows, cols = np.nonzero(labels)
     ids = labels[rows, cols].astype(np.int64)
@@ -504,9 +519,11 @@ def _stub_candidates(labels: np.ndarray, plan: FloorPlan, width: int, length: in
                 through = (cols.start - wall, cols.start) if dc < 0 else (cols.stop, cols.stop + wall)
                 beyond = (c0 - wall, cols.start - wall) if dc < 0 else (cols.stop + wall, c0 + length + wall)
                 checks = [((r0, r0 + width), through), ((r0 - wall, r0 + width + wall), beyond)]
-            inside_image = all(0 <= a < b <= n for (a, b), n in
-                               [(span, labels.shape[axis]) for check in checks for axis, span in enumerate(check)])
-            if inside_image and not any(labels[r[0]:r[1], c[0]:c[1]].any() for r, c in checks):
+            inside_image = all(
+                0 <= a < b <= n
+                for (a, b), n in [(span, labels.shape[axis]) for check in checks for axis, span in enumerate(check)]
+            )
+            if inside_image and not any(labels[r[0] : r[1], c[0] : c[1]].any() for r, c in checks):
                 found.append((place.id, name, rect))
     return found
 
@@ -575,8 +592,13 @@ def sketchify(
     >>> bool(np.isin(sketch.dropped, sketch.rooms).any()), bool(np.isin(sketch.extra, plan.rooms).any())
     (False, False)
     """
-    for name, value in (("wobble", wobble), ("rotation_deg", rotation_deg), ("pen_width", pen_width),
-                        ("pen_noise", pen_noise), ("scale_jitter", scale_jitter)):
+    for name, value in (
+        ("wobble", wobble),
+        ("rotation_deg", rotation_deg),
+        ("pen_width", pen_width),
+        ("pen_noise", pen_noise),
+        ("scale_jitter", scale_jitter),
+    ):
         if not value >= 0:
             raise ParameterError(f"must not be negative, got {value!r}", field=name)
     if not scale > 0:
@@ -584,8 +606,10 @@ def sketchify(
     if not scale_jitter < 1:
         raise ParameterError(f"must be below 1 (a band cannot vanish), got {scale_jitter!r}", field="scale_jitter")
     if pen_noise > pen_width:
-        raise ParameterError(f"must not exceed pen_width ({pen_width}) or walls would get thinner than in the plan,"
-                             f" got {pen_noise!r}", field="pen_noise")
+        raise ParameterError(
+            f"must not exceed pen_width ({pen_width}) or walls would get thinner than in the plan, got {pen_noise!r}",
+            field="pen_noise",
+        )
     rng = np.random.default_rng(seed)
     cw = int(plan.params.get("corridor_width", 30))
     # Room around the building for the stub, the rotation and the wobble.
@@ -612,8 +636,11 @@ def sketchify(
         width = int(round(cw * rng.uniform(0.6, 0.85)))
         length = int(round(cw * rng.uniform(1.6, 2.6)))
         # Not off a dead end: a dead end drawn longer is no new place to the eye.
-        candidates = [c for c in _stub_candidates(original, plan, width, length)
-                      if c[0] not in dropped and plan.graph.degree(c[0]) > 1]
+        candidates = [
+            c
+            for c in _stub_candidates(original, plan, width, length)
+            if c[0] not in dropped and plan.graph.degree(c[0]) > 1
+        ]
         if candidates:
             parent, direction, (r0, r1, c0, c1) = candidates[int(rng.integers(len(candidates)))]
             stub = max(kinds, default=0) + 1
@@ -627,7 +654,7 @@ def sketchify(
     notes.append(f"drawn at scale {scale:g} (local +-{scale_jitter:g}), rotated {angle:+.1f} degrees")
     # Inverse map, sketch pixel -> plan pixel: undo the rotation and scale about the centres,
     # then the per-axis stretch, then add the wobble.
-    grid_r, grid_c = np.mgrid[0:out_shape[0], 0:out_shape[1]].astype(np.float32)
+    grid_r, grid_c = np.mgrid[0 : out_shape[0], 0 : out_shape[1]].astype(np.float32)
     dr = (grid_r - out_shape[0] / 2) / scale
     dc = (grid_c - out_shape[1] / 2) / scale
     del grid_r, grid_c
@@ -684,13 +711,14 @@ def ground_truth_pairs(plan: FloorPlan, sketch: Sketch) -> list[tuple[list[tuple
     return [([s], [m]) for _, s, m in _shared_points(plan, sketch)]
 
 
-def ground_truth_correspondences(plan: FloorPlan, sketch: Sketch, *, sketch_path: str | Path | None = None,
-                                 metric_path: str | Path | None = None):
-    """The ground truth as a :class:`~ursim_core.correspondences.Correspondences` value.
+def ground_truth_correspondences(
+    plan: FloorPlan, sketch: Sketch, *, sketch_path: str | Path | None = None, metric_path: str | Path | None = None
+):
+    """The ground truth as a :class:`~ursim_core.correspondences.codec.Correspondences` value.
 
     One clique per place in both maps, numbered from 1 in place order, noted
     ``"place <id> <kind>"``; region lists are left empty (they depend on a segmentation,
-    see :func:`ursim_core.correspondences.assign_regions`).
+    see :func:`ursim_core.correspondences.codec.assign_regions`).
 
     Examples
     --------
@@ -701,7 +729,7 @@ def ground_truth_correspondences(plan: FloorPlan, sketch: Sketch, *, sketch_path
     >>> corr.metric.size == plan.free.shape
     True
     """
-    from ursim_core.correspondences import Clique, Correspondences, MapRef
+    from ursim_core.correspondences.codec import Clique, Correspondences, MapRef
 
     kinds = plan.kinds
     cliques = tuple(
@@ -712,7 +740,7 @@ def ground_truth_correspondences(plan: FloorPlan, sketch: Sketch, *, sketch_path
         sketch=MapRef(path=sketch_path, size=tuple(sketch.free.shape)),
         metric=MapRef(path=metric_path, size=tuple(plan.free.shape)),
         cliques=cliques,
-        annotator="ursim_core.synth (generated ground truth)",
+        annotator="ursim_core.synth.generator (generated ground truth)",
     )
 
 
@@ -741,8 +769,14 @@ def make_pair(
     >>> sketch.free.shape[0] > plan.free.shape[0]
     True
     """
-    plan = generate_floor_plan(shape=shape, n_rooms=n_rooms, seed=seed, corridor_width=corridor_width,
-                               wall_thickness=wall_thickness, door_width=door_width)
+    plan = generate_floor_plan(
+        shape=shape,
+        n_rooms=n_rooms,
+        seed=seed,
+        corridor_width=corridor_width,
+        wall_thickness=wall_thickness,
+        door_width=door_width,
+    )
     return plan, sketchify(plan, seed=seed, **sketch_options)
 
 
@@ -757,7 +791,7 @@ def save_example(plan: FloorPlan, sketch: Sketch, folder: str | Path, *, now: st
     """Write ``metric.png``, ``sketch.png`` (8-bit grey, 255 free, 0 wall) and ``ground_truth.json``.
 
     The JSON file is in the project's correspondence format
-    (:func:`ursim_core.correspondences.save_correspondences`), with the maps' sizes and
+    (:func:`ursim_core.correspondences.codec.save_correspondences`), with the maps' sizes and
     SHA-256 and one clique per place present in both maps.
 
     Parameters
@@ -780,8 +814,8 @@ def save_example(plan: FloorPlan, sketch: Sketch, folder: str | Path, *, now: st
     """
     import dataclasses
 
-    from ursim_core.atomic import atomic_write_bytes
-    from ursim_core.correspondences import MapRef, save_correspondences
+    from ursim_core.correspondences.codec import MapRef, save_correspondences
+    from ursim_core.io.atomic import atomic_write_bytes
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

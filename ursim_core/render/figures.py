@@ -6,15 +6,15 @@ All functions return RGB uint8 arrays (rows, cols, 3); :func:`save_png` writes t
 from __future__ import annotations
 
 import colorsys
+from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Iterable, Sequence
 
 import cv2
 import networkx as nx
 import numpy as np
 
-from ursim_core.atomic import atomic_write_bytes
 from ursim_core.errors import UrsimError
+from ursim_core.io.atomic import atomic_write_bytes
 
 __all__ = ["distinct_colors", "label_colors", "overlay_segmentation", "side_by_side_matches", "save_png"]
 
@@ -108,7 +108,7 @@ def overlay_segmentation(
     Examples
     --------
     >>> labels = np.zeros((20, 30), np.int32); labels[2:18, 2:14] = 1; labels[2:18, 14:28] = 2
-    >>> from ursim_core.graph import region_graph
+    >>> from ursim_core.segmentation.graph import region_graph
     >>> overlay_segmentation(labels, region_graph(labels)).shape
     (20, 30, 3)
     """
@@ -129,7 +129,9 @@ def overlay_segmentation(
     for region in marked:
         if region in graph:
             row, col = graph.nodes[region]["interior"]
-            cv2.circle(canvas, (int(col), int(row)), int(14 * scale + 6), (220, 20, 60), max(2, int(scale * 3)), cv2.LINE_AA)
+            cv2.circle(
+                canvas, (int(col), int(row)), int(14 * scale + 6), (220, 20, 60), max(2, int(scale * 3)), cv2.LINE_AA
+            )
     if show_ids:
         for region, (row, col) in graph.nodes(data="interior"):
             _put_label(canvas, str(region), row, col, scale)
@@ -156,10 +158,24 @@ def side_by_side_matches(
     for index, (s, m) in enumerate(pairs):
         sketch_colors[s] = pair_colors[index]
         metric_colors[m] = pair_colors[index]
-    left = overlay_segmentation(sketch[0], sketch[1], image=sketch[2], colors=sketch_colors, show_edges=False,
-                                marked=[a for a, _ in anchors], opacity=0.7)
-    right = overlay_segmentation(metric[0], metric[1], image=metric[2], colors=metric_colors, show_edges=False,
-                                 marked=[b for _, b in anchors], opacity=0.7)
+    left = overlay_segmentation(
+        sketch[0],
+        sketch[1],
+        image=sketch[2],
+        colors=sketch_colors,
+        show_edges=False,
+        marked=[a for a, _ in anchors],
+        opacity=0.7,
+    )
+    right = overlay_segmentation(
+        metric[0],
+        metric[1],
+        image=metric[2],
+        colors=metric_colors,
+        show_edges=False,
+        marked=[b for _, b in anchors],
+        opacity=0.7,
+    )
     scale = left.shape[0] / right.shape[0]
     right = cv2.resize(right, (max(1, round(right.shape[1] * scale)), left.shape[0]), interpolation=cv2.INTER_NEAREST)
     canvas = np.full((left.shape[0], left.shape[1] + gap + right.shape[1], 3), 255, np.uint8)

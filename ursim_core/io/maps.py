@@ -486,7 +486,7 @@ def _decode_image(data: bytes, path: Path, *, max_pixels: int, apply_exif_orient
             raise MapError("not an image (or a format Pillow cannot read)", path=path) from None
         except MemoryError:
             raise
-        except Exception as error:  # noqa: BLE001 - plugins raise many types on bad headers
+        except Exception as error:
             raise MapError(f"corrupt image header: {error}", path=path) from error
 
     width, height = image.size
@@ -507,7 +507,7 @@ def _decode_image(data: bytes, path: Path, *, max_pixels: int, apply_exif_orient
         image.load()
     except MemoryError:
         raise
-    except Exception as error:  # noqa: BLE001 - decoders raise OSError, SyntaxError, zlib.error, ...
+    except Exception as error:
         raise MapError(f"truncated or corrupt image data: {error}", path=path) from error
     if apply_exif_orientation:
         image = _exif_oriented(image)
@@ -519,7 +519,7 @@ def _exif_oriented(image):
 
     try:
         orientation = image.getexif().get(0x0112, 1)
-    except Exception:  # noqa: BLE001 - a broken EXIF block must not make the pixels unreadable
+    except Exception:
         return image
     if orientation in (2, 3, 4, 5, 6, 7, 8):
         return ImageOps.exif_transpose(image)
@@ -586,7 +586,9 @@ def _pixels_from_array(values: np.ndarray, path: Path | None) -> _Pixels:
     if values.ndim == 3 and values.shape[2] not in (1, 2, 3, 4):
         raise MapError(f"an image array needs 1, 2, 3 or 4 channels, got shape {values.shape}", path=path)
     if values.ndim > 3:
-        raise MapError(f"an image array must be (rows, cols) or (rows, cols, channels), got shape {values.shape}", path=path)
+        raise MapError(
+            f"an image array must be (rows, cols) or (rows, cols, channels), got shape {values.shape}", path=path
+        )
     if values.dtype not in (np.uint8, np.uint16):
         if not np.issubdtype(values.dtype, np.integer):
             raise MapError(
@@ -595,8 +597,7 @@ def _pixels_from_array(values: np.ndarray, path: Path | None) -> _Pixels:
             )
         if values.min() < 0 or values.max() > 255:
             raise MapError(
-                f"integer array of dtype {values.dtype} has values outside 0..255; "
-                "pass uint16 for 16-bit images",
+                f"integer array of dtype {values.dtype} has values outside 0..255; pass uint16 for 16-bit images",
                 path=path,
             )
         values = values.astype(np.uint8)
@@ -809,7 +810,9 @@ def _ros_settings(document: dict, yaml_path: Path) -> dict:
     }
 
 
-def _nav2_lookup_table(n_channels: int, *, mode: str, negate: int, free_thresh: float, occupied_thresh: float) -> np.ndarray:
+def _nav2_lookup_table(
+    n_channels: int, *, mode: str, negate: int, free_thresh: float, occupied_thresh: float
+) -> np.ndarray:
     """Occupancy for every possible sum of ``n_channels`` 16-bit channel values.
 
     The per-pixel arithmetic copies nav2's ``loadMapFromFile`` on a Q16 GraphicsMagick:
@@ -836,7 +839,9 @@ def _nav2_lookup_table(n_channels: int, *, mode: str, negate: int, free_thresh: 
     return table
 
 
-def _nav2_occupancy(pixels: _Pixels, *, mode: str, negate: int, free_thresh: float, occupied_thresh: float) -> np.ndarray:
+def _nav2_occupancy(
+    pixels: _Pixels, *, mode: str, negate: int, free_thresh: float, occupied_thresh: float
+) -> np.ndarray:
     colour, alpha = pixels.colour, pixels.alpha
     colour_to_q16 = 257 if colour.dtype == np.uint8 else 1
     alpha_to_q16 = 0 if alpha is None else (257 if alpha.dtype == np.uint8 else 1)

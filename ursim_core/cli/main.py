@@ -10,8 +10,9 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 from ursim_core.errors import ParameterError, UrsimError
 
@@ -81,14 +82,21 @@ def _parse_param(text: str) -> tuple[str, Any]:
 
 def _add_map_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("map loading")
-    group.add_argument("--threshold", type=int, default=250, help="grey value above which a pixel is free (default 250)")
-    group.add_argument("--nonzero-free", action="store_true",
-                       help="every non-zero pixel is free (the released URSIM driver's behaviour)")
-    group.add_argument("--max-pixels", type=int, default=64_000_000, help="refuse maps larger than this (default 64 Mpx)")
+    group.add_argument(
+        "--threshold", type=int, default=250, help="grey value above which a pixel is free (default 250)"
+    )
+    group.add_argument(
+        "--nonzero-free",
+        action="store_true",
+        help="every non-zero pixel is free (the released URSIM driver's behaviour)",
+    )
+    group.add_argument(
+        "--max-pixels", type=int, default=64_000_000, help="refuse maps larger than this (default 64 Mpx)"
+    )
 
 
 def _load(path: str | Path, args: argparse.Namespace):
-    from ursim_core.maps import load_map
+    from ursim_core.io.maps import load_map
 
     return load_map(path, threshold=args.threshold, nonzero_free=args.nonzero_free, max_pixels=args.max_pixels)
 
@@ -110,13 +118,16 @@ def _region_records(segmentation) -> list[dict[str, Any]]:
 
 
 def _write_segmentation_outputs(the_map, segmentation, out: Path, *, preset: str | None) -> None:
-    from ursim_core.atomic import atomic_write_text
-    from ursim_core.render import overlay_segmentation, save_png
+    from ursim_core.io.atomic import atomic_write_text
+    from ursim_core.render.figures import overlay_segmentation, save_png
     from ursim_core.segmentation import save_label_image
 
     name = the_map.name
     save_label_image(segmentation, out / f"{name}.labels.png")
-    save_png(out / f"{name}.overlay.png", overlay_segmentation(segmentation.labels, segmentation.graph, image=the_map.image, free=the_map.free))
+    save_png(
+        out / f"{name}.overlay.png",
+        overlay_segmentation(segmentation.labels, segmentation.graph, image=the_map.image, free=the_map.free),
+    )
     document = {
         "map": str(the_map.path) if the_map.path else None,
         "sha256": the_map.sha256,
@@ -226,9 +237,9 @@ def _matcher_record(config, result) -> dict[str, Any]:
 
 
 def cmd_match(args: argparse.Namespace) -> int:
-    from ursim_core.correspondences import Correspondences, MapRef, from_pairs, save_correspondences
+    from ursim_core.correspondences.codec import Correspondences, MapRef, from_pairs, save_correspondences
     from ursim_core.matching import match
-    from ursim_core.render import save_png, side_by_side_matches
+    from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image, segment
 
     config = _match_config(args)
@@ -276,14 +287,16 @@ def cmd_match(args: argparse.Namespace) -> int:
     )
     save_png(out / "matches.png", figure)
     m_text = f"{result.m:.3f}" if isinstance(result.m, (int, float)) else str(result.m)
-    print(f"{len(result.pairs)} matches ({sketch_seg.n_regions} sketch regions, {metric_seg.n_regions} metric regions), "
-          f"m = {m_text}, {elapsed * 1000:.1f} ms" + (f"; {result.reason}" if result.reason else ""))
+    print(
+        f"{len(result.pairs)} matches ({sketch_seg.n_regions} sketch regions, {metric_seg.n_regions} metric regions), "
+        f"m = {m_text}, {elapsed * 1000:.1f} ms" + (f"; {result.reason}" if result.reason else "")
+    )
     print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
     return 0
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
-    from ursim_core.evaluation import format_tables, run_evaluation, write_report
+    from ursim_core.evaluation.runner import format_tables, run_evaluation, write_report
 
     progress = ProgressBar(1, label="evaluate")
 
@@ -322,7 +335,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
 
 
 def cmd_convert(args: argparse.Namespace) -> int:
-    from ursim_core.convert import convert
+    from ursim_core.cli.convert import convert
 
     convert(Path(args.input), Path(args.output), sketch=args.sketch, metric=args.metric)
     print(f"wrote {args.output}")
@@ -330,7 +343,7 @@ def cmd_convert(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from ursim_core.bench import run_bench
+    from ursim_core.bench.runner import run_bench
 
     return run_bench(args.what, datasets=args.datasets, repeats=args.repeats)
 
@@ -348,18 +361,31 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     def sub(name: str, help_text: str, handler: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
-        p = commands.add_parser(name, help=help_text, description=help_text, epilog=EXAMPLES.get(name),
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+        p = commands.add_parser(
+            name,
+            help=help_text,
+            description=help_text,
+            epilog=EXAMPLES.get(name),
+            formatter_class=argparse.RawDescriptionHelpFormatter,
+        )
         p.set_defaults(handler=handler)
         return p
 
-    seg = sub("segment", "Segment maps into regions (MAORIS) and write labels, overlays and region tables.", cmd_segment)
+    seg = sub(
+        "segment", "Segment maps into regions (MAORIS) and write labels, overlays and region tables.", cmd_segment
+    )
     seg.add_argument("maps", nargs="*", metavar="MAP", help="map images or ROS map YAML files")
     seg.add_argument("-o", "--output", metavar="OUT", help="output folder")
-    seg.add_argument("--preset", default="sketch", help="parameter preset: sketch, robot, default, icra, ursim-released")
+    seg.add_argument(
+        "--preset", default="sketch", help="parameter preset: sketch, robot, default, icra, ursim-released"
+    )
     seg.add_argument("--param", action="append", metavar="NAME=VALUE", help="override one parameter (repeatable)")
-    seg.add_argument("--evaluate", nargs=2, metavar=("GT_DIR", "MAPS_DIR"),
-                     help="score the segmentation of MAPS_DIR against separator-line ground truth in GT_DIR")
+    seg.add_argument(
+        "--evaluate",
+        nargs=2,
+        metavar=("GT_DIR", "MAPS_DIR"),
+        help="score the segmentation of MAPS_DIR against separator-line ground truth in GT_DIR",
+    )
     _add_map_options(seg)
 
     mat = sub("match", "Match a sketch map to a metric map and write correspondences and a figure.", cmd_match)
@@ -370,26 +396,55 @@ def build_parser() -> argparse.ArgumentParser:
     mat.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     mat.add_argument("--matcher", choices=["planar", "hungarian", "vf2"], help="graph matcher")
     mat.add_argument("--released", action="store_true", help="start from the released C++ code's options")
-    mat.add_argument("--sketch-preset", default=MATCH_PRESETS["sketch"],
-                     help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)")
-    mat.add_argument("--metric-preset", default=MATCH_PRESETS["metric"],
-                     help=f"segmentation preset for the metric map (default {MATCH_PRESETS['metric']})")
-    mat.add_argument("--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)")
+    mat.add_argument(
+        "--sketch-preset",
+        default=MATCH_PRESETS["sketch"],
+        help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)",
+    )
+    mat.add_argument(
+        "--metric-preset",
+        default=MATCH_PRESETS["metric"],
+        help=f"segmentation preset for the metric map (default {MATCH_PRESETS['metric']})",
+    )
+    mat.add_argument(
+        "--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)"
+    )
     _add_map_options(mat)
 
     ev = sub("evaluate", "Run the paper's experiments on a dataset folder and write a report.", cmd_evaluate)
     ev.add_argument("dataset", metavar="DATASET")
     ev.add_argument("-o", "--output", metavar="REPORT", help="report folder (CSV, plots, summary.md)")
-    ev.add_argument("--matchers", nargs="+", default=["planar", "hungarian", "vf2"], choices=["planar", "hungarian", "vf2"])
-    ev.add_argument("--variants", nargs="+", default=["baseline", "T1", "T2", "T3", "T4"], choices=["baseline", "T1", "T2", "T3", "T4"])
-    ev.add_argument("--legacy-scoring", nargs="?", const="as-built", default="none", choices=["none", "as-built", "fnfix"],
-                    help="reproduce the released scorer: 'as-built' (default when given: false negatives dropped, "
-                         "explains the paper's figures) or 'fnfix' (its flag initialised)")
-    ev.add_argument("--paper", action="store_true",
-                    help="the paper's method (no position term, structural score + substitutions) instead of the default")
-    ev.add_argument("--released", action="store_true",
-                    help="every released-code option on (segmentation, binarisation, statistics, weights, rotations)")
-    ev.add_argument("--preset", help=f"segmentation preset of the sketches / input maps (default {MATCH_PRESETS['sketch']})")
+    ev.add_argument(
+        "--matchers", nargs="+", default=["planar", "hungarian", "vf2"], choices=["planar", "hungarian", "vf2"]
+    )
+    ev.add_argument(
+        "--variants",
+        nargs="+",
+        default=["baseline", "T1", "T2", "T3", "T4"],
+        choices=["baseline", "T1", "T2", "T3", "T4"],
+    )
+    ev.add_argument(
+        "--legacy-scoring",
+        nargs="?",
+        const="as-built",
+        default="none",
+        choices=["none", "as-built", "fnfix"],
+        help="reproduce the released scorer: 'as-built' (default when given: false negatives dropped, "
+        "explains the paper's figures) or 'fnfix' (its flag initialised)",
+    )
+    ev.add_argument(
+        "--paper",
+        action="store_true",
+        help="the paper's method (no position term, structural score + substitutions) instead of the default",
+    )
+    ev.add_argument(
+        "--released",
+        action="store_true",
+        help="every released-code option on (segmentation, binarisation, statistics, weights, rotations)",
+    )
+    ev.add_argument(
+        "--preset", help=f"segmentation preset of the sketches / input maps (default {MATCH_PRESETS['sketch']})"
+    )
     ev.add_argument("--metric-preset", help=f"segmentation preset of the model map (default {MATCH_PRESETS['metric']})")
     ev.add_argument("--maps", nargs="+", metavar="NAME", help="only these maps (e.g. 00 03 17)")
     ev.add_argument("--cache", metavar="DIR", help="cache segmentations in DIR between runs")

@@ -1,6 +1,6 @@
 """Region descriptors for URSIM: attributes, uniqueness, anchors, weights and heat-kernel signatures.
 
-Everything here works on region adjacency graphs (:func:`ursim_core.graph.region_graph`) and
+Everything here works on region adjacency graphs (:func:`ursim_core.segmentation.graph.region_graph`) and
 plain arrays.  A graph's regions are always taken in ascending region-id order; the arrays
 returned are indexed in that order (``nodes[i]`` is the region id of row ``i``).
 
@@ -140,9 +140,7 @@ def attribute_statistics(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mean, sd
 
 
-def standardise(
-    values: np.ndarray, *, mean: np.ndarray | None = None, sd: np.ndarray | None = None
-) -> np.ndarray:
+def standardise(values: np.ndarray, *, mean: np.ndarray | None = None, sd: np.ndarray | None = None) -> np.ndarray:
     """Z-scores of the columns; statistics default to the values' own.
 
     Columns whose sd is 0 get z = 0 (no region stands out on a constant attribute).
@@ -191,6 +189,7 @@ def uniqueness_score(z_size: np.ndarray, z_pca: np.ndarray) -> np.ndarray:
     >>> uniqueness_score(np.array([0.0, 3.0]), np.array([0.0, 3.0])).round(3).tolist()
     [0.601, 0.996]
     """
+
     def pdf(x):
         return np.exp(-0.5 * np.square(x)) / np.sqrt(2.0 * np.pi)
 
@@ -261,9 +260,7 @@ def anchor_pairs(cost: np.ndarray) -> list[tuple[int, int]]:
     return [(int(r), int(c)) for r, c in zip(rows, cols)]
 
 
-def vertex_weights(
-    z: np.ndarray, *, kind: str = "size", floor: float = SIZE_WEIGHT_FLOOR
-) -> np.ndarray:
+def vertex_weights(z: np.ndarray, *, kind: str = "size", floor: float = SIZE_WEIGHT_FLOOR) -> np.ndarray:
     """Vertex weights of the Laplacian from standardised (size, pca_shape) attributes.
 
     Parameters
@@ -295,7 +292,9 @@ def vertex_weights(
     raise ValueError(f"weights must be 'size', 'uniqueness' or 'equal', not {kind!r}")
 
 
-def weighted_laplacian(graph: nx.Graph, weights: np.ndarray, *, nodes: Sequence | None = None, dense: bool | None = None):
+def weighted_laplacian(
+    graph: nx.Graph, weights: np.ndarray, *, nodes: Sequence | None = None, dense: bool | None = None
+):
     """Vertex-weighted Laplacian (Chung and Langlands).
 
     ``L(u,u) = sum_{v~u} w_v``, ``L(u,v) = -sqrt(w_u w_v)`` when u ~ v, else 0.
@@ -325,9 +324,7 @@ def weighted_laplacian(graph: nx.Graph, weights: np.ndarray, *, nodes: Sequence 
     if dense is None:
         dense = n <= DENSE_LIMIT
     index = {node: i for i, node in enumerate(nodes)}
-    edges = np.array(
-        [(index[a], index[b]) for a, b in graph.edges() if a != b], dtype=np.int64
-    ).reshape(-1, 2)
+    edges = np.array([(index[a], index[b]) for a, b in graph.edges() if a != b], dtype=np.int64).reshape(-1, 2)
     rows = np.concatenate([edges[:, 0], edges[:, 1]])
     cols = np.concatenate([edges[:, 1], edges[:, 0]])
     root = np.sqrt(weights)
@@ -350,8 +347,9 @@ def _expm_apply(laplacian, vectors: np.ndarray, times: np.ndarray) -> np.ndarray
     operator = sparse.csr_matrix(laplacian)
     if _uniform_grid(times) and times.size > 1:
         return np.asarray(
-            expm_multiply(-operator, vectors, start=float(times[0]), stop=float(times[-1]),
-                          num=times.size, endpoint=True)
+            expm_multiply(
+                -operator, vectors, start=float(times[0]), stop=float(times[-1]), num=times.size, endpoint=True
+            )
         )
     return np.stack([expm_multiply(-float(t) * operator, vectors) for t in times])
 
@@ -629,9 +627,15 @@ def pair_descriptors(
         metric_types = region_types(metric_graph, nodes=metric_nodes)
         c_matrix = _blend_positions(
             (sketch_types[:, None] != metric_types[None, :]).astype(np.float64),
-            sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight)
-        return PairDescriptors(sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [],
-                               None, None, None, None, c_matrix, notes)
+            sketch_graph,
+            sketch_nodes,
+            metric_graph,
+            metric_nodes,
+            position_weight,
+        )
+        return PairDescriptors(
+            sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [], None, None, None, None, c_matrix, notes
+        )
 
     uses_anchors = variant in ("T2", "T4")
     if weights is None:
@@ -645,14 +649,16 @@ def pair_descriptors(
     metric_anchor_rows: list[int] = []
     if uses_anchors:
         if not unique_sketch or not unique_metric:
-            notes.append("no anchors: no unique region in the "
-                         + ("sketch" if not unique_sketch else "metric map"))
+            notes.append("no anchors: no unique region in the " + ("sketch" if not unique_sketch else "metric map"))
         else:
             sketch_rows = np.flatnonzero(sketch_unique)
             metric_rows = np.flatnonzero(metric_unique)
             cost = disparity_matrix(
-                sketch_z[sketch_rows], metric_z[metric_rows], disparity=disparity,
-                raw_pca_first=sketch_values[sketch_rows, 1], raw_pca_second=metric_values[metric_rows, 1],
+                sketch_z[sketch_rows],
+                metric_z[metric_rows],
+                disparity=disparity,
+                raw_pca_first=sketch_values[sketch_rows, 1],
+                raw_pca_second=metric_values[metric_rows, 1],
             )
             for row, col in anchor_pairs(cost):
                 sketch_anchor_rows.append(int(sketch_rows[row]))
@@ -667,18 +673,38 @@ def pair_descriptors(
         (metric_graph, metric_nodes, metric_weights, metric_anchor_rows),
     ):
         laplacian = weighted_laplacian(graph, vertex_weight, nodes=nodes)
-        signatures.append(heat_kernel_signatures(
-            laplacian, anchors=anchor_rows if uses_anchors else None, times=times, method=method))
-    c_matrix = _blend_positions(signature_distance(signatures[0], signatures[1]),
-                                sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight)
-    return PairDescriptors(sketch_nodes, metric_nodes, sketch_z, metric_z, unique_sketch, unique_metric,
-                           anchors, sketch_weights, metric_weights, signatures[0], signatures[1],
-                           c_matrix, notes)
+        signatures.append(
+            heat_kernel_signatures(laplacian, anchors=anchor_rows if uses_anchors else None, times=times, method=method)
+        )
+    c_matrix = _blend_positions(
+        signature_distance(signatures[0], signatures[1]),
+        sketch_graph,
+        sketch_nodes,
+        metric_graph,
+        metric_nodes,
+        position_weight,
+    )
+    return PairDescriptors(
+        sketch_nodes,
+        metric_nodes,
+        sketch_z,
+        metric_z,
+        unique_sketch,
+        unique_metric,
+        anchors,
+        sketch_weights,
+        metric_weights,
+        signatures[0],
+        signatures[1],
+        c_matrix,
+        notes,
+    )
 
 
 def _blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight):
     if not position_weight:
         return c_matrix
-    distances = position_distance(region_positions(sketch_graph, nodes=sketch_nodes),
-                                  region_positions(metric_graph, nodes=metric_nodes))
+    distances = position_distance(
+        region_positions(sketch_graph, nodes=sketch_nodes), region_positions(metric_graph, nodes=metric_nodes)
+    )
     return (c_matrix + position_weight * distances) / (1.0 + position_weight)

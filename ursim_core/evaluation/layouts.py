@@ -212,7 +212,9 @@ def _discover_kth(folder: Path) -> list[Experiment]:
 
 def _find_model(model_folder: Path, dataset: Path) -> Path:
     if not model_folder.is_dir():
-        raise FormatError("missing model/ folder with the metric model map (expected model/model_simple.png)", path=dataset)
+        raise FormatError(
+            "missing model/ folder with the metric model map (expected model/model_simple.png)", path=dataset
+        )
     images = _images_by_stem(model_folder)
     if _MODEL_STEM in images:
         return images[_MODEL_STEM]

@@ -19,8 +19,14 @@ def _kind(path: Path) -> str:
         raise ParameterError("unknown correspondence file type (expected .dat or .json)", path=path) from None
 
 
-def convert(source: Path, target: Path, *, sketch: str | Path | None = None, metric: str | Path | None = None,
-            tolerance: int = 10) -> None:
+def convert(
+    source: Path,
+    target: Path,
+    *,
+    sketch: str | Path | None = None,
+    metric: str | Path | None = None,
+    tolerance: int = 10,
+) -> None:
     """Convert ``source`` (.dat or .json) to ``target`` (.json or .dat).
 
     For ``.dat -> .json``, ``sketch`` and ``metric`` name the two maps: they are recorded in the JSON
@@ -34,7 +40,7 @@ def convert(source: Path, target: Path, *, sketch: str | Path | None = None, met
     ...
     ursim_core.errors.ParameterError: a.txt: unknown correspondence file type (expected .dat or .json)
     """
-    from ursim_core.correspondences import (
+    from ursim_core.correspondences.codec import (
         MapRef,
         assign_regions,
         load_correspondences,
@@ -51,15 +57,21 @@ def convert(source: Path, target: Path, *, sketch: str | Path | None = None, met
     if (sketch is None) != (metric is None):
         raise ParameterError("give both --sketch and --metric, or neither")
     if sketch is not None and metric is not None:
-        from ursim_core.maps import load_map
+        from ursim_core.io.maps import load_map
         from ursim_core.segmentation import segment
 
         maps = {"sketch": load_map(sketch), "metric": load_map(metric)}
         segs = {side: segment(m, preset="default") for side, m in maps.items()}
         refs = {
-            side: MapRef(path=Path(m.path).resolve(), sha256=m.sha256, size=tuple(m.shape),
-                         segmentation_method=segs[side].method, segmentation_params=dict(segs[side].params),
-                         labels_path=None, extra={})
+            side: MapRef(
+                path=Path(m.path).resolve(),
+                sha256=m.sha256,
+                size=tuple(m.shape),
+                segmentation_method=segs[side].method,
+                segmentation_params=dict(segs[side].params),
+                labels_path=None,
+                extra={},
+            )
             for side, m in maps.items()
         }
         corr = dataclasses.replace(corr, sketch=refs["sketch"], metric=refs["metric"])

@@ -28,17 +28,18 @@ import operator
 import os
 import re
 import urllib.parse
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path, PurePath
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
-from ursim_core.atomic import atomic_write_text
 from ursim_core.errors import FormatError, SegmentationError
+from ursim_core.io.atomic import atomic_write_text
 
 __all__ = [
     "FORMAT_NAME",
@@ -353,17 +354,17 @@ def utc_timestamp(moment: datetime | None = None) -> str:
 
     Examples
     --------
-    >>> utc_timestamp(datetime(2024, 5, 1, 12, 0, tzinfo=timezone.utc))
+    >>> utc_timestamp(datetime(2024, 5, 1, 12, 0, tzinfo=UTC))
     '2024-05-01T12:00:00Z'
     """
-    moment = datetime.now(timezone.utc) if moment is None else moment.astimezone(timezone.utc)
+    moment = datetime.now(UTC) if moment is None else moment.astimezone(UTC)
     return moment.strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 # --------------------------------------------------------------------------- JSON
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def correspondences_schema(version: int = CURRENT_VERSION) -> dict:
     """The JSON Schema of a correspondence file version, as shipped in the package.
 
@@ -372,11 +373,13 @@ def correspondences_schema(version: int = CURRENT_VERSION) -> dict:
     >>> correspondences_schema()["properties"]["format"]
     {'const': 'ursim-correspondences'}
     """
-    resource = resources.files("ursim_core").joinpath("schemas", f"correspondences-{version}.schema.json")
+    resource = resources.files("ursim_core.correspondences").joinpath(
+        "schemas", f"correspondences-{version}.schema.json"
+    )
     return json.loads(resource.read_text(encoding="utf-8"))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _validator(version: int = CURRENT_VERSION):
     import jsonschema
 

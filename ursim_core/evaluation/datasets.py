@@ -12,10 +12,9 @@ from pathlib import Path
 __all__ = ["dataset_root", "DATASET_ENV", "MISSING_REASON"]
 
 DATASET_ENV = "URSIM_DATASETS"
-_REPO_ROOT = Path(__file__).resolve().parent.parent
+_REPO_ROOT = Path(__file__).resolve().parents[2]
 MISSING_REASON = (
-    f"research datasets not found: set ${DATASET_ENV} or place them in "
-    f"{_REPO_ROOT.parent / 'shared' / 'datasets'}"
+    f"research datasets not found: set ${DATASET_ENV} or place them in {_REPO_ROOT.parent / 'shared' / 'datasets'}"
 )
 
 

@@ -2,13 +2,13 @@
 
 Pipeline (:func:`run_evaluation`):
 
-1. :func:`ursim_core.dataset_layout.discover` lists the experiments (map pair + ground truth).
+1. :func:`ursim_core.evaluation.layouts.discover` lists the experiments (map pair + ground truth).
 2. Every distinct map is loaded and segmented once, in parallel over ``workers`` processes
    (biggest maps first so the two cores finish together). Segmentations can be kept across runs
    in a caller-owned dict (``segmentation_cache``) and on disk (``cache_dir``); keys include the
    file's SHA-256, so an edited map is segmented again.
 3. The ground-truth points of each annotator are mapped to the regions of the segmentations being
-   evaluated (:func:`ursim_core.correspondences.assign_regions`, 10 px tolerance as the released
+   evaluated (:func:`ursim_core.correspondences.codec.assign_regions`, 10 px tolerance as the released
    code). The points were clicked on MAORIS with its default parameters; they are mapped onto
    whatever segmentation is evaluated, so a point may land in a merged or split region.
 4. For each (experiment, matcher, variant) the m-independent work is done once
@@ -16,7 +16,7 @@ Pipeline (:func:`run_evaluation`):
    (:func:`ursim_core.matching.match_prepared`) and scored against every annotator
    (:func:`score_matches`). These tasks also run on the process pool.
 5. Human vs human: on a map pair that several annotators annotated, each annotator's cliques are
-   scored against each other's (:func:`ursim_core.evaluation_scoring.score_cliques`).
+   scored against each other's (:func:`ursim_core.evaluation.scoring.score_cliques`).
 
 Summaries (:func:`summarise`): for each annotator (and all annotators pooled) and each matcher x
 variant, the F1 over maps with
@@ -25,12 +25,12 @@ variant, the F1 over maps with
 - ``fixed``: the single m of the grid with the best mean F1 over the maps,
 - ``auto``: the automatic choice of m (:mod:`ursim_core.matching.auto_m`),
 
-as median and mean +- sample sd. :mod:`ursim_core.report` turns a result into tables, a CSV,
+as median and mean +- sample sd. :mod:`ursim_core.evaluation.report` turns a result into tables, a CSV,
 plots and a markdown summary.
 
 Scoring is correct by default; ``legacy_scoring=True`` reproduces what the released binary printed
 (false negatives always 0) and ``"fnfix"`` the released scorer with its uninitialised flag fixed
-(see :mod:`ursim_core.evaluation_scoring`).
+(see :mod:`ursim_core.evaluation.scoring`).
 """
 
 from __future__ import annotations
@@ -52,9 +52,9 @@ from typing import Any
 
 import numpy as np
 
-from ursim_core.dataset_layout import Experiment, discover
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation_scoring import MatchScore, score_cliques, score_matches
+from ursim_core.evaluation.layouts import Experiment, discover
+from ursim_core.evaluation.scoring import MatchScore, score_cliques, score_matches
 from ursim_core.matching import MATCH_PRESETS
 
 __all__ = [
@@ -252,7 +252,9 @@ class EvaluationResult:
 # --------------------------------------------------------------------------- summaries
 
 
-def summarise(rows: Iterable[RunRow], *, pool: bool = True, m_grid: Sequence[float] | None = None) -> tuple[Summary, ...]:
+def summarise(
+    rows: Iterable[RunRow], *, pool: bool = True, m_grid: Sequence[float] | None = None
+) -> tuple[Summary, ...]:
     """Oracle, best-fixed and automatic-m summaries of matcher runs.
 
     Parameters
@@ -331,7 +333,9 @@ def _summaries_of_method(annotator, matcher, variant, rows, grid_labels) -> list
     swept_maps = [name for name in maps if fixed.get(name)]
     if swept_maps:
         # Oracle: per map the best F1 of the grid; smallest m on ties.
-        best_rows = [max(sorted(fixed[name].values(), key=lambda r: r.m_value), key=lambda r: r.f1) for name in swept_maps]
+        best_rows = [
+            max(sorted(fixed[name].values(), key=lambda r: r.m_value), key=lambda r: r.f1) for name in swept_maps
+        ]
         result.append(_summary(annotator, matcher, variant, "oracle", swept_maps, best_rows))
 
         common = set.intersection(*(set(fixed[name]) for name in swept_maps))
@@ -440,7 +444,7 @@ def run_evaluation(
     Parameters
     ----------
     dataset_dir : str, Path or sequence of Experiment
-        A dataset folder (see :func:`ursim_core.dataset_layout.discover`) or experiments.
+        A dataset folder (see :func:`ursim_core.evaluation.layouts.discover`) or experiments.
     matchers : sequence of {'planar', 'hungarian', 'vf2'}, keyword-only
     variants : sequence of {'baseline', 'T1', 'T2', 'T3', 'T4'}, keyword-only
     m_grid : sequence of float, keyword-only
@@ -476,7 +480,7 @@ def run_evaluation(
     cache_dir : str or Path, keyword-only
         Folder of an on-disk segmentation cache (created if needed).
     threshold, nonzero_free : keyword-only
-        Map loading options (:func:`ursim_core.maps.load_map`); default 250 / False, or
+        Map loading options (:func:`ursim_core.io.maps.load_map`); default 250 / False, or
         non-zero-is-free when ``released``.
 
     Returns
@@ -492,7 +496,7 @@ def run_evaluation(
 
     Examples
     --------
-    >>> from ursim_core.datasets import dataset_root
+    >>> from ursim_core.evaluation.datasets import dataset_root
     >>> root = dataset_root()
     >>> if root is not None:  # doctest: +SKIP
     ...     result = run_evaluation(root / "ursim_kth_sketches", matchers=["planar"], variants=["T4"], maps=["01"])
@@ -531,9 +535,13 @@ def run_evaluation(
     known = {f.name for f in dataclasses.fields(MatchConfig)}
     for name in overrides:
         if name in ("variant", "matcher", "m", "m_grid"):
-            raise ParameterError(f"'{name}' is set by the runner; use the matchers/variants/m_grid options", field="config_overrides")
+            raise ParameterError(
+                f"'{name}' is set by the runner; use the matchers/variants/m_grid options", field="config_overrides"
+            )
         if name not in known:
-            raise ParameterError(f"unknown matching option '{name}' (known: {', '.join(sorted(known))})", field="config_overrides")
+            raise ParameterError(
+                f"unknown matching option '{name}' (known: {', '.join(sorted(known))})", field="config_overrides"
+            )
     base_config = dataclasses.replace(base_config, m_grid=tuple(m_grid), **overrides)
 
     load_options = {
@@ -658,7 +666,12 @@ def _checked_choice(values: Sequence[str], allowed: Sequence[str], name: str) ->
 def _checked_grid(m_grid: Sequence[float]) -> list[float]:
     values = []
     for m in m_grid:
-        if isinstance(m, bool) or not isinstance(m, (int, float, np.floating, np.integer)) or not math.isfinite(m) or m < 0:
+        if (
+            isinstance(m, bool)
+            or not isinstance(m, (int, float, np.floating, np.integer))
+            or not math.isfinite(m)
+            or m < 0
+        ):
             raise ParameterError(f"m values must be non-negative numbers, got {m!r}", field="m_grid")
         values.append(float(m))
     if not values:
@@ -717,7 +730,7 @@ class _SegmentationJob:
     load_key: str
 
     @classmethod
-    def of(cls, path: Path, preset: str, load: dict, digests: dict[Path, str]) -> "_SegmentationJob":
+    def of(cls, path: Path, preset: str, load: dict, digests: dict[Path, str]) -> _SegmentationJob:
         path = Path(path)
         if path not in digests:
             try:
@@ -738,7 +751,7 @@ class _SegmentationJob:
 
 def _segment_job(job: _SegmentationJob):
     """Load and segment one map (runs in a worker process)."""
-    from ursim_core.maps import load_map
+    from ursim_core.io.maps import load_map
     from ursim_core.segmentation import segment
 
     return segment(load_map(job.path, **job.load), preset=job.preset)
@@ -746,9 +759,14 @@ def _segment_job(job: _SegmentationJob):
 
 @functools.lru_cache(maxsize=1)
 def _segmenter_code_digest() -> str:
-    from ursim_core.segmentation import maoris
+    """Digest of every source file of the segmentation package: a cached result is stale when any changes."""
+    import ursim_core.segmentation as package
 
-    return hashlib.sha256(Path(maoris.__file__).read_bytes()).hexdigest()
+    digest = hashlib.sha256()
+    root = Path(package.__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()
 
 
 def _disk_cache_path(cache_dir: Path, job: _SegmentationJob) -> Path:
@@ -757,16 +775,21 @@ def _disk_cache_path(cache_dir: Path, job: _SegmentationJob) -> Path:
     # The resolved parameters (not only the preset name) and the segmenter's source go in the
     # key, so a changed preset definition or a changed MAORIS implementation invalidates the cache.
     identity = json.dumps(
-        {"sha256": job.digest, "params": resolve_params("maoris", job.preset), "load": job.load, "version": 1,
-         "code": _segmenter_code_digest()},
+        {
+            "sha256": job.digest,
+            "params": resolve_params("maoris", job.preset),
+            "load": job.load,
+            "version": 1,
+            "code": _segmenter_code_digest(),
+        },
         sort_keys=True,
     )
     return cache_dir / f"{job.path.stem}-{hashlib.sha256(identity.encode()).hexdigest()[:24]}.npz"
 
 
 def _read_disk_cache(path: Path, job: _SegmentationJob):
-    from ursim_core.graph import region_graph
     from ursim_core.segmentation import Segmentation, resolve_params
+    from ursim_core.segmentation.graph import region_graph
 
     try:
         with np.load(path) as stored:
@@ -774,11 +797,13 @@ def _read_disk_cache(path: Path, job: _SegmentationJob):
     except (OSError, KeyError, ValueError):
         # A missing, damaged or foreign cache file is only a cache miss.
         return None
-    return Segmentation(labels=labels, graph=region_graph(labels), method="maoris", params=resolve_params("maoris", job.preset))
+    return Segmentation(
+        labels=labels, graph=region_graph(labels), method="maoris", params=resolve_params("maoris", job.preset)
+    )
 
 
 def _write_disk_cache(path: Path, segmentation) -> None:
-    from ursim_core.atomic import atomic_write_bytes
+    from ursim_core.io.atomic import atomic_write_bytes
 
     buffer = io.BytesIO()
     np.savez_compressed(buffer, labels=segmentation.labels)
@@ -849,7 +874,7 @@ def _pixel_count(path: Path) -> int:
 
         with Image.open(path) as image:
             return image.width * image.height
-    except Exception:  # noqa: BLE001 - only an ordering hint; load_map reports the real problem
+    except Exception:
         return 0
 
 
@@ -858,7 +883,7 @@ def _pixel_count(path: Path) -> int:
 
 def _references(experiments, input_jobs, segmentations):
     """Per experiment (same order): annotator -> reference cliques as (sketch_regions, metric_regions)."""
-    from ursim_core.correspondences import assign_regions, load_dat, regions_at_points
+    from ursim_core.correspondences.codec import assign_regions, load_dat, regions_at_points
 
     references: list[dict[str, tuple]] = []
     notes: list[str] = []
@@ -962,7 +987,9 @@ def _run_task(task: _MatchTask, segmentations: dict[str, Any]) -> list[RunRow]:
     return rows
 
 
-def _run_tasks(tasks: list[_MatchTask], segmentations: dict[str, Any], workers: int, reporter: _Progress) -> list[RunRow]:
+def _run_tasks(
+    tasks: list[_MatchTask], segmentations: dict[str, Any], workers: int, reporter: _Progress
+) -> list[RunRow]:
     # Largest problems first so the workers finish together; the segmentations reach each
     # worker once through the pool initializer instead of once per task.
     order = sorted(
@@ -980,7 +1007,9 @@ def _run_tasks(tasks: list[_MatchTask], segmentations: dict[str, Any], workers: 
         reporter.step(f"match {task.name} {task.matcher} {task.variant}")
     position = {(t.name, t.model, t.matcher, t.variant): index for index, t in enumerate(tasks)}
     m_position = {label: i for i, label in enumerate([m_label(m) for m in tasks[0].m_grid] + [AUTO])} if tasks else {}
-    rows.sort(key=lambda r: (position[(r.map, r.model, r.matcher, r.variant)], r.annotator, m_position.get(r.m_label, 0)))
+    rows.sort(
+        key=lambda r: (position[(r.map, r.model, r.matcher, r.variant)], r.annotator, m_position.get(r.m_label, 0))
+    )
     return rows
 
 
@@ -1029,14 +1058,14 @@ def _human_rows(experiments, input_jobs, segmentations, references, legacy_mode)
 
 
 def format_tables(result: EvaluationResult) -> str:
-    """Table-1-style text tables of a result (see :func:`ursim_core.report.format_tables`)."""
-    from ursim_core.report import format_tables as _format_tables
+    """Table-1-style text tables of a result (see :func:`ursim_core.evaluation.report.format_tables`)."""
+    from ursim_core.evaluation.report import format_tables as _format_tables
 
     return _format_tables(result)
 
 
 def write_report(result: EvaluationResult, out_dir: str | Path) -> dict[str, Path]:
-    """Write runs.csv, summary.md and the plots (see :func:`ursim_core.report.write_report`)."""
-    from ursim_core.report import write_report as _write_report
+    """Write runs.csv, summary.md and the plots (see :func:`ursim_core.evaluation.report.write_report`)."""
+    from ursim_core.evaluation.report import write_report as _write_report
 
     return _write_report(result, out_dir)

@@ -1,6 +1,6 @@
 """Benchmarks of the URSIM matcher: KTH sketches (time per match, full m sweep) and scale.
 
-Run ``python -m ursim_core.bench_matching [--datasets PATH] [--sizes 300 1000] [--accuracy]``.
+Run ``python -m ursim_core.bench.matching [--datasets PATH] [--sizes 300 1000] [--accuracy]``.
 Figures are printed, never asserted (speed targets belong here, not in unit tests).
 
 - :func:`bench_kth`: segments the 18 KTH sketches and the model once (cached in memory), then times
@@ -47,8 +47,12 @@ def random_region_graph(n: int, *, seed: int = 0, keep_fraction: float = 0.5) ->
     points = rng.uniform(0.0, side, size=(n, 2))
     graph = nx.Graph()
     for node, (row, col) in enumerate(points):
-        graph.add_node(node, size=int(rng.lognormal(8.0, 0.8)), pca_shape=float(rng.uniform(0.0, 1.0)),
-                       centroid=(float(row), float(col)))
+        graph.add_node(
+            node,
+            size=int(rng.lognormal(8.0, 0.8)),
+            pca_shape=float(rng.uniform(0.0, 1.0)),
+            centroid=(float(row), float(col)),
+        )
     if n < 2:
         return graph
     delaunay_edges = set()
@@ -140,7 +144,7 @@ def bench_scale(sizes=(300, 1000), *, m: float = 0.01, seed: int = 0, config=Non
         Per size: ``n``, ``edges``, ``prepare_s``, ``match_s``, ``peak_mib``,
         ``growth_mib``, ``seeds``, ``pairs``, ``f1``.
     """
-    from .matching import MatchConfig, match_prepared, prepare
+    from ursim_core.matching import MatchConfig, match_prepared, prepare
 
     config = MatchConfig(m=m) if config is None else config
     rows = []
@@ -162,15 +166,26 @@ def bench_scale(sizes=(300, 1000), *, m: float = 0.01, seed: int = 0, config=Non
         del prepared
         after = tracemalloc.get_traced_memory()[0]
         tracemalloc.stop()
-        rows.append(dict(
-            n=n, edges=graph.number_of_edges(), prepare_s=prepared_at - start, match_s=done - prepared_at,
-            peak_mib=(peak - before) / 2**20, growth_mib=(after - before) / 2**20,
-            seeds=result.seeds_count, pairs=len(result.pairs), f1=_identity_f1(result.pairs, mapping),
-        ))
-        print(f"scale n={n:5d} edges={rows[-1]['edges']:5d}: prepare {rows[-1]['prepare_s']:.3f} s, "
-              f"match {rows[-1]['match_s']:.3f} s, tracemalloc peak {rows[-1]['peak_mib']:.1f} MiB, "
-              f"growth {rows[-1]['growth_mib']:.2f} MiB, seeds {result.seeds_count}, "
-              f"pairs {len(result.pairs)}, F1 vs truth {rows[-1]['f1']:.3f}", flush=True)
+        rows.append(
+            dict(
+                n=n,
+                edges=graph.number_of_edges(),
+                prepare_s=prepared_at - start,
+                match_s=done - prepared_at,
+                peak_mib=(peak - before) / 2**20,
+                growth_mib=(after - before) / 2**20,
+                seeds=result.seeds_count,
+                pairs=len(result.pairs),
+                f1=_identity_f1(result.pairs, mapping),
+            )
+        )
+        print(
+            f"scale n={n:5d} edges={rows[-1]['edges']:5d}: prepare {rows[-1]['prepare_s']:.3f} s, "
+            f"match {rows[-1]['match_s']:.3f} s, tracemalloc peak {rows[-1]['peak_mib']:.1f} MiB, "
+            f"growth {rows[-1]['growth_mib']:.2f} MiB, seeds {result.seeds_count}, "
+            f"pairs {len(result.pairs)}, F1 vs truth {rows[-1]['f1']:.3f}",
+            flush=True,
+        )
     return rows
 
 
@@ -189,23 +204,27 @@ def bench_kth(dataset_root=None, *, m: float = 0.1, repeats: int = 3) -> dict:
     dict
         The printed figures, keyed ``<config>_<figure>`` (milliseconds or seconds as named).
     """
-    from .datasets import dataset_root as locate
-    from .matching import M_GRID, MatchConfig, match_prepared, prepare
-    from .matching.experiments import kth_pairs, score_pairs
+    from ursim_core.evaluation.datasets import dataset_root as locate
+    from ursim_core.evaluation.kth_protocol import kth_pairs, score_pairs
+    from ursim_core.matching import M_GRID, MatchConfig, match_prepared, prepare
 
     root = locate(dataset_root)
     if root is None:
         print("bench_kth: datasets not found, skipped")
         return {}
     figures = {}
-    for label, pipeline, config in (("default", "recommended", MatchConfig()),
-                                    ("released", "released", MatchConfig.released())):
+    for label, pipeline, config in (
+        ("default", "recommended", MatchConfig()),
+        ("released", "released", MatchConfig.released()),
+    ):
         cases = kth_pairs(root, pipeline=pipeline)
-        print(f"kth {label}: {len(cases.sketches)} sketches + model, {pipeline} pipeline: segmentation "
-              f"{cases.segmentation_seconds:.1f} s (0 when already done in this process; not counted below)",
-              flush=True)
+        print(
+            f"kth {label}: {len(cases.sketches)} sketches + model, {pipeline} pipeline: segmentation "
+            f"{cases.segmentation_seconds:.1f} s (0 when already done in this process; not counted below)",
+            flush=True,
+        )
         prepare_times, match_times, auto_times = [], [], []
-        for name, sketch in cases.sketches.items():
+        for sketch in cases.sketches.values():
             t0 = time.perf_counter()
             prepared = prepare(sketch, cases.model, config)
             prepare_times.append(time.perf_counter() - t0)
@@ -231,10 +250,12 @@ def bench_kth(dataset_root=None, *, m: float = 0.1, repeats: int = 3) -> dict:
         figures[f"{label}_match_max_ms"] = 1000 * max(match_times)
         figures[f"{label}_prepare_median_ms"] = 1000 * statistics.median(prepare_times)
         figures[f"{label}_sweep_s"] = sweep
-        line = (f"kth {label}: one match at m={m}: median {figures[f'{label}_match_median_ms']:.2f} ms, "
-                f"max {figures[f'{label}_match_max_ms']:.2f} ms; prepare median "
-                f"{figures[f'{label}_prepare_median_ms']:.2f} ms; 20-m sweep + scoring, "
-                f"{len(cases.sketches)} sketches x {len(cases.references)} annotators: {sweep:.2f} s")
+        line = (
+            f"kth {label}: one match at m={m}: median {figures[f'{label}_match_median_ms']:.2f} ms, "
+            f"max {figures[f'{label}_match_max_ms']:.2f} ms; prepare median "
+            f"{figures[f'{label}_prepare_median_ms']:.2f} ms; 20-m sweep + scoring, "
+            f"{len(cases.sketches)} sketches x {len(cases.references)} annotators: {sweep:.2f} s"
+        )
         if auto_times:
             figures[f"{label}_auto_median_ms"] = 1000 * statistics.median(auto_times)
             line += f"; one m='auto' match: median {figures[f'{label}_auto_median_ms']:.1f} ms"
@@ -246,13 +267,12 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--datasets", default=None)
     parser.add_argument("--sizes", type=int, nargs="*", default=[300, 1000])
-    parser.add_argument("--auto-sizes", type=int, nargs="*", default=[300],
-                        help="sizes also timed with m='auto'")
+    parser.add_argument("--auto-sizes", type=int, nargs="*", default=[300], help="sizes also timed with m='auto'")
     parser.add_argument("--skip-kth", action="store_true")
     parser.add_argument("--accuracy", action="store_true", help="also print the KTH accuracy table")
     arguments = parser.parse_args(argv)
     if arguments.accuracy:
-        from .matching.experiments import accuracy_report
+        from ursim_core.evaluation.kth_protocol import accuracy_report
 
         accuracy_report(arguments.datasets)
     if not arguments.skip_kth:
@@ -260,7 +280,7 @@ def main(argv=None) -> int:
     if arguments.sizes:
         bench_scale(tuple(arguments.sizes))
     if arguments.auto_sizes:
-        from .matching import MatchConfig
+        from ursim_core.matching import MatchConfig
 
         print("with m='auto':")
         bench_scale(tuple(arguments.auto_sizes), config=MatchConfig())

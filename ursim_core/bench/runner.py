@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ursim_core.datasets import MISSING_REASON, dataset_root
+from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 
 __all__ = ["run_bench"]
 
@@ -17,7 +17,7 @@ def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats:
 
         print(f"segmentation kernels ready in {compile_kernels():.1f} s (compiled on first use, then cached)")
     if what in ("segment", "all"):
-        from ursim_core.bench_segmentation import bench_segmentation, print_table
+        from ursim_core.bench.segmentation import bench_segmentation, print_table
 
         if root is None:
             print(f"segment: skipped ({MISSING_REASON})")
@@ -25,12 +25,12 @@ def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats:
             print("== segmentation of the largest maps (median of repeats)")
             print_table(bench_segmentation(root, repeats=repeats))
     if what in ("scale", "all"):
-        from ursim_core.bench_segmentation import bench_scale, print_table
+        from ursim_core.bench.segmentation import bench_scale, print_table
 
         print("== segmentation scale (generated buildings)")
         print_table(bench_scale())
     if what in ("match", "all"):
-        from ursim_core.bench_matching import main as bench_matching
+        from ursim_core.bench.matching import main as bench_matching
 
         print("== matching (KTH pairs, then generated graphs of 300 and 1000 regions)")
         if root is None:

@@ -31,9 +31,10 @@ C++ loop did; undefined ratios (0/0) are 0 instead of NaN.
 from __future__ import annotations
 
 import operator
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from itertools import product
-from typing import Any, Iterable, Sequence
+from typing import Any
 
 from ursim_core.errors import ParameterError
 
@@ -96,8 +97,8 @@ def score_matches(pairs: Iterable[tuple[int, int]], reference: Iterable, *, lega
     reference : iterable
         Reference cliques, each a ``(sketch_regions, metric_regions)`` pair of
         collections of region ids, or an object with ``sketch_regions`` and
-        ``metric_regions`` attributes (a :class:`~ursim_core.correspondences.Clique`).
-        A :class:`~ursim_core.correspondences.Correspondences` is taken as its cliques.
+        ``metric_regions`` attributes (a :class:`~ursim_core.correspondences.codec.Clique`).
+        A :class:`~ursim_core.correspondences.codec.Correspondences` is taken as its cliques.
     legacy : {False, True, "as-built", "fnfix"}, keyword-only
         Scoring rules; see the module docstring. False is the correct scoring.
 

@@ -1,18 +1,18 @@
 """The KTH sketch-matching experiment: segmentations, reference cliques and F1 tables.
 
-Used by the matching benchmark (``ursim_core.bench_matching``), the dataset regression test and
+Used by the matching benchmark (``ursim_core.bench.matching``), the dataset regression test and
 the studies behind the defaults (``ursim_core.matching.auto_m``). The data (18 KTH sketches, the
 metric model, ground truth by two annotators) is read from the datasets folder and never copied.
 
-Protocol (``original_code.md`` §1.1, §1.13; correct scoring of ``ursim_core.evaluation_scoring``):
+Protocol (``original_code.md`` §1.1, §1.13; correct scoring of ``ursim_core.evaluation.scoring``):
 
-- Sketches and the model are loaded with :func:`ursim_core.maps.load_map` and segmented with MAORIS
+- Sketches and the model are loaded with :func:`ursim_core.io.maps.load_map` and segmented with MAORIS
   (:func:`ursim_core.segmentation.segment`). The *recommended* pipeline binarises at > 250 and uses
   the ``"default"`` preset (t = 0.25, doors 40, the parameters the ground truth was clicked on) for
   both maps; the *released* pipeline uses every non-zero pixel as free and the ``"ursim-released"``
   preset (t = 0.50) for both, as the released driver did.
 - Ground-truth points map to regions of the segmentation being matched by
-  :func:`ursim_core.correspondences.regions_at_points` (10 px tolerance).
+  :func:`ursim_core.correspondences.codec.regions_at_points` (10 px tolerance).
 - F1 is computed per sketch and annotator with ``score_matches`` (correct mode by default:
   pairs counted once, cliques with an empty side ignored; ``legacy="fnfix"`` reproduces the
   released scorer with the flag initialised).
@@ -55,16 +55,16 @@ def reference_cliques(labels: np.ndarray, metric_labels: np.ndarray, cliques, *,
     labels, metric_labels : ndarray
         Label images of the sketch and the metric map.
     cliques : iterable of Clique
-        From :func:`ursim_core.correspondences.load_dat` (``sketch_points``, ``metric_points``).
+        From :func:`ursim_core.correspondences.codec.load_dat` (``sketch_points``, ``metric_points``).
 
     Examples
     --------
-    >>> from ursim_core.correspondences import Clique
+    >>> from ursim_core.correspondences.codec import Clique
     >>> sketch = np.array([[1, 1, 2]]); metric = np.array([[5, 6, 6]])
     >>> reference_cliques(sketch, metric, [Clique(id=1, sketch_points=[(0, 2)], metric_points=[(0, 0)])])
     [({2}, {5})]
     """
-    from ..correspondences import Correspondences, assign_regions
+    from ursim_core.correspondences.codec import Correspondences, assign_regions
 
     assigned = assign_regions(Correspondences(cliques=tuple(cliques)), labels, metric_labels, tolerance=tolerance)
     return [(set(c.sketch_regions), set(c.metric_regions)) for c in assigned.cliques]
@@ -72,7 +72,7 @@ def reference_cliques(labels: np.ndarray, metric_labels: np.ndarray, cliques, *,
 
 def score_pairs(pairs, reference, *, legacy=False):
     """Score matched pairs against reference cliques (``evaluation_scoring.score_matches``)."""
-    from ..evaluation_scoring import score_matches
+    from ursim_core.evaluation.scoring import score_matches
 
     return score_matches(list(pairs), reference, legacy=legacy)
 
@@ -108,8 +108,8 @@ _CACHE: dict = {}
 
 
 def _segment_file(path: Path, nonzero_free: bool, preset: str):
-    from ..maps import load_map
-    from ..segmentation import segment
+    from ursim_core.io.maps import load_map
+    from ursim_core.segmentation import segment
 
     return segment(load_map(path, nonzero_free=nonzero_free), preset=preset)
 
@@ -120,14 +120,14 @@ def kth_pairs(root, *, pipeline: str = "recommended", sketches: Sequence[str] | 
     Parameters
     ----------
     root : Path
-        The datasets folder (``ursim_core.datasets.dataset_root()``).
+        The datasets folder (``ursim_core.evaluation.datasets.dataset_root()``).
     pipeline : {'recommended', 'released'}
     sketches : sequence of str, optional
         Subset of sketch names; default all 18.
     """
     import time
 
-    from ..correspondences import load_dat
+    from ursim_core.correspondences.codec import load_dat
 
     root = Path(root)
     folder = root / "ursim_kth_sketches"
@@ -155,12 +155,24 @@ def kth_pairs(root, *, pipeline: str = "recommended", sketches: Sequence[str] | 
             cliques = load_dat(path).cliques
             ground_truth[annotator][name] = cliques
             references[annotator][name] = reference_cliques(segmentations[name].labels, model.labels, cliques)
-    return KthCases(pipeline=pipeline, sketches=segmentations, model=model, references=references,
-                    segmentation_seconds=time.perf_counter() - start, ground_truth=ground_truth)
+    return KthCases(
+        pipeline=pipeline,
+        sketches=segmentations,
+        model=model,
+        references=references,
+        segmentation_seconds=time.perf_counter() - start,
+        ground_truth=ground_truth,
+    )
 
 
-def f1_table(cases: KthCases, config, m_values: Sequence[float] | None = None, *, legacy=False,
-             prepared_hook: Callable | None = None) -> dict:
+def f1_table(
+    cases: KthCases,
+    config,
+    m_values: Sequence[float] | None = None,
+    *,
+    legacy=False,
+    prepared_hook: Callable | None = None,
+) -> dict:
     """F1 of every sketch, annotator and m.
 
     Parameters
@@ -178,7 +190,7 @@ def f1_table(cases: KthCases, config, m_values: Sequence[float] | None = None, *
         ``{annotator: {sketch: [F1 per m]}}`` (a list of one value when ``m_values`` is None),
         plus key ``"m"`` with the m values actually used per sketch.
     """
-    from . import match_prepared, prepare
+    from ursim_core.matching import match_prepared, prepare
 
     table = {annotator: {} for annotator in cases.references}
     used_m = {}
@@ -241,8 +253,8 @@ def accuracy_report(dataset_root=None) -> dict:
     """
     from dataclasses import replace
 
-    from ..datasets import dataset_root as locate
-    from . import M_GRID, MatchConfig
+    from ursim_core.evaluation.datasets import dataset_root as locate
+    from ursim_core.matching import M_GRID, MatchConfig
 
     root = locate(dataset_root)
     if root is None:
@@ -264,12 +276,15 @@ def accuracy_report(dataset_root=None) -> dict:
             s = summarise(f1_table(cases, config, M_GRID, legacy=legacy))
             summaries[label] = s
             parts.append("oracle " + " / ".join(f"{s[a]['oracle'][0]:.3f}" for a in ANNOTATORS))
-            parts.append("best fixed " + " / ".join(
-                f"{s[a]['best_fixed'][1]:.3f} (m {M_GRID[s[a]['best_fixed'][0]]})" for a in ANNOTATORS))
+            parts.append(
+                "best fixed "
+                + " / ".join(f"{s[a]['best_fixed'][1]:.3f} (m {M_GRID[s[a]['best_fixed'][0]]})" for a in ANNOTATORS)
+            )
         if with_auto:
             s = summarise(f1_table(cases, replace(config, m="auto"), legacy=legacy))
             summaries[label + ", auto"] = s
-            parts.append("auto " + " / ".join(
-                f"{s[a]['first'][0]:.3f} (median {s[a]['first'][1]:.3f})" for a in ANNOTATORS))
+            parts.append(
+                "auto " + " / ".join(f"{s[a]['first'][0]:.3f} (median {s[a]['first'][1]:.3f})" for a in ANNOTATORS)
+            )
         print(" | ".join(parts), flush=True)
     return summaries

@@ -1,6 +1,6 @@
 """Reports of an evaluation: Table-1-style text, runs.csv, plots and a markdown summary.
 
-Everything here is a pure function of an :class:`ursim_core.evaluation.EvaluationResult`
+Everything here is a pure function of an :class:`ursim_core.evaluation.runner.EvaluationResult`
 (its ``rows``, ``human_rows``, ``summaries``, ``settings`` and ``timings``), except
 :func:`write_report`, which writes the files atomically.
 
@@ -40,15 +40,33 @@ __all__ = [
 PAPER_TABLE1: dict[str, dict[str, dict[str, Any]]] = {
     "hungarian": {
         "median": {"baseline": 0.27, "T1": 0.50, "T2": 0.42, "T3": 0.40, "T4": 0.47},
-        "mean": {"baseline": (0.27, 0.23), "T1": (0.48, 0.24), "T2": (0.47, 0.24), "T3": (0.42, 0.22), "T4": (0.50, 0.24)},
+        "mean": {
+            "baseline": (0.27, 0.23),
+            "T1": (0.48, 0.24),
+            "T2": (0.47, 0.24),
+            "T3": (0.42, 0.22),
+            "T4": (0.50, 0.24),
+        },
     },
     "vf2": {
         "median": {"baseline": 0.00, "T1": 0.00, "T2": 0.00, "T3": 0.00, "T4": 0.00},
-        "mean": {"baseline": (0.03, 0.17), "T1": (0.22, 0.33), "T2": (0.22, 0.33), "T3": (0.13, 0.29), "T4": (0.13, 0.29)},
+        "mean": {
+            "baseline": (0.03, 0.17),
+            "T1": (0.22, 0.33),
+            "T2": (0.22, 0.33),
+            "T3": (0.13, 0.29),
+            "T4": (0.13, 0.29),
+        },
     },
     "planar": {
         "median": {"baseline": 0.67, "T1": 0.74, "T2": 0.67, "T3": 0.67, "T4": 0.80},
-        "mean": {"baseline": (0.61, 0.30), "T1": (0.68, 0.28), "T2": (0.70, 0.23), "T3": (0.70, 0.25), "T4": (0.73, 0.22)},
+        "mean": {
+            "baseline": (0.61, 0.30),
+            "T1": (0.68, 0.28),
+            "T2": (0.70, 0.23),
+            "T3": (0.70, 0.25),
+            "T4": (0.73, 0.22),
+        },
     },
 }
 #: Same paper, one annotator's cliques scored against the other's (shared/design/paper.md).
@@ -98,12 +116,12 @@ def runs_csv(result) -> str:
 
     Examples
     --------
-    >>> from ursim_core.evaluation import EvaluationResult, RunRow
+    >>> from ursim_core.evaluation.runner import EvaluationResult, RunRow
     >>> row = RunRow("00", "a", "planar", "T4", "0.1", 0.1, 1, 1, 0, 0.5, 1.0, 2 / 3, 4, 5, 6, 0.01)
     >>> runs_csv(EvaluationResult(rows=(row,))).splitlines()[1]
     '00,a,planar,T4,0.1,0.1,1,1,0,0.5,1,0.666667,4,5,6,0.01,,0,correct,'
     """
-    from ursim_core.evaluation import RUN_COLUMNS
+    from ursim_core.evaluation.runner import RUN_COLUMNS
 
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -133,7 +151,7 @@ def _mean_sd(mean: float, sd: float) -> str:
 
 
 def _methods(result) -> tuple[list[str], list[str]]:
-    from ursim_core.evaluation import MATCHERS, VARIANTS
+    from ursim_core.evaluation.runner import MATCHERS, VARIANTS
 
     present_matchers = {s.matcher for s in result.summaries}
     present_variants = {s.variant for s in result.summaries}
@@ -155,7 +173,10 @@ def _table1(result, annotator: str, choice: str) -> tuple[list[str], list[list[s
     cells = {(m, v): result.summary(annotator, m, v, choice) for m in matchers for v in variants}
     rows = []
     for matcher in matchers:
-        rows.append([f"{_MATCHER_NAMES.get(matcher, matcher)} median"] + [_number(cells[matcher, v].median if cells[matcher, v] else None) for v in variants])
+        rows.append(
+            [f"{_MATCHER_NAMES.get(matcher, matcher)} median"]
+            + [_number(cells[matcher, v].median if cells[matcher, v] else None) for v in variants]
+        )
     for matcher in matchers:
         rows.append(
             [f"{_MATCHER_NAMES.get(matcher, matcher)} mean"]
@@ -163,7 +184,10 @@ def _table1(result, annotator: str, choice: str) -> tuple[list[str], list[list[s
         )
     if choice == "fixed":
         for matcher in matchers:
-            rows.append([f"{_MATCHER_NAMES.get(matcher, matcher)} best m"] + [cells[matcher, v].fixed_m if cells[matcher, v] else "-" for v in variants])
+            rows.append(
+                [f"{_MATCHER_NAMES.get(matcher, matcher)} best m"]
+                + [cells[matcher, v].fixed_m if cells[matcher, v] else "-" for v in variants]
+            )
     if choice == "auto":
         for matcher in matchers:
             rows.append(
@@ -283,7 +307,7 @@ def format_tables(result) -> str:
 
     Examples
     --------
-    >>> from ursim_core.evaluation import EvaluationResult, RunRow
+    >>> from ursim_core.evaluation.runner import EvaluationResult, RunRow
     >>> rows = [RunRow(name, "a", "planar", "T4", "0.1", 0.1, 1, 0, 0, 1.0, 1.0, f1, 1, 3, 3, 0.0)
     ...         for name, f1 in (("00", 1.0), ("01", 0.5))]
     >>> text = format_tables(EvaluationResult(rows=tuple(rows), settings={"matchers": ["planar"], "variants": ["T4"]}))
@@ -306,7 +330,7 @@ def format_tables(result) -> str:
 
 
 def _pooled() -> str:
-    from ursim_core.evaluation import POOLED
+    from ursim_core.evaluation.runner import POOLED
 
     return POOLED
 
@@ -319,12 +343,12 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
 
     Examples
     --------
-    >>> from ursim_core.evaluation import EvaluationResult, RunRow
+    >>> from ursim_core.evaluation.runner import EvaluationResult, RunRow
     >>> rows = [RunRow("00", "a", "planar", "T4", "0.1", 0.1, 1, 0, 0, 1.0, 1.0, 1.0, 1, 3, 3, 0.0)]
     >>> "| Planar median | 1.00 |" in markdown_summary(EvaluationResult(rows=tuple(rows)))
     True
     """
-    from ursim_core.evaluation import mean_f1_by_m
+    from ursim_core.evaluation.runner import mean_f1_by_m
 
     settings = result.settings
     lines = ["# URSIM evaluation", ""]
@@ -341,7 +365,11 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
         "",
     ]
     for annotator in _annotator_groups(result):
-        who = "all annotators pooled (one sample per map and annotator)" if annotator == _pooled() else f"annotator {annotator}"
+        who = (
+            "all annotators pooled (one sample per map and annotator)"
+            if annotator == _pooled()
+            else f"annotator {annotator}"
+        )
         lines += [f"## {who}", ""]
         for choice in ("oracle", "fixed", "auto"):
             header, rows, n_maps = _table1(result, annotator, choice)
@@ -350,7 +378,12 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
             lines += [f"### F1, {_CHOICE_TITLES[choice]} ({n_maps} maps)", "", _markdown_table(header, rows), ""]
         precision_rows = _precision_recall_rows(result, annotator)
         if precision_rows:
-            lines += ["### Mean precision / recall at the oracle m", "", _markdown_table(["matcher", *_variant_header(result)], precision_rows), ""]
+            lines += [
+                "### Mean precision / recall at the oracle m",
+                "",
+                _markdown_table(["matcher", *_variant_header(result)], precision_rows),
+                "",
+            ]
 
     human = _human_lines(result)
     if human:
@@ -365,7 +398,7 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
             labels = sorted({(m, label) for key in keys for m, label, _, _ in by_m[key]})
             header = ["m"] + [f"{_MATCHER_NAMES.get(k[1], k[1])} {_VARIANT_NAMES.get(k[2], k[2])}" for k in keys]
             table_rows = []
-            for m_value, label in labels:
+            for _m_value, label in labels:
                 values = {key: {lab: mean for _, lab, mean, _ in by_m[key]} for key in keys}
                 table_rows.append([label] + [_number(values[key].get(label, math.nan)) for key in keys])
             lines += [f"### {annotator}", "", _markdown_table(header, table_rows), ""]
@@ -412,7 +445,7 @@ def _reason_counts(result) -> list[tuple[str, int]]:
 
 
 def _published_markdown(result) -> list[str]:
-    from ursim_core.evaluation import VARIANTS
+    from ursim_core.evaluation.runner import VARIANTS
 
     header, rows = _paper_table1(VARIANTS, ("hungarian", "vf2", "planar"))
     lines = [
@@ -436,9 +469,22 @@ def _published_markdown(result) -> list[str]:
         for annotator in ("malcolm", "vasiliki"):
             oracle_mean, oracle_median = figures["oracle"][annotator]
             fixed_m, fixed_mean, fixed_median = figures["fixed"][annotator]
-            table_rows.append([scoring, annotator, f"{oracle_median:.3f}", f"{oracle_mean:.3f}", f"{fixed_m:g}", f"{fixed_median:.3f}", f"{fixed_mean:.3f}"])
+            table_rows.append(
+                [
+                    scoring,
+                    annotator,
+                    f"{oracle_median:.3f}",
+                    f"{oracle_mean:.3f}",
+                    f"{fixed_m:g}",
+                    f"{fixed_median:.3f}",
+                    f"{fixed_mean:.3f}",
+                ]
+            )
     lines += [
-        _markdown_table(["scoring", "annotator", "oracle median", "oracle mean", "best fixed m", "fixed median", "fixed mean"], table_rows),
+        _markdown_table(
+            ["scoring", "annotator", "oracle median", "oracle mean", "best fixed m", "fixed median", "fixed mean"],
+            table_rows,
+        ),
         "",
         "- Baselines on all 26 sketches (fnfix, mean F1 malcolm / vasiliki): "
         + "; ".join(f"{_MATCHER_NAMES[k]} {v[0]:.3f} / {v[1]:.3f}" for k, v in RELEASED_BASELINES.items())
@@ -480,13 +526,13 @@ def plot_f1_vs_m(result) -> bytes:
 
     Examples
     --------
-    >>> from ursim_core.evaluation import EvaluationResult, RunRow
+    >>> from ursim_core.evaluation.runner import EvaluationResult, RunRow
     >>> rows = [RunRow("00", "a", "planar", "T4", label, m, 1, 0, 0, 1.0, 1.0, m, 1, 3, 3, 0.0)
     ...         for label, m in (("0", 0.0), ("0.1", 0.1))]
     >>> plot_f1_vs_m(EvaluationResult(rows=tuple(rows)))[:8] == b"\\x89PNG\\r\\n\\x1a\\n"
     True
     """
-    from ursim_core.evaluation import POOLED, mean_f1_by_m
+    from ursim_core.evaluation.runner import POOLED, mean_f1_by_m
 
     plt = _pyplot()
     by_m = mean_f1_by_m(result.rows)
@@ -496,8 +542,12 @@ def plot_f1_vs_m(result) -> bytes:
         return _empty_plot(plt, "no fixed-m runs to plot")
     colours = plt.get_cmap("tab10")
     figure, axes = plt.subplots(
-        len(matchers), len(annotators), figsize=(5.2 * len(annotators), 3.3 * len(matchers)), squeeze=False,
-        sharex=True, sharey=True,
+        len(matchers),
+        len(annotators),
+        figsize=(5.2 * len(annotators), 3.3 * len(matchers)),
+        squeeze=False,
+        sharex=True,
+        sharey=True,
     )
     for row_index, matcher in enumerate(matchers):
         for col_index, annotator in enumerate(annotators):
@@ -506,8 +556,13 @@ def plot_f1_vs_m(result) -> bytes:
                 colour = colours(variant_index % 10)
                 points = by_m.get((annotator, matcher, variant))
                 if points:
-                    axis.plot([p[0] for p in points], [p[2] for p in points], marker=".", color=colour,
-                              label=_VARIANT_NAMES.get(variant, variant))
+                    axis.plot(
+                        [p[0] for p in points],
+                        [p[2] for p in points],
+                        marker=".",
+                        color=colour,
+                        label=_VARIANT_NAMES.get(variant, variant),
+                    )
                 auto = result.summary(annotator, matcher, variant, "auto")
                 if auto is not None and auto.n:
                     axis.axhline(auto.mean, color=colour, linestyle="--", linewidth=1)
@@ -536,13 +591,13 @@ def plot_boxplots(result) -> bytes:
 
     Examples
     --------
-    >>> from ursim_core.evaluation import EvaluationResult, RunRow
+    >>> from ursim_core.evaluation.runner import EvaluationResult, RunRow
     >>> rows = [RunRow(name, "a", "planar", "T4", "0.1", 0.1, 1, 0, 0, 1.0, 1.0, f1, 1, 3, 3, 0.0)
     ...         for name, f1 in (("00", 1.0), ("01", 0.5))]
     >>> plot_boxplots(EvaluationResult(rows=tuple(rows)))[:4] == b"\\x89PNG"
     True
     """
-    from ursim_core.evaluation import POOLED
+    from ursim_core.evaluation.runner import POOLED
 
     plt = _pyplot()
     matchers, variants = _methods(result)
@@ -555,8 +610,14 @@ def plot_boxplots(result) -> bytes:
     humans = list(result.human_summaries)
     width = 0.8 / len(annotators)
     figure, axes = plt.subplots(
-        len(choices), 1, figsize=(max(7.0, 0.75 * (len(methods) + len(humans)) * max(1, len(annotators)) ** 0.5 + 2), 3.2 * len(choices)),
-        squeeze=False, sharey=True,
+        len(choices),
+        1,
+        figsize=(
+            max(7.0, 0.75 * (len(methods) + len(humans)) * max(1, len(annotators)) ** 0.5 + 2),
+            3.2 * len(choices),
+        ),
+        squeeze=False,
+        sharey=True,
     )
     tick_labels = [f"{_MATCHER_NAMES.get(m, m)}\n{_VARIANT_NAMES.get(v, v)}" for m, v in methods]
     tick_labels += [f"human\n{h.variant} vs {h.annotator}" for h in humans]
@@ -569,16 +630,28 @@ def plot_boxplots(result) -> bytes:
                     data.append(list(item.f1))
                     positions.append(method_index - 0.4 + width * (annotator_index + 0.5))
             if data:
-                boxes = axis.boxplot(data, positions=positions, widths=width * 0.9, patch_artist=True, manage_ticks=False,
-                                     medianprops={"color": "black"})
+                boxes = axis.boxplot(
+                    data,
+                    positions=positions,
+                    widths=width * 0.9,
+                    patch_artist=True,
+                    manage_ticks=False,
+                    medianprops={"color": "black"},
+                )
                 for patch in boxes["boxes"]:
                     patch.set_facecolor(colours(annotator_index % 8))
                 axis.plot([], [], color=colours(annotator_index % 8), linewidth=8, label=annotator)
         if humans:
             data = [list(h.f1) for h in humans]
             positions = [len(methods) + i for i in range(len(humans))]
-            boxes = axis.boxplot(data, positions=positions, widths=0.5, patch_artist=True, manage_ticks=False,
-                                 medianprops={"color": "black"})
+            boxes = axis.boxplot(
+                data,
+                positions=positions,
+                widths=0.5,
+                patch_artist=True,
+                manage_ticks=False,
+                medianprops={"color": "black"},
+            )
             for patch in boxes["boxes"]:
                 patch.set_facecolor("lightgrey")
         axis.set_xticks(range(len(tick_labels)))
@@ -587,8 +660,14 @@ def plot_boxplots(result) -> bytes:
         axis.set_ylabel("F1")
         axis.set_title(f"F1 per map, {_CHOICE_TITLES[choice]}", fontsize=10)
         axis.grid(axis="y", alpha=0.3)
-    figure.legend(*axes[0][0].get_legend_handles_labels(), loc="upper center", ncol=len(annotators), frameon=False,
-                  fontsize=9, bbox_to_anchor=(0.5, 1.0))
+    figure.legend(
+        *axes[0][0].get_legend_handles_labels(),
+        loc="upper center",
+        ncol=len(annotators),
+        frameon=False,
+        fontsize=9,
+        bbox_to_anchor=(0.5, 1.0),
+    )
     figure.tight_layout(rect=(0, 0, 1, 1 - 0.3 / figure.get_figheight()))
     return _png(figure)
 
@@ -617,12 +696,12 @@ def write_report(result, out_dir: str | Path) -> dict[str, Path]:
     Examples
     --------
     >>> import tempfile
-    >>> from ursim_core.evaluation import EvaluationResult, RunRow
+    >>> from ursim_core.evaluation.runner import EvaluationResult, RunRow
     >>> rows = [RunRow("00", "a", "planar", "T4", "0.1", 0.1, 1, 0, 0, 1.0, 1.0, 1.0, 1, 3, 3, 0.0)]
     >>> sorted(write_report(EvaluationResult(rows=tuple(rows)), tempfile.mkdtemp()))
     ['boxplots.png', 'f1_vs_m.png', 'runs.csv', 'summary.md']
     """
-    from ursim_core.atomic import atomic_write_bytes, atomic_write_text
+    from ursim_core.io.atomic import atomic_write_bytes, atomic_write_text
 
     folder = Path(out_dir)
     folder.mkdir(parents=True, exist_ok=True)

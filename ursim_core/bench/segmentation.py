@@ -26,13 +26,13 @@ import resource
 import statistics
 import time
 import tracemalloc
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
-from typing import Callable, Iterable, Mapping
 
 import numpy as np
 
 from ursim_core.segmentation.maoris import PRESETS, MaorisParams, maoris_labels
-from ursim_core.synth import make_large_building
+from ursim_core.synth.generator import make_large_building
 
 __all__ = [
     "bench_segmentation",
@@ -68,7 +68,7 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
     Parameters
     ----------
     dataset_root : Path or None
-        The shared datasets folder (``ursim_core.datasets.dataset_root()``);
+        The shared datasets folder (``ursim_core.evaluation.datasets.dataset_root()``);
         None gives no rows.
     repeats : int, keyword-only
         Runs per map; the median is reported.
@@ -78,7 +78,7 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
     list of dict
         ``map``, ``shape``, ``preset``, ``regions``, ``wall_s``, ``cpu_s``.
     """
-    from ursim_core.maps import load_map
+    from ursim_core.io.maps import load_map
 
     rows: list[dict] = []
     if dataset_root is None:
@@ -105,7 +105,7 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
 def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, preset: str = "robot") -> list[dict]:
     """Time and peak memory of segmenting generated buildings of growing size.
 
-    The buildings come from :func:`ursim_core.synth.make_large_building` (bands of rooms along
+    The buildings come from :func:`ursim_core.synth.generator.make_large_building` (bands of rooms along
     corridors; about a thousand rooms at 4000 x 4000).
 
     Returns
@@ -169,7 +169,7 @@ def bench_quality(
         ``method``, ``gt``, ``maps`` (count), mean ``precision``, ``recall``,
         ``f1``, ``evaluator_f1`` over the maps.
     """
-    from ursim_core.maps import load_map
+    from ursim_core.io.maps import load_map
     from ursim_core.segmentation.scoring import (
         gt_labels_from_separator_image,
         load_label_array,
@@ -233,7 +233,7 @@ def print_table(rows: list[dict]) -> None:
 
 
 if __name__ == "__main__":  # pragma: no cover - manual run
-    from ursim_core.datasets import dataset_root
+    from ursim_core.evaluation.datasets import dataset_root
 
     print_table(bench_segmentation(dataset_root()))
     print_table(bench_scale())

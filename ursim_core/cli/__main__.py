@@ -1,0 +1,5 @@
+import sys
+
+from ursim_core.cli.main import main
+
+sys.exit(main())

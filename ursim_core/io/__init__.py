@@ -1,0 +1,35 @@
+"""Reading and writing files: map images, ROS map_server YAML, atomic writes.
+
+Owns: :class:`Map` and its loaders (:func:`load_map`, :func:`map_from_array`), the pixel <->
+world conversions, and :func:`atomic_write_bytes` / :func:`atomic_write_text`, which every
+save of the project goes through.
+
+May import: :mod:`ursim_core.errors` only. Everything else builds on it.
+
+>>> from ursim_core.io import map_from_array
+>>> import numpy as np
+>>> map_from_array(np.full((4, 5), 255, np.uint8)).shape
+(4, 5)
+"""
+
+import lazy_loader as _lazy
+
+__getattr__, __dir__, __all__ = _lazy.attach(
+    __name__,
+    submodules=["atomic", "maps"],
+    submod_attrs={
+        "atomic": ["atomic_write_bytes", "atomic_write_text"],
+        "maps": [
+            "Map",
+            "load_map",
+            "map_from_array",
+            "pixel_to_world",
+            "world_to_pixel",
+            "DEFAULT_FREE_THRESHOLD",
+            "DEFAULT_MAX_PIXELS",
+            "OCCUPANCY_FREE",
+            "OCCUPANCY_OCCUPIED",
+            "OCCUPANCY_UNKNOWN",
+        ],
+    },
+)

@@ -1,0 +1,14 @@
+"""Pictures of results: segmentation overlays and side-by-side match figures (PNG, atomic).
+
+May import: :mod:`ursim_core.io` and :mod:`ursim_core.errors`; it draws plain arrays and graphs.
+"""
+
+import lazy_loader as _lazy
+
+__getattr__, __dir__, __all__ = _lazy.attach(
+    __name__,
+    submodules=["figures"],
+    submod_attrs={
+        "figures": ["distinct_colors", "label_colors", "overlay_segmentation", "side_by_side_matches", "save_png"]
+    },
+)
