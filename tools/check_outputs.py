@@ -90,7 +90,12 @@ def produce(out: Path) -> dict[str, str]:
 def _digests(out: Path) -> dict[str, str]:
     digests = {}
     for path in sorted(out.rglob("*")):
-        if path.is_file() and path.suffix in (".png", ".json", ".csv") and "cache" not in path.parts and path.name != "digests.json":
+        if (
+            path.is_file()
+            and path.suffix in (".png", ".json", ".csv")
+            and "cache" not in path.parts
+            and path.name != "digests.json"
+        ):
             if path.name.endswith(".overlay.png") or (path.parent.name == "evaluate" and path.suffix == ".png"):
                 continue  # figures: matplotlib and font versions, not outputs of the method
             digests[str(path.relative_to(out))] = _digest(path, out)
