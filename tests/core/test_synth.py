@@ -13,7 +13,7 @@ from scipy import ndimage
 from ursim_core.correspondences.codec import assign_regions, load_correspondences
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation.scoring import score_matches
-from ursim_core.matching import match
+from ursim_core.matching import MatchConfig, match
 from ursim_core.segmentation import segment
 from ursim_core.synth.generator import (
     Sketch,
@@ -201,8 +201,8 @@ def test_save_example_writes_loadable_files(tmp_path):
     assert (tmp_path / "ground_truth.json").read_bytes() == first
 
 
-def _f1(sketch_seg, metric_seg, truth) -> float:
-    result = match(sketch_seg, metric_seg)
+def _f1(sketch_seg, metric_seg, truth, config=None) -> float:
+    result = match(sketch_seg, metric_seg) if config is None else match(sketch_seg, metric_seg, config=config)
     truth = assign_regions(truth, sketch_seg.labels, metric_seg.labels)
     reference = [(set(c.sketch_regions), set(c.metric_regions)) for c in truth.cliques]
     return score_matches(result.pairs, reference).f1
@@ -228,6 +228,14 @@ def test_matcher_recovers_sketchified_copies_on_average():
         plan, sketch = make_pair(seed=seed)
         truth = ground_truth_correspondences(plan, sketch)
         scores.append(_f1(segment(sketch.free, preset="default"), segment(plan.free, preset="default"), truth))
-    # Measured mean 0.978, min 0.889 (seeds 4 and 9) with the matcher defaults of 2026-11-22;
-    # the bounds leave room for matcher changes but catch a broken pipeline.
-    assert np.mean(scores) >= 0.85 and min(scores) >= 0.7
+    # Measured mean 0.922 with the orientation-free default (2026-12-01): 11 of 12 at 0.95-1.0;
+    # seed 4, a nearly symmetric plan, scores its half-turned reading lower (0.205 against 0.217)
+    # and gets 0.11. Told the sketch is upright, the matcher gets mean 0.978, min 0.889 as before.
+    assert np.mean(scores) >= 0.88 and sorted(scores)[1] >= 0.7
+    upright = []
+    for seed in range(12):
+        plan, sketch = make_pair(seed=seed)
+        truth = ground_truth_correspondences(plan, sketch)
+        config = MatchConfig(orientation="upright", mirrored=False)
+        upright.append(_f1(segment(sketch.free, preset="default"), segment(plan.free, preset="default"), truth, config))
+    assert np.mean(upright) >= 0.85 and min(upright) >= 0.7

@@ -79,6 +79,7 @@ __all__ = [
     "region_positions",
     "position_distance",
     "pair_descriptors",
+    "blend_positions",
 ]
 
 ATTRIBUTES = ("size", "pca_shape")
@@ -550,6 +551,9 @@ class PairDescriptors:
     metric_signatures: np.ndarray | None
     c_matrix: np.ndarray
     notes: list = field(default_factory=list)
+    #: The signature (or type) comparison alone, before the position blend: what a turned
+    #: sketch shares with the upright one (see ``ursim_core.matching.orientation``).
+    signature_c: np.ndarray | None = None
 
 
 def pair_descriptors(
@@ -625,7 +629,7 @@ def pair_descriptors(
     if variant == "baseline":
         sketch_types = region_types(sketch_graph, nodes=sketch_nodes)
         metric_types = region_types(metric_graph, nodes=metric_nodes)
-        c_matrix = _blend_positions(
+        c_matrix = blend_positions(
             (sketch_types[:, None] != metric_types[None, :]).astype(np.float64),
             sketch_graph,
             sketch_nodes,
@@ -633,8 +637,9 @@ def pair_descriptors(
             metric_nodes,
             position_weight,
         )
+        types_c = (sketch_types[:, None] != metric_types[None, :]).astype(np.float64)
         return PairDescriptors(
-            sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [], None, None, None, None, c_matrix, notes
+            sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [], None, None, None, None, c_matrix, notes, types_c
         )
 
     uses_anchors = variant in ("T2", "T4")
@@ -676,8 +681,9 @@ def pair_descriptors(
         signatures.append(
             heat_kernel_signatures(laplacian, anchors=anchor_rows if uses_anchors else None, times=times, method=method)
         )
-    c_matrix = _blend_positions(
-        signature_distance(signatures[0], signatures[1]),
+    signature_c = signature_distance(signatures[0], signatures[1])
+    c_matrix = blend_positions(
+        signature_c,
         sketch_graph,
         sketch_nodes,
         metric_graph,
@@ -698,10 +704,12 @@ def pair_descriptors(
         signatures[1],
         c_matrix,
         notes,
+        signature_c,
     )
 
 
-def _blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight):
+def blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight):
+    """``(c + beta * d_position) / (1 + beta)`` with beta = ``position_weight`` (c itself when 0)."""
     if not position_weight:
         return c_matrix
     distances = position_distance(

@@ -76,13 +76,6 @@ class Alignment:
     second: tuple = ()
 
 
-def _same_function(same) -> SameRelation:
-    if callable(same):
-        return same
-    matrix = same
-    return lambda a, b: bool(matrix[a][b])
-
-
 def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
     """Levenshtein distance and the released code's backtrace.
 
@@ -108,19 +101,24 @@ def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
     >>> levenshtein([0, 1], [0], [[False], [True]])
     (1, 'dn')
     """
-    is_same = _same_function(same)
     rows, cols = len(first), len(second)
     table = [[0] * (cols + 1) for _ in range(rows + 1)]
     for i in range(rows + 1):
         table[i][0] = i
     for j in range(cols + 1):
         table[0][j] = j
+    if callable(same):
+        equal = [[bool(same(a, b)) for b in second] for a in first]
+    else:  # a matrix: read its rows once instead of one call per cell (the matcher's hot loop)
+        equal = [[same[a][b] for b in second] for a in first]
     for i in range(1, rows + 1):
-        element = first[i - 1]
+        equal_row = equal[i - 1]
         above, here = table[i - 1], table[i]
         for j in range(1, cols + 1):
-            substitution = above[j - 1] + (0 if is_same(element, second[j - 1]) else 1)
-            here[j] = min(substitution, above[j] + 1, here[j - 1] + 1)
+            substitution = above[j - 1] + (0 if equal_row[j - 1] else 1)
+            insertion, deletion = here[j - 1] + 1, above[j] + 1
+            best = substitution if substitution < deletion else deletion
+            here[j] = best if best < insertion else insertion
     operations = []
     i, j = rows, cols
     while i > 0 or j > 0:

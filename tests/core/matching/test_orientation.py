@@ -1,0 +1,169 @@
+"""Orientation-free matching: wall angles, candidates, turned graphs, and invariance on generated pairs."""
+
+from __future__ import annotations
+
+import functools
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from ursim_core.correspondences import regions_at_points
+from ursim_core.errors import ParameterError
+from ursim_core.evaluation.scoring import score_matches
+from ursim_core.matching import MatchConfig, match, prepare
+from ursim_core.matching.orientation import orientation_candidates, oriented_graph, transform_points
+from ursim_core.segmentation.canonical import _turned, canonical_pose, dihedral, segment_canonical, wall_angle
+from ursim_core.synth import ground_truth_correspondences, make_pair
+
+
+def _rectangle_turned(degrees: float) -> np.ndarray:
+    free = np.zeros((200, 200), bool)
+    free[60:140, 40:160] = True
+    turned, _ = _turned(free, degrees)
+    return turned
+
+
+@pytest.mark.parametrize("degrees", [0, 10, 30, -20, 44])
+def test_wall_angle_finds_the_turn_of_a_rectangle(degrees):
+    assert wall_angle(_rectangle_turned(degrees)) == pytest.approx(degrees, abs=1.5)
+
+
+def test_wall_angle_of_nothing_is_zero():
+    assert wall_angle(np.zeros((10, 10), bool)) == 0.0
+
+
+def test_candidates_cover_quarter_turns_and_mirrors_of_the_wall_difference():
+    candidates = orientation_candidates(sketch_angle=20.0, metric_angle=5.0)
+    assert len(candidates) == 8 and len(set(candidates)) == 8
+    plain = sorted(d for d, m in candidates if not m)
+    assert plain == pytest.approx([75.0, 165.0, 255.0, 345.0])
+    mirrored = sorted(d for d, m in candidates if m)
+    assert mirrored == pytest.approx([25.0, 115.0, 205.0, 295.0])
+    assert orientation_candidates(orientation="upright") == [(0.0, False)]
+    assert orientation_candidates(orientation=-90, mirrored=True) == [(270.0, True)]
+
+
+def test_transform_points_turns_counter_clockwise_on_screen():
+    # (row, col): a point to the right of the origin goes up (smaller row) when turned by 90 degrees.
+    assert transform_points(np.array([[0.0, 1.0]]), degrees=90, mirrored=False).round(9).tolist() == [[-1.0, 0.0]]
+    assert transform_points(np.array([[2.0, 1.0]]), degrees=0, mirrored=True).tolist() == [[2.0, -1.0]]
+
+
+def test_oriented_graph_moves_positions_and_keeps_everything_else():
+    graph = nx.Graph()
+    graph.add_node(1, centroid=(10.0, 20.0), bbox=(0, 10, 20, 30), size=5)
+    graph.add_node(2, centroid=(30.0, 20.0), bbox=(20, 10, 40, 30), size=7)
+    graph.add_edge(1, 2, boundary=3)
+    turned = oriented_graph(graph, degrees=90, mirrored=False)
+    assert turned is not graph and graph.nodes[1]["centroid"] == (10.0, 20.0)
+    assert turned.nodes[1]["size"] == 5 and turned.edges[1, 2]["boundary"] == 3
+    expected = transform_points(np.array([[10.0, 20.0]]), degrees=90, mirrored=False)[0]
+    assert turned.nodes[1]["centroid"] == pytest.approx(tuple(expected))
+    assert oriented_graph(graph, degrees=0, mirrored=False) is graph
+
+
+def test_config_validates_orientation_and_mirrored():
+    for bad in ("sideways", float("nan"), True):
+        with pytest.raises(ParameterError, match="orientation"):
+            MatchConfig(orientation=bad)
+    with pytest.raises(ParameterError, match="mirrored"):
+        MatchConfig(mirrored="yes")
+    assert MatchConfig.paper().orientation == "upright" and MatchConfig.released().mirrored is False
+
+
+def test_known_orientation_is_used_as_given():
+    plan, sketch = make_pair(seed=1)
+    s, m = segment_canonical(sketch.free, preset="default"), segment_canonical(plan.free, preset="default")
+    prepared = prepare(s, m, MatchConfig(orientation=90, mirrored=True))
+    assert prepared.orientation == (90.0, True) and prepared.orientation_scan == {}
+    result = match(s, m)
+    assert result.orientation in result.orientation_scan
+    assert result.orientation_scan[result.orientation] == min(result.orientation_scan.values())
+
+
+def test_canonical_pose_is_the_same_image_for_all_eight_transforms():
+    plan, _ = make_pair(seed=3)
+    reference = dihedral(plan.free, *canonical_pose(plan.free))
+    for quarter_turns in range(4):
+        for mirrored in (False, True):
+            moved = dihedral(plan.free, quarter_turns, mirrored)
+            assert np.array_equal(dihedral(moved, *canonical_pose(moved)), reference)
+
+
+def test_canonical_segmentation_turns_with_the_map():
+    plan, _ = make_pair(seed=2)
+    upright = segment_canonical(plan.free, preset="default")
+    for quarter_turns, mirrored in ((1, False), (2, True), (3, True)):
+        moved = segment_canonical(dihedral(plan.free, quarter_turns, mirrored), preset="default")
+        assert np.array_equal(moved.labels, dihedral(upright.labels, quarter_turns, mirrored))
+
+
+# --- invariance of the whole pipeline on generated pairs (ground truth transformed alike) ---
+
+
+def _moved(free: np.ndarray, points: list, kind: str):
+    rows, cols = free.shape
+    if kind.startswith("dihedral"):
+        quarter_turns, mirrored = int(kind[-2]), kind[-1] == "m"
+        index = dihedral(np.arange(rows * cols).reshape(rows, cols), quarter_turns, mirrored)
+        where = np.empty(rows * cols, np.int64)
+        where[index.ravel()] = np.arange(rows * cols)
+        new_cols = index.shape[1]
+        return dihedral(free, quarter_turns, mirrored), [
+            (int(where[r * cols + c] // new_cols), int(where[r * cols + c] % new_cols)) for r, c in points
+        ]
+    if kind.startswith("angle"):
+        image, matrix = _turned(free, float(kind[5:]))
+        xy = np.array([(c, r, 1.0) for r, c in points]) @ matrix.T
+        return image, [(round(y), round(x)) for x, y in xy]
+    scale = float(kind[5:])
+    import cv2
+
+    image = cv2.resize(free.astype(np.uint8) * 255, (round(cols * scale), round(rows * scale))) >= 128
+    return image, [(int(r * scale), int(c * scale)) for r, c in points]
+
+
+@functools.cache
+def _f1(seed: int, kind: str) -> float:
+    plan, sketch = make_pair(seed=seed)
+    truth = ground_truth_correspondences(plan, sketch)
+    flat = [p for clique in truth.cliques for p in clique.sketch_points]
+    image, moved = _moved(sketch.free, flat, kind)
+    s, m = segment_canonical(image, preset="default"), segment_canonical(plan.free, preset="default")
+    result = match(s, m)
+    points = iter(moved)
+    reference = []
+    for clique in truth.cliques:
+        sketch_points = [next(points) for _ in clique.sketch_points]
+        reference.append(
+            (
+                {r for r in regions_at_points(s.labels, sketch_points) if r},
+                {r for r in regions_at_points(m.labels, clique.metric_points) if r},
+            )
+        )
+    return score_matches(result.pairs, reference).f1
+
+
+SEEDS = (0, 1, 2, 3)
+#: Mean F1 over SEEDS measured with this code (upright 0.988). Seed 0 turned by a free angle is a
+#: near tie between the right turn and the half turn (normalised scores 0.305 and 0.303) and loses.
+MEASURED = {"angle30": 0.746, "angle-65": 0.694, "scale0.5": 0.972, "scale1.6": 1.0}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["dihedral1r", "dihedral2r", "dihedral3r", "dihedral0m", "dihedral1m", "dihedral2m"])
+def test_turned_and_mirrored_sketches_match_exactly_as_upright(kind):
+    for seed in SEEDS:
+        assert _f1(seed, kind) == pytest.approx(_f1(seed, "dihedral0r"), abs=1e-9), seed
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["angle30", "angle-65", "scale0.5", "scale1.6"])
+def test_sketches_turned_by_any_angle_or_rescaled_match_about_as_well(kind):
+    # A free angle resamples the sketch (its segmentation changes a little) and a scale changes
+    # MAORIS' pixel-sized thresholds, so these are not exact; measured per kind in MEASURED.
+    upright = np.mean([_f1(seed, "dihedral0r") for seed in SEEDS])
+    moved = np.mean([_f1(seed, kind) for seed in SEEDS])
+    assert upright >= 0.9
+    assert moved >= MEASURED[kind] - 0.05, (kind, moved, upright)

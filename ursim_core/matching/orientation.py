@@ -1,0 +1,134 @@
+"""Orientation of a sketch relative to its metric map: candidates, and region graphs turned to them.
+
+People draw sketches in any orientation, and sometimes mirrored. The signatures of
+:mod:`~ursim_core.matching.descriptors` do not see orientation, but the position term does (it
+compares region centroids normalised to each map's extent), and so does the planar matcher (the
+cyclic order of neighbours reverses in a mirror image). So the matcher tries the orientations a
+sketch can plausibly have and keeps the one whose best hypothesis scores lowest
+(:func:`ursim_core.matching.pipeline.match`).
+
+Which orientations: buildings are drawn with their walls along few directions. The dominant wall
+direction of each map, modulo 90 degrees
+(:func:`ursim_core.segmentation.canonical.wall_angle`), gives the turn that brings the
+sketch's walls parallel to the metric map's; the four quarter turns of that, mirrored or not, are
+the eight candidates (:func:`orientation_candidates`). A sketch turned by any angle, not only by
+multiples of 90 degrees, is therefore handled.
+
+A candidate is ``(degrees, mirrored)``: the sketch is mirrored left-right first (when ``mirrored``),
+then turned ``degrees`` counter-clockwise as seen on the screen. :func:`oriented_graph` applies it
+to the ``centroid`` and ``bbox`` attributes of a region graph; the label image is never touched, so
+region ids and points stay in the sketch's own pixel frame.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import networkx as nx
+import numpy as np
+
+from ursim_core.segmentation.canonical import wall_angle
+
+__all__ = ["ORIENTATIONS", "wall_angle", "orientation_candidates", "oriented_graph", "transform_points"]
+
+#: The values of ``MatchConfig.orientation`` other than a number of degrees.
+ORIENTATIONS = ("any", "upright")
+
+
+def orientation_candidates(
+    *,
+    orientation="any",
+    mirrored: bool | None = None,
+    sketch_angle: float = 0.0,
+    metric_angle: float = 0.0,
+) -> list[tuple[float, bool]]:
+    """The ``(degrees, mirrored)`` turns to try for a sketch, the identity first.
+
+    Parameters
+    ----------
+    orientation : 'any', 'upright' or float, keyword-only
+        'upright': the sketch is drawn in the metric map's orientation (one candidate);
+        a number: the sketch is brought to the metric map by turning it that many degrees
+        counter-clockwise (after mirroring when ``mirrored``); 'any': unknown.
+    mirrored : bool or None, keyword-only
+        Whether the sketch is a mirror image; None = unknown (both are tried; 'upright' and a
+        number of degrees then mean not mirrored).
+    sketch_angle, metric_angle : float, keyword-only
+        :func:`wall_angle` of each map, used by 'any'.
+
+    Examples
+    --------
+    >>> orientation_candidates(orientation="upright")
+    [(0.0, False)]
+    >>> orientation_candidates(orientation=90, mirrored=True)
+    [(90.0, True)]
+    >>> orientation_candidates(mirrored=False, sketch_angle=10.0)
+    [(350.0, False), (80.0, False), (170.0, False), (260.0, False)]
+    """
+    if orientation == "upright":
+        return [(0.0, bool(mirrored))]
+    if orientation != "any":
+        return [(float(orientation) % 360.0, bool(mirrored))]
+    flags = (False, True) if mirrored is None else (bool(mirrored),)
+    candidates = []
+    for flag in flags:
+        # Mirroring negates every angle of the sketch, its walls' direction included.
+        base = metric_angle - (-sketch_angle if flag else sketch_angle)
+        base = (base + 45.0) % 90.0 - 45.0
+        for quarter in range(4):
+            candidates.append((round((base + 90.0 * quarter) % 360.0, 9) % 360.0, flag))
+    return candidates
+
+
+def transform_points(points: np.ndarray, *, degrees: float, mirrored: bool) -> np.ndarray:
+    """(row, col) points mirrored left-right (when asked) then turned counter-clockwise about 0.
+
+    Examples
+    --------
+    >>> transform_points(np.array([[0.0, 10.0]]), degrees=90, mirrored=False).round(6).tolist()
+    [[-10.0, 0.0]]
+    """
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    x, y_up = points[:, 1].copy(), -points[:, 0]
+    if mirrored:
+        x = -x
+    theta = math.radians(degrees)
+    c, s = math.cos(theta), math.sin(theta)
+    x, y_up = c * x - s * y_up, s * x + c * y_up
+    return np.stack([-y_up, x], axis=1)
+
+
+def oriented_graph(graph: nx.Graph, *, degrees: float, mirrored: bool) -> nx.Graph:
+    """A copy of a region graph whose ``centroid`` and ``bbox`` are turned to a candidate.
+
+    The bounding box of a turned region is the box around its turned corners. Other attributes
+    (size, shape, interior point) are kept as they are; the identity returns the graph itself.
+
+    Examples
+    --------
+    >>> g = nx.Graph(); g.add_node(1, centroid=(0.0, 10.0), bbox=(0, 0, 2, 20))
+    >>> (np.round(oriented_graph(g, degrees=180, mirrored=False).nodes[1]["centroid"], 6) + 0.0).tolist()
+    [0.0, -10.0]
+    """
+    if not mirrored and degrees % 360.0 == 0.0:
+        return graph
+    out = graph.copy()
+    nodes: Sequence = list(out.nodes)
+    if not nodes:
+        return out
+    centroids = np.array([out.nodes[n]["centroid"] for n in nodes], dtype=np.float64).reshape(-1, 2)
+    moved = transform_points(centroids, degrees=degrees, mirrored=mirrored)
+    with_box = [n for n in nodes if "bbox" in out.nodes[n]]
+    if with_box:
+        boxes = np.array([out.nodes[n]["bbox"] for n in with_box], dtype=np.float64).reshape(-1, 4)
+        corners = np.stack([boxes[:, [0, 1]], boxes[:, [0, 3]], boxes[:, [2, 1]], boxes[:, [2, 3]]], axis=1).reshape(
+            -1, 2
+        )
+        turned = transform_points(corners, degrees=degrees, mirrored=mirrored).reshape(-1, 4, 2)
+        low, high = turned.min(axis=1), turned.max(axis=1)
+        for i, node in enumerate(with_box):
+            out.nodes[node]["bbox"] = (float(low[i, 0]), float(low[i, 1]), float(high[i, 0]), float(high[i, 1]))
+    for i, node in enumerate(nodes):
+        out.nodes[node]["centroid"] = (float(moved[i, 0]), float(moved[i, 1]))
+    return out

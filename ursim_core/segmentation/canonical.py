@@ -1,0 +1,234 @@
+"""Segmentation that does not depend on how the map is turned: segment in a canonical pose.
+
+MAORIS walks the image in raster order, so the same sketch turned by 90 degrees or mirrored can
+come out with another number of regions, and region ids always follow the raster order. A sketch
+can be drawn in any orientation, and the user expects the same regions whichever way it lies.
+:func:`segment_canonical` therefore
+
+1. turns the map so that its dominant wall direction is along the image axes (only when it is
+   off by more than ``min_angle`` degrees: resampling costs detail),
+2. picks, among the 8 quarter turns and mirror images of that, the one whose second and third
+   central moments of free space satisfy a fixed rule (:func:`canonical_pose`), the same image
+   whichever of the 8 it started as,
+3. segments that image, numbers the regions in its raster order, and maps the label image back
+   to the map's own pixel frame (exactly for quarter turns and mirrors; nearest pixel for a
+   free angle).
+
+Points clicked on the map keep their meaning: the returned labels are in the original frame.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["wall_angle", "canonical_pose", "segment_canonical", "dihedral"]
+
+# Contours are simplified to polygons with this tolerance (pixels) before their edge directions are
+# taken: pixel staircases of a straight wall would otherwise vote for 0 and 90 degrees.
+_POLYGON_TOLERANCE = 2.0
+# Images larger than this (pixels) are reduced before their contours are traced: the angle of long
+# walls does not need every pixel, and an 8000 x 8000 map would cost 0.1 s for nothing.
+_ANGLE_MAX_PIXELS = 1_500_000
+# Below this many degrees off the axes a map is not resampled: walls a few degrees off are
+# how people draw, and resampling would blur thin walls for nothing.
+_MIN_ANGLE = 3.0
+
+
+def wall_angle(free: np.ndarray) -> float:
+    """Dominant wall direction of a map, in degrees in [-45, 45), from its free-space outline.
+
+    The outline is traced (OpenCV contours), simplified to polygons, and each polygon edge votes
+    for its direction modulo 90 degrees with a weight equal to its length (a circular mean of four
+    times the angle). Angles are counter-clockwise as seen on the screen.
+
+    Parameters
+    ----------
+    free : ndarray of bool or int, shape (rows, cols)
+        Free space (or a label image: non-zero is free).
+
+    Returns
+    -------
+    float
+        0.0 for an empty map or one with no dominant direction.
+
+    Examples
+    --------
+    >>> free = np.zeros((60, 80), bool); free[10:50, 10:70] = True
+    >>> round(wall_angle(free), 3)
+    0.0
+    """
+    import cv2
+
+    mask = np.asarray(free) != 0
+    if not mask.any():
+        return 0.0
+    if mask.size > _ANGLE_MAX_PIXELS:
+        step = math.ceil(math.sqrt(mask.size / _ANGLE_MAX_PIXELS))
+        mask = mask[::step, ::step]
+    contours, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_LIST, cv2.CHAIN_APPROX_NONE)
+    total = 0j
+    for contour in contours:
+        polygon = cv2.approxPolyDP(contour, _POLYGON_TOLERANCE, True).reshape(-1, 2).astype(np.float64)
+        if len(polygon) < 2:
+            continue
+        edges = np.roll(polygon, -1, axis=0) - polygon
+        dx, dy_up = edges[:, 0], -edges[:, 1]
+        lengths = np.hypot(dx, dy_up)
+        total += (lengths * np.exp(4j * np.arctan2(dy_up, dx))).sum()
+    if abs(total) < 1e-9:
+        return 0.0
+    degrees = math.degrees(np.angle(total) / 4)
+    return float((degrees + 45.0) % 90.0 - 45.0)
+
+
+def dihedral(image: np.ndarray, quarter_turns: int, mirrored: bool) -> np.ndarray:
+    """``image`` turned counter-clockwise by ``quarter_turns`` x 90 degrees, then mirrored left-right.
+
+    Examples
+    --------
+    >>> dihedral(np.array([[1, 2], [3, 4]]), 1, False).tolist()
+    [[2, 4], [1, 3]]
+    >>> dihedral(np.array([[1, 2], [3, 4]]), 0, True).tolist()
+    [[2, 1], [4, 3]]
+    """
+    out = np.rot90(image, quarter_turns % 4)
+    if mirrored:
+        out = out[:, ::-1]
+    return np.ascontiguousarray(out)
+
+
+def _undo_dihedral(image: np.ndarray, quarter_turns: int, mirrored: bool) -> np.ndarray:
+    out = image[:, ::-1] if mirrored else image
+    return np.ascontiguousarray(np.rot90(out, -(quarter_turns % 4)))
+
+
+def _moments(free: np.ndarray) -> tuple[float, float, float, float]:
+    rows, cols = np.nonzero(free)
+    if rows.size == 0:
+        return 0.0, 0.0, 0.0, 0.0
+    r = rows - rows.mean()
+    c = cols - cols.mean()
+    return float((r * r).mean()), float((c * c).mean()), float((r**3).mean()), float((c**3).mean())
+
+
+def canonical_pose(free: np.ndarray) -> tuple[int, bool]:
+    """The quarter turns and mirroring that bring ``free`` to its canonical pose.
+
+    Canonical: free space spreads at least as much along the columns as along the rows, and its
+    third central moment is non-negative along both axes (more mass towards the top-left, a tail
+    towards the bottom-right). Every quarter turn or mirror image of a map has the same canonical
+    image; exact ties (a symmetric map) go to the first pose in a fixed order.
+
+    Examples
+    --------
+    >>> free = np.zeros((30, 40), bool); free[2:10, 2:38] = True; free[10:28, 2:8] = True
+    >>> pose = canonical_pose(free)
+    >>> all(
+    ...     np.array_equal(dihedral(dihedral(free, k, m), *canonical_pose(dihedral(free, k, m))), dihedral(free, *pose))
+    ...     for k in range(4) for m in (False, True)
+    ... )
+    True
+    """
+    free = np.asarray(free) != 0
+    best_key, best = None, (0, False)
+    for mirrored in (False, True):
+        for quarter_turns in range(4):
+            var_r, var_c, skew_r, skew_c = _moments(dihedral(free, quarter_turns, mirrored))
+            # Round so that the same moments computed from a turned copy compare equal.
+            key = (
+                var_c >= var_r - 1e-9 * max(var_c, var_r, 1.0),
+                skew_r >= -1e-9,
+                skew_c >= -1e-9,
+                round(skew_r, 6),
+                round(skew_c, 6),
+            )
+            if best_key is None or key > best_key:
+                best_key, best = key, (quarter_turns, mirrored)
+    return best
+
+
+def _renumber(labels: np.ndarray) -> np.ndarray:
+    """Region ids made consecutive (1..N) in their old order; 0 stays 0."""
+    ids, inverse = np.unique(labels, return_inverse=True)
+    offset = 0 if ids[0] == 0 else 1
+    return (np.arange(ids.size, dtype=np.int32) + offset)[inverse].reshape(labels.shape)
+
+
+def _turned(free: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
+    """``free`` turned counter-clockwise by ``degrees`` on a canvas that holds it, and the affine map."""
+    import cv2
+
+    rows, cols = free.shape
+    theta = math.radians(degrees)
+    c, s = abs(math.cos(theta)), abs(math.sin(theta))
+    new_cols, new_rows = int(math.ceil(cols * c + rows * s)), int(math.ceil(cols * s + rows * c))
+    matrix = cv2.getRotationMatrix2D(((cols - 1) / 2, (rows - 1) / 2), degrees, 1.0)
+    matrix[0, 2] += (new_cols - cols) / 2
+    matrix[1, 2] += (new_rows - rows) / 2
+    image = cv2.warpAffine(
+        free.astype(np.uint8) * 255, matrix, (new_cols, new_rows), flags=cv2.INTER_LINEAR, borderValue=0
+    )
+    return image >= 128, matrix
+
+
+def segment_canonical(
+    map_or_free,
+    *,
+    method: str = "maoris",
+    preset: str | None = "sketch",
+    params: dict[str, Any] | None = None,
+    min_angle: float = _MIN_ANGLE,
+):
+    """:func:`ursim_core.segmentation.segment` made independent of the map's orientation.
+
+    Same parameters and result as :func:`~ursim_core.segmentation.segment` (labels in the
+    map's own pixel frame), plus ``min_angle``: the smallest wall-direction offset, in degrees,
+    for which the map is turned before segmenting. ``Segmentation.params`` records the pose
+    under the key ``"_pose"``.
+
+    Examples
+    --------
+    >>> free = np.zeros((100, 170), bool)  # a large and a small room joined by a corridor
+    >>> free[10:90, 10:70] = free[30:70, 100:150] = free[45:55, 70:100] = True
+    >>> a = segment_canonical(free, preset="default")
+    >>> b = segment_canonical(np.rot90(free), preset="default")
+    >>> np.array_equal(np.rot90(a.labels), b.labels)
+    True
+    """
+    import cv2
+
+    from ursim_core.segmentation.graph import region_graph
+    from ursim_core.segmentation.interface import Segmentation, segment
+
+    free = np.asarray(getattr(map_or_free, "free", map_or_free)) != 0
+    angle = wall_angle(free)
+    work, matrix = (free, None) if abs(angle) < min_angle else _turned(free, -angle)
+    quarter_turns, mirrored = canonical_pose(work)
+    inner = segment(dihedral(work, quarter_turns, mirrored), method=method, preset=preset, params=params)
+    labels = _undo_dihedral(inner.labels, quarter_turns, mirrored)
+    if matrix is not None:
+        inverse = cv2.invertAffineTransform(matrix)
+        labels = cv2.warpAffine(
+            labels.astype(np.float32),
+            inverse,
+            (free.shape[1], free.shape[0]),
+            flags=cv2.INTER_NEAREST,
+            borderValue=0,
+        ).astype(np.int32)
+        labels[~free] = 0
+        labels = _renumber(labels)
+    pose = {
+        "degrees": round(-angle, 6) if matrix is not None else 0.0,
+        "quarter_turns": quarter_turns,
+        "mirrored": mirrored,
+    }
+    return Segmentation(
+        labels=labels,
+        graph=region_graph(labels),
+        method=inner.method,
+        params={**inner.params, "_pose": pose},
+        source=inner.source,
+    )
