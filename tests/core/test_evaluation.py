@@ -10,17 +10,17 @@ import pytest
 from PIL import Image
 
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation.runner import (
+from ursim_core.evaluation.results import (
     DEFAULT_M_GRID,
     POOLED,
     EvaluationResult,
     RunRow,
     m_label,
     mean_f1_by_m,
-    run_evaluation,
     summarise,
     summarise_human,
 )
+from ursim_core.evaluation.runner import run_evaluation
 
 
 def _row(name, m, f1, *, annotator="malcolm", matcher="planar", variant="T4", precision=None, recall=None, auto_m=0.05):

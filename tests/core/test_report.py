@@ -10,17 +10,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ursim_core.evaluation.report import (
-    PAPER_TABLE1,
-    RELEASED_KTH,
-    format_tables,
-    markdown_summary,
-    plot_boxplots,
-    plot_f1_vs_m,
-    runs_csv,
-    write_report,
-)
-from ursim_core.evaluation.runner import RUN_COLUMNS, EvaluationResult, RunRow, m_label
+from ursim_core.evaluation.plots import plot_boxplots, plot_f1_vs_m
+from ursim_core.evaluation.published import PAPER_TABLE1, RELEASED_KTH
+from ursim_core.evaluation.report import markdown_summary, runs_csv, write_report
+from ursim_core.evaluation.results import RUN_COLUMNS, EvaluationResult, RunRow, m_label
+from ursim_core.evaluation.tables import format_tables
 
 MATCHERS = ("planar", "hungarian")
 VARIANTS = ("T4", "baseline")

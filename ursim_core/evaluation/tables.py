@@ -1,0 +1,132 @@
+"""Table-1-style text tables of an evaluation (rows = matcher, columns = variants) for the terminal."""
+
+from __future__ import annotations
+
+from ursim_core.evaluation.formatting import (
+    CHOICE_TITLES,
+    MATCHER_NAMES,
+    VARIANT_NAMES,
+    m_text,
+    mean_sd,
+    median,
+    number,
+    text_table,
+)
+from ursim_core.evaluation.published import comparison_lines
+from ursim_core.evaluation.results import MATCHERS, POOLED, VARIANTS
+
+__all__ = ["format_tables", "methods", "annotator_groups", "table1", "heading", "human_lines"]
+
+
+def methods(result) -> tuple[list[str], list[str]]:
+
+    present_matchers = {s.matcher for s in result.summaries}
+    present_variants = {s.variant for s in result.summaries}
+    matchers = [m for m in result.settings.get("matchers", MATCHERS) if m in present_matchers]
+    variants = [v for v in result.settings.get("variants", VARIANTS) if v in present_variants]
+    # Paper order of the columns whatever order they were run in.
+    variants.sort(key=lambda v: VARIANTS.index(v) if v in VARIANTS else len(VARIANTS))
+    return matchers, variants
+
+
+def annotator_groups(result) -> list[str]:
+    return list(dict.fromkeys(s.annotator for s in result.summaries))
+
+
+def table1(result, annotator: str, choice: str) -> tuple[list[str], list[list[str]], int]:
+    """Header, rows and number of maps of one Table-1-style table."""
+    matchers, variants = methods(result)
+    header = ["matcher"] + [VARIANT_NAMES.get(v, v) for v in variants]
+    cells = {(m, v): result.summary(annotator, m, v, choice) for m in matchers for v in variants}
+    rows = []
+    for matcher in matchers:
+        rows.append(
+            [f"{MATCHER_NAMES.get(matcher, matcher)} median"]
+            + [number(cells[matcher, v].median if cells[matcher, v] else None) for v in variants]
+        )
+    for matcher in matchers:
+        rows.append(
+            [f"{MATCHER_NAMES.get(matcher, matcher)} mean"]
+            + [mean_sd(cells[matcher, v].mean, cells[matcher, v].sd) if cells[matcher, v] else "-" for v in variants]
+        )
+    if choice == "fixed":
+        for matcher in matchers:
+            rows.append(
+                [f"{MATCHER_NAMES.get(matcher, matcher)} best m"]
+                + [cells[matcher, v].fixed_m if cells[matcher, v] else "-" for v in variants]
+            )
+    if choice == "auto":
+        for matcher in matchers:
+            rows.append(
+                [f"{MATCHER_NAMES.get(matcher, matcher)} median m"]
+                + [m_text(median(cells[matcher, v].m_values)) if cells[matcher, v] else "-" for v in variants]
+            )
+    n_maps = max((s.n for s in cells.values() if s is not None), default=0)
+    return header, rows, n_maps
+
+
+def human_lines(result) -> list[str]:
+    lines = []
+    for item in result.human_summaries:
+        lines.append(
+            f"Human vs human ({item.variant}'s cliques scored against {item.annotator}'s): "
+            f"median {number(item.median)}, mean {mean_sd(item.mean, item.sd)} ({item.n} maps)"
+        )
+    return lines
+
+
+def _scoring_name(result) -> str:
+    return {"correct": "correct", "as-built": "legacy (released binary, FN = 0)", "fnfix": "legacy fnfix"}.get(
+        result.settings.get("scoring", "correct"), str(result.settings.get("scoring"))
+    )
+
+
+def heading(result) -> list[str]:
+    settings, timings = result.settings, result.timings
+    grid = settings.get("m_grid") or []
+    grid_text = f"{len(grid)} values {min(grid):g} .. {max(grid):g}" if grid else "none"
+    lines = [
+        f"URSIM evaluation of {settings.get('dataset') or 'the given experiments'}: "
+        f"{settings.get('n_experiments', len(result.experiments))} experiments, scoring {_scoring_name(result)}",
+        f"segmentation presets {', '.join(settings.get('presets_used', [])) or '-'}; m grid {grid_text}"
+        + (" + auto" if settings.get("auto_m", True) else "")
+        + ("; released-code configuration" if settings.get("released") else ""),
+    ]
+    if timings:
+        lines.append(
+            f"time: segmentation {timings.get('segmentation_s', 0):.1f} s "
+            f"({timings.get('maps', 0)} maps, {timings.get('maps_from_cache', 0)} from cache), "
+            f"matching {timings.get('matching_s', 0):.1f} s, total {timings.get('total_s', 0):.1f} s "
+            f"on {settings.get('workers', 1)} worker(s)"
+        )
+    return lines
+
+
+def format_tables(result) -> str:
+    """Table-1-style text tables (rows = matcher, columns = variants) for the terminal.
+
+    One table per annotator (then all annotators pooled) and per choice of m (oracle, best fixed,
+    automatic), the human-vs-human lines, and the published figures for comparison.
+
+    Examples
+    --------
+    >>> from ursim_core.evaluation.results import EvaluationResult, RunRow
+    >>> rows = [RunRow(name, "a", "planar", "T4", "0.1", 0.1, 1, 0, 0, 1.0, 1.0, f1, 1, 3, 3, 0.0)
+    ...         for name, f1 in (("00", 1.0), ("01", 0.5))]
+    >>> text = format_tables(EvaluationResult(rows=tuple(rows), settings={"matchers": ["planar"], "variants": ["T4"]}))
+    >>> [line for line in text.splitlines() if line.startswith("Planar mean")][0]
+    'Planar mean    0.75 ± 0.35'
+    """
+    lines = heading(result)
+    for annotator in annotator_groups(result):
+        who = "all annotators pooled" if annotator == POOLED else f"annotator {annotator}"
+        for choice in ("oracle", "fixed", "auto"):
+            header, rows, n_maps = table1(result, annotator, choice)
+            if not n_maps:
+                continue
+            lines += ["", f"F1, {CHOICE_TITLES[choice]}, {who}, {n_maps} maps", text_table(header, rows)]
+    human = human_lines(result)
+    if human:
+        lines += [""] + human
+    lines += [""] + comparison_lines(result)
+    return "\n".join(lines) + "\n"
