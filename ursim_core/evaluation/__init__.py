@@ -6,7 +6,8 @@ layouts and where the datasets are (:mod:`~ursim_core.evaluation.layouts`,
 (:mod:`~ursim_core.evaluation.runner`, with its segmentation cache :mod:`~ursim_core.evaluation.cache`,
 process pool :mod:`~ursim_core.evaluation.pool` and scored tasks :mod:`~ursim_core.evaluation.tasks`),
 the values it produces and their summaries (:mod:`~ursim_core.evaluation.results`), the KTH protocol
-of the matching benchmark (:mod:`~ursim_core.evaluation.kth_protocol`) and the report
+of the matching benchmark (:mod:`~ursim_core.evaluation.kth_protocol`), turned and mirrored
+sketches with their ground truth (:mod:`~ursim_core.evaluation.augment`) and the report
 (:mod:`~ursim_core.evaluation.report`: CSV and markdown; :mod:`~ursim_core.evaluation.tables`,
 :mod:`~ursim_core.evaluation.plots`, :mod:`~ursim_core.evaluation.published`).
 
@@ -19,6 +20,7 @@ import lazy_loader as _lazy
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
     submodules=[
+        "augment",
         "cache",
         "datasets",
         "formatting",
@@ -35,7 +37,15 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "tasks",
     ],
     submod_attrs={
-        "scoring": ["MatchScore", "score_matches", "score_cliques", "SCORING_MODES"],
+        "scoring": [
+            "MatchScore",
+            "score_matches",
+            "score_cliques",
+            "SCORING_MODES",
+            "PlaceScore",
+            "place_accuracy",
+        ],
+        "augment": ["Orientation", "DIHEDRAL", "parse_augment", "transform_image", "transform_points"],
         "layouts": ["Experiment", "discover"],
         "datasets": ["dataset_root", "DATASET_ENV", "MISSING_REASON"],
         "results": [
