@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ursim_core.cli.common import check_output_folder, progress_bar
@@ -10,7 +11,8 @@ from ursim_core.cli.common import check_output_folder, progress_bar
 HELP = "Run the paper's experiments on a dataset folder and write a report."
 EXAMPLES = """examples:
   ursim evaluate ../shared/datasets/ursim_kth_sketches -o report/
-  ursim evaluate ../shared/datasets/ursim_halmstad_robot_maps/E5 --matchers planar --variants T4"""
+  ursim evaluate ../shared/datasets/ursim_halmstad_robot_maps/E5 --matchers planar --variants T4
+  ursim evaluate ../shared/datasets/ursim_kth_sketches --matchers planar --variants T4 --augment dihedral"""
 
 _MATCHERS = ["planar", "hungarian", "vf2"]
 _VARIANTS = ["baseline", "T1", "T2", "T3", "T4"]
@@ -47,9 +49,16 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--maps", nargs="+", metavar="NAME", help="only these maps (e.g. 00 03 17)")
     parser.add_argument("--cache", metavar="DIR", help="cache segmentations in DIR between runs")
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    parser.add_argument(
+        "--augment",
+        metavar="SPEC",
+        help="also score every sketch turned / mirrored, each orientation as its own run: 'dihedral' "
+        "(the 8 orientations) or 'angles=15,30,...' (degrees counter-clockwise; upright always included)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
+    from ursim_core.evaluation.augment import parse_augment
     from ursim_core.evaluation.report import write_report
     from ursim_core.evaluation.runner import run_evaluation
     from ursim_core.evaluation.tables import format_tables
@@ -57,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
     if args.output:
         # Refused now rather than after the whole run.
         check_output_folder(args.output)
+    augment = None if args.augment is None else parse_augment(args.augment)
     progress = progress_bar(1, "evaluate")
 
     legacy: bool | str = {"none": False, "as-built": True, "fnfix": "fnfix"}[args.legacy_scoring]
@@ -81,7 +91,10 @@ def run(args: argparse.Namespace) -> int:
         cache_dir=args.cache,
         config_overrides=overrides,
         progress=progress,
+        augment=augment,
     )
+    for warning in result.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     print(format_tables(result))
     if args.output:
         write_report(result, Path(args.output))

@@ -25,17 +25,24 @@ __all__ = ["SegmentationJob", "segment_all"]
 
 @dataclass(frozen=True)
 class SegmentationJob:
-    """One map to segment. Equal jobs (same file content, preset and loading) share a result,
-    so a model stored under two names (Halmstad: GT/Malcolm/model_simple.png = E5_08.png) and a
-    map used by several experiments are segmented once."""
+    """One map to segment. Equal jobs (same file content, preset, loading and orientation) share
+    a result, so a model stored under two names (Halmstad: GT/Malcolm/model_simple.png =
+    E5_08.png) and a map used by several experiments are segmented once.
+
+    ``orientation`` (an :class:`~ursim_core.evaluation.augment.Orientation`, None for the map as
+    it is) turns and mirrors the loaded map before it is segmented."""
 
     path: Path = field(compare=False)
     digest: str
     preset: str
     load_key: str
+    augment: str = ""
+    orientation: Any = field(default=None, compare=False)
 
     @classmethod
-    def of(cls, path: Path, preset: str, load: dict, digests: dict[Path, str]) -> SegmentationJob:
+    def of(
+        cls, path: Path, preset: str, load: dict, digests: dict[Path, str], orientation: Any = None
+    ) -> SegmentationJob:
         path = Path(path)
         if path not in digests:
             try:
@@ -43,11 +50,20 @@ class SegmentationJob:
             except OSError:
                 # load_map reports the real problem, naming the file, when the map is loaded.
                 digests[path] = f"unreadable:{path.resolve()}"
-        return cls(path=path, digest=digests[path], preset=preset, load_key=json.dumps(load, sort_keys=True))
+        if orientation is not None and orientation.is_identity:
+            orientation = None
+        return cls(
+            path=path,
+            digest=digests[path],
+            preset=preset,
+            load_key=json.dumps(load, sort_keys=True),
+            augment="" if orientation is None else orientation.name,
+            orientation=orientation,
+        )
 
     @property
     def key(self) -> str:
-        return f"{self.digest}|{self.preset}|{self.load_key}"
+        return f"{self.digest}|{self.preset}|{self.load_key}" + (f"|{self.augment}" if self.augment else "")
 
     @property
     def load(self) -> dict:
@@ -59,7 +75,12 @@ def _segment_job(job: SegmentationJob):
     from ursim_core.io.maps import load_map
     from ursim_core.segmentation import segment
 
-    return segment(load_map(job.path, **job.load), preset=job.preset)
+    the_map = load_map(job.path, **job.load)
+    if job.orientation is not None:
+        from ursim_core.evaluation.augment import transform_map
+
+        the_map = transform_map(the_map, job.orientation)
+    return segment(the_map, preset=job.preset)
 
 
 @functools.lru_cache(maxsize=1)
@@ -86,6 +107,8 @@ def _disk_cache_path(cache_dir: Path, job: SegmentationJob) -> Path:
             "load": job.load,
             "version": 1,
             "code": _segmenter_code_digest(),
+            # Only augmented jobs carry the key, so the cache files of upright maps keep their names.
+            **({"augment": job.augment} if job.augment else {}),
         },
         sort_keys=True,
     )
@@ -147,5 +170,6 @@ def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir)
             memory_cache[job.key] = segmentation
         if cache_folder is not None:
             _write_disk_cache(_disk_cache_path(cache_folder, job), segmentation)
-        reporter.step(f"segment {job.path.name}: {segmentation.n_regions} regions")
+        turned = f" {job.augment}" if job.augment else ""
+        reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
     return segmentations, cached

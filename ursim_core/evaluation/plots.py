@@ -8,7 +8,7 @@ from ursim_core.evaluation.formatting import CHOICE_TITLES, MATCHER_NAMES, VARIA
 from ursim_core.evaluation.results import POOLED, mean_f1_by_m
 from ursim_core.evaluation.tables import annotator_groups, methods
 
-__all__ = ["plot_f1_vs_m", "plot_boxplots"]
+__all__ = ["plot_f1_vs_m", "plot_place_vs_m", "plot_boxplots"]
 
 
 def _png(figure) -> bytes:
@@ -30,7 +30,12 @@ def _pyplot():
     return plt
 
 
-def plot_f1_vs_m(result) -> bytes:
+def plot_place_vs_m(result) -> bytes:
+    """PNG of mean place accuracy against m, laid out as :func:`plot_f1_vs_m`."""
+    return plot_f1_vs_m(result, value="place_accuracy")
+
+
+def plot_f1_vs_m(result, *, value: str = "f1") -> bytes:
     """PNG of mean F1 against m: one panel per matcher x annotator, one line per variant.
 
     The mean F1 with the automatic m is drawn as a dashed horizontal line of the variant's colour.
@@ -45,7 +50,8 @@ def plot_f1_vs_m(result) -> bytes:
     """
 
     plt = _pyplot()
-    by_m = mean_f1_by_m(result.rows)
+    by_m = mean_f1_by_m(result.rows, value=value)
+    what = "place accuracy" if value == "place_accuracy" else "F1"
     matchers, variants = methods(result)
     annotators = [a for a in annotator_groups(result) if a != POOLED]
     if not by_m or not matchers or not annotators:
@@ -74,15 +80,20 @@ def plot_f1_vs_m(result) -> bytes:
                         label=VARIANT_NAMES.get(variant, variant),
                     )
                 auto = result.summary(annotator, matcher, variant, "auto")
-                if auto is not None and auto.n:
-                    axis.axhline(auto.mean, color=colour, linestyle="--", linewidth=1)
+                auto_value = (
+                    None
+                    if auto is None or not auto.n
+                    else (auto.mean_place if value == "place_accuracy" else auto.mean)
+                )
+                if auto_value is not None and auto_value == auto_value:  # not NaN
+                    axis.axhline(auto_value, color=colour, linestyle="--", linewidth=1)
             axis.set_title(f"{MATCHER_NAMES.get(matcher, matcher)}, {annotator}", fontsize=10)
             axis.set_ylim(0, 1.02)
             axis.grid(alpha=0.3)
             if row_index == len(matchers) - 1:
                 axis.set_xlabel("m")
             if col_index == 0:
-                axis.set_ylabel("mean F1 over maps")
+                axis.set_ylabel(f"mean {what} over maps")
     handles, labels = axes[0][0].get_legend_handles_labels()
     from matplotlib.lines import Line2D
 

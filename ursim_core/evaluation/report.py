@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from ursim_core.evaluation.formatting import MATCHER_NAMES, VARIANT_NAMES, markdown_table, number
-from ursim_core.evaluation.plots import plot_boxplots, plot_f1_vs_m
+from ursim_core.evaluation.plots import plot_boxplots, plot_f1_vs_m, plot_place_vs_m
 from ursim_core.evaluation.published import published_markdown
 from ursim_core.evaluation.results import POOLED, RUN_COLUMNS, mean_f1_by_m
 from ursim_core.evaluation.tables import (
@@ -25,8 +25,11 @@ from ursim_core.evaluation.tables import (
     annotator_groups,
     format_tables,
     heading,
+    headline_choice,
     human_lines,
     methods,
+    orientation_table,
+    per_sketch_table,
     table1,
 )
 
@@ -66,7 +69,9 @@ def _csv_value(value: Any) -> Any:
 # --------------------------------------------------------------------------- markdown
 
 
-def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png", "boxplots.png")) -> str:
+def markdown_summary(
+    result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png", "place_vs_m.png", "boxplots.png")
+) -> str:
     """The summary.md text: settings, Table-1-style tables, F1 per m, published figures, notes.
 
     Examples
@@ -89,6 +94,9 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
         "F1 per map pair, then median and mean ± sample sd over the maps. *Oracle* picks the best m of the grid",
         "for each map (as the paper's Table 1), *best fixed m* the single m with the highest mean F1, *automatic m*",
         "the matcher's own choice. Ground-truth points are mapped onto the evaluated segmentation (10 px tolerance).",
+        "*Place* rows: mean place accuracy (would a robot sent to each sketched ground-truth point reach the",
+        "annotated place? Points with no region or an unmatched region fail; mean over a clique's points, then",
+        f"over cliques; places in the MAORIS `{settings.get('place_reference_preset', 'default')}` segmentation of the metric map).",
         "",
     ]
     for annotator in annotator_groups(result):
@@ -116,19 +124,29 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
     if human:
         lines += ["## Human vs human", ""] + [f"- {line}" for line in human] + [""]
 
+    table = orientation_table(result)
+    if table is not None:
+        lines += [
+            f"## Per orientation ({CHOICE_TITLES[headline_choice(result)]}, all annotators pooled)",
+            "",
+            "Mean F1 / mean place accuracy of the sketches turned and mirrored (mirror first, then turned",
+            "counter-clockwise; ground truth transformed alike). *worst*: the lowest F1 of each column.",
+            "",
+            markdown_table(*table),
+            "",
+        ]
+
     by_m = mean_f1_by_m(result.rows)
     if by_m:
         lines += ["## Mean F1 for each fixed m", ""]
-        annotators = list(dict.fromkeys(key[0] for key in by_m))
-        for annotator in annotators:
-            keys = [key for key in by_m if key[0] == annotator]
-            labels = sorted({(m, label) for key in keys for m, label, _, _ in by_m[key]})
-            header = ["m"] + [f"{MATCHER_NAMES.get(k[1], k[1])} {VARIANT_NAMES.get(k[2], k[2])}" for k in keys]
-            table_rows = []
-            for _m_value, label in labels:
-                values = {key: {lab: mean for _, lab, mean, _ in by_m[key]} for key in keys}
-                table_rows.append([label] + [number(values[key].get(label, math.nan)) for key in keys])
-            lines += [f"### {annotator}", "", markdown_table(header, table_rows), ""]
+        lines += _by_m_tables(by_m)
+
+    by_m = mean_f1_by_m(result.rows, value="place_accuracy")
+    if by_m:
+        lines += ["## Mean place accuracy for each fixed m", ""]
+        lines += _by_m_tables(by_m)
+
+    lines += _per_sketch_markdown(result)
 
     lines += ["## Published figures for comparison", ""]
     lines += published_markdown(result)
@@ -139,6 +157,38 @@ def markdown_summary(result, *, files: Sequence[str] = ("runs.csv", "f1_vs_m.png
         lines += ["## Degenerate runs (reason reported by the matcher, count of runs)", ""]
         lines += [f"- {count} x {reason}" for reason, count in reasons] + [""]
     return "\n".join(lines).rstrip() + "\n"
+
+
+def _by_m_tables(by_m) -> list[str]:
+    lines = []
+    annotators = list(dict.fromkeys(key[0] for key in by_m))
+    for annotator in annotators:
+        keys = [key for key in by_m if key[0] == annotator]
+        labels = sorted({(m, label) for key in keys for m, label, _, _ in by_m[key]})
+        header = ["m"] + [f"{MATCHER_NAMES.get(k[1], k[1])} {VARIANT_NAMES.get(k[2], k[2])}" for k in keys]
+        values = {key: {lab: mean for _, lab, mean, _ in by_m[key]} for key in keys}
+        table_rows = [[label] + [number(values[key].get(label, math.nan)) for key in keys] for _, label in labels]
+        lines += [f"### {annotator}", "", markdown_table(header, table_rows), ""]
+    return lines
+
+
+def _per_sketch_markdown(result) -> list[str]:
+    matchers, variants = methods(result)
+    choice = headline_choice(result)
+    sections = []
+    for matcher in matchers:
+        for variant in variants:
+            table = per_sketch_table(result, matcher, variant, choice)
+            if table is not None and table[1]:
+                title = f"{MATCHER_NAMES.get(matcher, matcher)} {VARIANT_NAMES.get(variant, variant)}"
+                sections += [f"### {title}", "", markdown_table(*table), ""]
+    if not sections:
+        return []
+    return [
+        f"## Per sketch ({CHOICE_TITLES[choice]}): F1 / place accuracy, mean over the annotators",
+        "",
+        *sections,
+    ]
 
 
 def _variant_header(result) -> list[str]:
@@ -175,7 +225,7 @@ def _reason_counts(result) -> list[tuple[str, int]]:
 
 
 def write_report(result, out_dir: str | Path) -> dict[str, Path]:
-    """Write runs.csv, summary.md, f1_vs_m.png and boxplots.png into ``out_dir``.
+    """Write runs.csv, summary.md, f1_vs_m.png, place_vs_m.png and boxplots.png into ``out_dir``.
 
     The folder is created if needed; each file is written atomically, so an interrupted run
     leaves every file either complete or at its previous version.
@@ -191,7 +241,7 @@ def write_report(result, out_dir: str | Path) -> dict[str, Path]:
     >>> from ursim_core.evaluation.results import EvaluationResult, RunRow
     >>> rows = [RunRow("00", "a", "planar", "T4", "0.1", 0.1, 1, 0, 0, 1.0, 1.0, 1.0, 1, 3, 3, 0.0)]
     >>> sorted(write_report(EvaluationResult(rows=tuple(rows)), tempfile.mkdtemp()))
-    ['boxplots.png', 'f1_vs_m.png', 'runs.csv', 'summary.md']
+    ['boxplots.png', 'f1_vs_m.png', 'place_vs_m.png', 'runs.csv', 'summary.md']
     """
     from ursim_core.io.atomic import atomic_write_bytes, atomic_write_text
 
@@ -201,6 +251,7 @@ def write_report(result, out_dir: str | Path) -> dict[str, Path]:
     contents: list[tuple[str, str | bytes]] = [
         ("runs.csv", runs_csv(result)),
         ("f1_vs_m.png", plot_f1_vs_m(result)),
+        ("place_vs_m.png", plot_place_vs_m(result)),
         ("boxplots.png", plot_boxplots(result)),
         ("summary.md", markdown_summary(result)),
     ]

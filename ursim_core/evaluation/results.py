@@ -77,6 +77,10 @@ class RunRow:
 
     Human-vs-human rows have ``matcher='human'``, ``variant`` = the annotator whose cliques were
     scored, ``annotator`` = the reference annotator, ``m_label='-'`` and ``m_value`` NaN.
+
+    ``place_accuracy`` is :func:`ursim_core.evaluation.scoring.place_accuracy` of the same pairs
+    (NaN when no clique could be scored); ``augment`` the orientation of the sketch
+    (:attr:`ursim_core.evaluation.augment.Orientation.name`, '' when the run was not augmented).
     """
 
     map: str
@@ -99,6 +103,13 @@ class RunRow:
     n_pairs: int = 0
     scoring: str = "correct"
     reason: str = ""
+    place_accuracy: float = math.nan
+    augment: str = ""
+
+    @property
+    def sample(self) -> str:
+        """The map and orientation: ``'00'``, or ``'00@rot90'`` for an augmented run."""
+        return f"{self.map}@{self.augment}" if self.augment else self.map
 
 
 #: Column order of runs.csv (the RunRow fields).
@@ -118,8 +129,9 @@ class Summary:
     choice : {'oracle', 'fixed', 'auto', 'human'}
     maps : tuple of str
         Map names (``'map/annotator'`` when pooled), in the order of the values.
-    f1, precision, recall : tuple of float
-        One value per map.
+    f1, precision, recall, place : tuple of float
+        One value per map (``place``: place accuracy, NaN where none could be scored). Augmented
+        runs are separate samples, named ``'map@orientation'``.
     m_values : tuple of float
         The m used for each map (NaN for human rows).
     fixed_m : str
@@ -136,6 +148,7 @@ class Summary:
     recall: tuple[float, ...]
     m_values: tuple[float, ...]
     fixed_m: str = ""
+    place: tuple[float, ...] = ()
 
     @property
     def n(self) -> int:
@@ -162,6 +175,12 @@ class Summary:
     def mean_recall(self) -> float:
         return float(statistics.fmean(self.recall)) if self.recall else math.nan
 
+    @property
+    def mean_place(self) -> float:
+        """Mean place accuracy over the maps where it could be scored (NaN when none)."""
+        values = [value for value in self.place if not math.isnan(value)]
+        return float(statistics.fmean(values)) if values else math.nan
+
 
 @dataclass(frozen=True)
 class EvaluationResult:
@@ -180,6 +199,9 @@ class EvaluationResult:
         ``segmentation_s``, ``matching_s``, ``total_s`` (wall clock), map counts.
     notes : tuple of str
         Observations worth reporting (e.g. ground-truth points that fell on no region).
+    warnings : tuple of str
+        The notes a user must see at once (e.g. a map scored against one annotator only
+        because the other's file is missing); also in ``notes``.
     """
 
     rows: tuple[RunRow, ...] = ()
@@ -188,6 +210,7 @@ class EvaluationResult:
     settings: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     @functools.cached_property
     def summaries(self) -> tuple[Summary, ...]:
@@ -248,7 +271,8 @@ def summarise(
     >>> {s.choice: (round(s.mean, 2), s.fixed_m) for s in summarise(rows)}
     {'oracle': (0.7, ''), 'fixed': (0.6, '0.1'), 'auto': (0.7, '')}
     """
-    rows = [row for row in rows if row.matcher != HUMAN]
+    # Each (map, orientation) is a sample of its own.
+    rows = [dataclasses.replace(row, map=row.sample) for row in rows if row.matcher != HUMAN]
     grid_labels = None if m_grid is None else {m_label(m) for m in m_grid}
     annotators = list(dict.fromkeys(row.annotator for row in rows))
     groups: dict[str, list[RunRow]] = {annotator: [] for annotator in annotators}
@@ -321,6 +345,7 @@ def _summary(annotator, matcher, variant, choice, maps, rows, *, fixed_m: str = 
         f1=tuple(float(r.f1) for r in rows),
         precision=tuple(float(r.precision) for r in rows),
         recall=tuple(float(r.recall) for r in rows),
+        place=tuple(float(r.place_accuracy) for r in rows),
         m_values=tuple(float(r.m_value) for r in rows),
         fixed_m=fixed_m,
     )
@@ -341,13 +366,16 @@ def summarise_human(rows: Iterable[RunRow]) -> tuple[Summary, ...]:
         if row.matcher == HUMAN:
             groups.setdefault((row.annotator, row.variant), []).append(row)
     return tuple(
-        _summary(reference, HUMAN, scored, HUMAN, [r.map for r in group], group)
+        _summary(reference, HUMAN, scored, HUMAN, [r.sample for r in group], group)
         for (reference, scored), group in groups.items()
     )
 
 
-def mean_f1_by_m(rows: Iterable[RunRow]) -> dict[tuple[str, str, str], list[tuple[float, str, float, int]]]:
-    """Mean F1 over maps for every fixed m, per (annotator, matcher, variant).
+def mean_f1_by_m(
+    rows: Iterable[RunRow], *, value: str = "f1"
+) -> dict[tuple[str, str, str], list[tuple[float, str, float, int]]]:
+    """Mean F1 (or another value: ``value="place_accuracy"``) over maps for every fixed m,
+    per (annotator, matcher, variant). NaN values (no scorable clique) are left out of a mean.
 
     Returns
     -------
@@ -367,9 +395,14 @@ def mean_f1_by_m(rows: Iterable[RunRow]) -> dict[tuple[str, str, str], list[tupl
     for row in rows:
         if row.matcher == HUMAN or row.m_label == AUTO:
             continue
-        values.setdefault((row.annotator, row.matcher, row.variant), {}).setdefault(row.m_label, []).append(row.f1)
+        number = float(getattr(row, value))
+        if math.isnan(number):
+            continue
+        values.setdefault((row.annotator, row.matcher, row.variant), {}).setdefault(row.m_label, []).append(number)
         m_of[row.m_label] = row.m_value
     return {
-        key: sorted(((m_of[label], label, float(statistics.fmean(f1s)), len(f1s)) for label, f1s in per_m.items()))
+        key: sorted(
+            ((m_of[label], label, float(statistics.fmean(items)), len(items)) for label, items in per_m.items())
+        )
         for key, per_m in values.items()
     }

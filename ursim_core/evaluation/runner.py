@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from ursim_core.errors import ParameterError
+from ursim_core.evaluation.augment import UPRIGHT, Orientation, parse_augment
 from ursim_core.evaluation.cache import SegmentationJob, segment_all
 from ursim_core.evaluation.layouts import Experiment, discover
 from ursim_core.evaluation.pool import Progress, ProgressCallback
@@ -58,8 +59,8 @@ from ursim_core.evaluation.results import (
     summarise,
     summarise_human,
 )
-from ursim_core.evaluation.scoring import score_matches
-from ursim_core.evaluation.tasks import MatchTask, human_vs_human_rows, model_label, references_of, run_tasks
+from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, score_matches
+from ursim_core.evaluation.tasks import Instance, MatchTask, human_vs_human_rows, model_label, references_of, run_tasks
 
 __all__ = [
     "run_evaluation",
@@ -98,6 +99,7 @@ def run_evaluation(
     cache_dir: str | Path | None = None,
     threshold: float | None = None,
     nonzero_free: bool | None = None,
+    augment: str | Sequence[Orientation] | None = None,
 ) -> EvaluationResult:
     """Run every matcher x variant over a dataset, sweeping m, and score against every annotator.
 
@@ -142,6 +144,17 @@ def run_evaluation(
     threshold, nonzero_free : keyword-only
         Map loading options (:func:`ursim_core.io.maps.load_map`); default 250 / False, or
         non-zero-is-free when ``released``.
+    augment : str or sequence of Orientation, keyword-only
+        Score every sketch in several orientations, each as its own run (``RunRow.augment``):
+        ``'dihedral'`` (the 8 orientations), ``'angles=15,30,...'`` or
+        :class:`~ursim_core.evaluation.augment.Orientation` values. The sketch image is turned
+        and mirrored (new pixels are obstacle) and its ground-truth points moved alike. The
+        upright orientation is always run. None (default): the sketches as they are, with an
+        empty ``augment``.
+
+    Every run is scored by pair F1 and by place accuracy
+    (:func:`ursim_core.evaluation.scoring.place_accuracy`), against a reference segmentation of
+    each metric map with the MAORIS ``default`` preset and default loading.
 
     Returns
     -------
@@ -208,24 +221,34 @@ def run_evaluation(
         "threshold": 250 if threshold is None else threshold,
         "nonzero_free": released if nonzero_free is None else bool(nonzero_free),
     }
-    # Per experiment (same order): the (input map, model map) segmentation jobs.
-    input_jobs: list[tuple[SegmentationJob, SegmentationJob]] = []
+    orientations = _checked_orientations(augment)
+    input_preset = preset or ("ursim-released" if released else MATCH_PRESETS["sketch"])
+    model_preset = metric_preset or ("ursim-released" if released else MATCH_PRESETS["metric"])
+    # Per experiment and orientation: the segmentation jobs of the instance.
+    instances: list[Instance] = []
     digests: dict[Path, str] = {}
     for experiment in experiments:
-        input_preset = preset or ("ursim-released" if released else MATCH_PRESETS["sketch"])
-        model_preset = metric_preset or ("ursim-released" if released else MATCH_PRESETS["metric"])
-        input_jobs.append(
-            (
-                SegmentationJob.of(experiment.sketch, input_preset, load_options, digests),
-                SegmentationJob.of(experiment.metric, model_preset, load_options, digests),
+        upright = SegmentationJob.of(experiment.sketch, input_preset, load_options, digests)
+        metric_job = SegmentationJob.of(experiment.metric, model_preset, load_options, digests)
+        place_job = SegmentationJob.of(experiment.metric, PLACE_REFERENCE_PRESET, PLACE_REFERENCE_LOAD, digests)
+        for orientation in orientations or (None,):
+            instances.append(
+                Instance(
+                    experiment=experiment,
+                    sketch_job=SegmentationJob.of(experiment.sketch, input_preset, load_options, digests, orientation),
+                    metric_job=metric_job,
+                    place_job=place_job,
+                    upright_job=upright,
+                    orientation=None if orientation is None or orientation.is_identity else orientation,
+                    augment="" if orientation is None else orientation.name,
+                )
             )
-        )
-    distinct_jobs = list(dict.fromkeys(job for pair in input_jobs for job in pair))
+    distinct_jobs = list(dict.fromkeys(job for instance in instances for job in instance.jobs))
     for preset_name in sorted({job.preset for job in distinct_jobs}):
         # An unknown preset is reported now, not by a worker process after other maps ran.
         resolve_params("maoris", preset_name)
 
-    n_tasks = len(experiments) * len(matchers) * len(variants)
+    n_tasks = len(instances) * len(matchers) * len(variants)
     total_steps = len(distinct_jobs) + n_tasks + (1 if human else 0)
     reporter = Progress(progress, total_steps)
 
@@ -233,14 +256,16 @@ def run_evaluation(
     segmentations, cached = segment_all(distinct_jobs, workers, reporter, segmentation_cache, cache_dir)
     segmentation_s = time.perf_counter() - segment_started
 
-    references, notes = references_of(experiments, input_jobs, segmentations)
+    references, notes = references_of(instances, segmentations)
+    warnings = _missing_annotator_warnings(experiments)
     match_started = time.perf_counter()
     tasks = [
         MatchTask(
-            name=experiment.name,
-            model=model_label(experiment),
-            sketch_key=jobs[0].key,
-            metric_key=jobs[1].key,
+            name=instance.experiment.name,
+            model=model_label(instance.experiment),
+            sketch_key=instance.sketch_job.key,
+            metric_key=instance.metric_job.key,
+            place_key=instance.place_job.key,
             matcher=matcher,
             variant=variant,
             config=_config_for(base_config, matcher, variant, released),
@@ -248,8 +273,9 @@ def run_evaluation(
             references=reference,
             legacy=legacy_mode,
             auto_m=auto_m,
+            augment=instance.augment,
         )
-        for experiment, jobs, reference in zip(experiments, input_jobs, references)
+        for instance, reference in zip(instances, references)
         for matcher in matchers
         for variant in variants
     ]
@@ -258,7 +284,7 @@ def run_evaluation(
 
     human_rows: list[RunRow] = []
     if human:
-        human_rows = human_vs_human_rows(experiments, input_jobs, segmentations, references, legacy_mode)
+        human_rows = human_vs_human_rows(instances, segmentations, references, legacy_mode)
         reporter.step("human vs human")
 
     settings = {
@@ -269,7 +295,7 @@ def run_evaluation(
         "auto_m": auto_m,
         "preset": preset,
         "metric_preset": metric_preset,
-        "presets_used": sorted({job.preset for job in distinct_jobs}),
+        "presets_used": sorted({job.preset for i in instances for job in (i.sketch_job, i.metric_job)}),
         "load_options": load_options,
         "scoring": legacy_mode,
         "released": released,
@@ -277,6 +303,8 @@ def run_evaluation(
         "config": _config_summary(base_config),
         "config_overrides": overrides,
         "n_experiments": len(experiments),
+        "augment": [o.name for o in orientations],
+        "place_reference_preset": PLACE_REFERENCE_PRESET,
     }
     timings = {
         "segmentation_s": segmentation_s,
@@ -293,8 +321,41 @@ def run_evaluation(
         experiments=tuple(experiments),
         settings=settings,
         timings=timings,
-        notes=tuple(notes),
+        notes=tuple(warnings + notes),
+        warnings=tuple(warnings),
     )
+
+
+#: Loading of the metric map for its place-accuracy reference segmentation (the default loading).
+PLACE_REFERENCE_LOAD = {"threshold": 250, "nonzero_free": False}
+
+
+def _checked_orientations(augment) -> tuple[Orientation, ...]:
+    if augment is None:
+        return ()
+    orientations = parse_augment(augment) if isinstance(augment, str) else tuple(augment)
+    for item in orientations:
+        if not isinstance(item, Orientation):
+            raise ParameterError(f"expected Orientation values, got {item!r}", field="augment")
+    # Upright first, always: every augmented run has its reference orientation.
+    return tuple(dict.fromkeys((UPRIGHT, *orientations)))
+
+
+def _missing_annotator_warnings(experiments) -> list[str]:
+    """Say which maps are scored against fewer annotators than the dataset has."""
+    annotators = list(dict.fromkeys(name for e in experiments for name in e.ground_truth))
+    warnings = []
+    if len(annotators) < 2:
+        return warnings
+    for experiment in experiments:
+        missing = [name for name in annotators if name not in experiment.ground_truth]
+        if missing:
+            present = ", ".join(experiment.ground_truth) or "nobody"
+            warnings.append(
+                f"map {experiment.name} (model {model_label(experiment)}): no ground truth of "
+                f"{', '.join(missing)} (file missing); scored against {present} only"
+            )
+    return warnings
 
 
 def _checked_choice(values: Sequence[str], allowed: Sequence[str], name: str) -> list[str]:
