@@ -77,18 +77,11 @@ def add_map_options(parser: argparse.ArgumentParser) -> None:
 
 
 def load(path: str | Path, args: argparse.Namespace):
-    """Load a map with the map-loading options of ``args``; refuse one with no free space."""
-    from ursim_core.errors import MapError
+    """Load a map with the map-loading options of ``args`` (a map with no free pixel is refused
+    by :func:`ursim_core.io.maps.load_map`)."""
     from ursim_core.io.maps import load_map
 
-    the_map = load_map(path, threshold=args.threshold, nonzero_free=args.nonzero_free, max_pixels=args.max_pixels)
-    if not the_map.free.any():
-        raise MapError(
-            f"no free space: no pixel is brighter than the threshold {args.threshold} "
-            "(an all-black or all-occupied map; try --threshold or --nonzero-free)",
-            path=path,
-        )
-    return the_map
+    return load_map(path, threshold=args.threshold, nonzero_free=args.nonzero_free, max_pixels=args.max_pixels)
 
 
 def progress_bar(total: int, label: str) -> Callable[..., None]:

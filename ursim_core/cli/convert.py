@@ -25,6 +25,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if (args.sketch is None) != (args.metric is None):
+        raise UsageError("give both --sketch and --metric, or neither")
     target = Path(args.output)
     if target.is_dir():
         raise ParameterError("is a folder; give the file to write", path=target)

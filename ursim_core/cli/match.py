@@ -1,4 +1,10 @@
-"""``ursim match``: match a sketch map to a metric map, write correspondences and a figure."""
+"""``ursim match``: match a sketch map to a metric map, write correspondences and a figure.
+
+With ``--reference FILE`` (a ground-truth .dat or correspondence JSON of the same pair) the result
+is also scored: precision, recall, F1 (:func:`ursim_core.evaluation.scoring.score_matches`) and
+place accuracy (:func:`ursim_core.evaluation.scoring.place_accuracy`, places in the MAORIS
+``default`` segmentation of the metric map).
+"""
 
 from __future__ import annotations
 
@@ -20,7 +26,8 @@ from ursim_core.errors import ParameterError
 HELP = "Match a sketch map to a metric map and write correspondences and a figure."
 EXAMPLES = """examples:
   ursim match resources/example/sketch.png resources/example/metric.png -o out/
-  ursim match sketch.png metric.yaml --m 0.1 --variant T2 --matcher hungarian -o out/"""
+  ursim match sketch.png metric.yaml --m 0.1 --variant T2 --matcher hungarian -o out/
+  ursim match 00.png model_simple.png -o out/ --reference gt_00_model_simple.dat"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -46,6 +53,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)"
+    )
+    parser.add_argument(
+        "--reference",
+        metavar="FILE",
+        help="ground truth of this pair (.dat or .json): print precision, recall, F1 and place accuracy",
     )
     add_map_options(parser)
 
@@ -87,6 +99,38 @@ def matcher_record(config, result) -> dict[str, Any]:
     }
 
 
+def load_reference(path: str | Path):
+    """A ground-truth file of either format, by its suffix."""
+    from ursim_core.correspondences.codec import load_correspondences, load_dat
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".dat":
+        return load_dat(path)
+    if suffix == ".json":
+        return load_correspondences(path)
+    raise ParameterError("unknown ground-truth file type (expected .dat or .json)", path=path)
+
+
+def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, metric_preset: str, params: dict):
+    """Pair score and place score of ``pairs`` against a ground truth with points."""
+    from ursim_core.correspondences.codec import assign_regions
+    from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, place_accuracy, score_matches
+
+    assigned = assign_regions(reference, sketch_seg.labels, metric_seg.labels, tolerance=10)
+    pair_score = score_matches(pairs, assigned)
+    if metric_preset == PLACE_REFERENCE_PRESET and not params:
+        place_labels = metric_seg.labels
+    else:
+        from ursim_core.cli.segment import segment_checked
+
+        place_labels = segment_checked(metric_map, preset=PLACE_REFERENCE_PRESET, params={}).labels
+    place = place_accuracy(
+        pairs, reference, sketch_seg.labels, metric_seg.labels, place_labels, metric_seg.graph, tolerance=10
+    )
+    return pair_score, place
+
+
 def run(args: argparse.Namespace) -> int:
     from ursim_core.cli.segment import segment_checked
     from ursim_core.correspondences.codec import Correspondences, MapRef, from_pairs, save_correspondences
@@ -96,6 +140,8 @@ def run(args: argparse.Namespace) -> int:
 
     config = match_config(args)
     out = check_output_folder(args.output)
+    # A bad ground-truth file is reported before any work.
+    reference = None if args.reference is None else load_reference(args.reference)
     sketch_map, metric_map = load(args.sketch, args), load(args.metric, args)
     params = segmentation_params(args)
     sketch_seg = segment_checked(sketch_map, preset=args.sketch_preset, params=params)
@@ -146,4 +192,14 @@ def run(args: argparse.Namespace) -> int:
         f"m = {m_text}, {elapsed * 1000:.1f} ms" + (f"; {result.reason}" if result.reason else "")
     )
     print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
+    if reference is not None:
+        pair_score, place = reference_scores(
+            result.pairs, reference, sketch_seg, metric_seg, metric_map, metric_preset=args.metric_preset, params=params
+        )
+        place_text = "-" if place.accuracy != place.accuracy else f"{place.accuracy:.3f}"
+        print(
+            f"against {args.reference}: precision {pair_score.precision:.3f}, recall {pair_score.recall:.3f}, "
+            f"F1 {pair_score.f1:.3f} (tp {pair_score.tp}, fp {pair_score.fp}, fn {pair_score.fn}); "
+            f"place accuracy {place_text} ({place.successes}/{place.n_points} points, {place.n_cliques} cliques)"
+        )
     return 0

@@ -110,10 +110,13 @@ def segment_checked(the_map, *, preset: str, params: dict[str, Any]):
     announce_kernel_compilation()
     segmentation = segment(the_map, preset=preset, params=params)
     if segmentation.n_regions == 0:
-        raise SegmentationError(
-            "0 regions: the free space holds no room of the preset's minimum size (no free space?)",
-            path=the_map.path,
+        free = int(the_map.free.sum())
+        why = (
+            "every pixel is free: there are no walls to find rooms between"
+            if free == the_map.free.size
+            else f"{free} free pixel(s), but no room of the preset's minimum size"
         )
+        raise SegmentationError(f"0 regions: {why}", path=the_map.path)
     return segmentation
 
 
