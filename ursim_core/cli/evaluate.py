@@ -50,6 +50,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cache", metavar="DIR", help="cache segmentations in DIR between runs")
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on a Dask cluster (e.g. tcp://host:8786; start one with 'dask scheduler' and "
+        "'dask worker ADDRESS'; needs pip install 'ursim-studio[distributed]')",
+    )
+    parser.add_argument(
         "--augment",
         metavar="SPEC",
         help="also score every sketch turned / mirrored, each orientation as its own run: 'dihedral' "
@@ -92,6 +98,7 @@ def run(args: argparse.Namespace) -> int:
         config_overrides=overrides,
         progress=progress,
         augment=augment,
+        scheduler=args.scheduler,
     )
     for warning in result.warnings:
         print(f"warning: {warning}", file=sys.stderr)

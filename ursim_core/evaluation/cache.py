@@ -20,7 +20,7 @@ import numpy as np
 
 from ursim_core.evaluation.pool import Progress, completed, pixel_count
 
-__all__ = ["SegmentationJob", "segment_all"]
+__all__ = ["SegmentationJob", "segment_job", "segment_all", "read_cached", "store_segmentation"]
 
 
 @dataclass(frozen=True)
@@ -70,7 +70,7 @@ class SegmentationJob:
         return json.loads(self.load_key)
 
 
-def _segment_job(job: SegmentationJob):
+def segment_job(job: SegmentationJob):
     """Load and segment one map (runs in a worker process)."""
     from ursim_core.io.maps import load_map
     from ursim_core.segmentation import segment
@@ -143,19 +143,32 @@ def _write_disk_cache(path: Path, segmentation) -> None:
         pass
 
 
+def read_cached(job: SegmentationJob, memory_cache, cache_dir):
+    """The job's segmentation from the memory cache, else the disk cache (kept in memory), or None."""
+    found = None
+    if memory_cache is not None:
+        found = memory_cache.get(job.key)
+    if found is None and cache_dir is not None:
+        found = _read_disk_cache(_disk_cache_path(Path(cache_dir), job), job)
+        if found is not None and memory_cache is not None:
+            memory_cache[job.key] = found
+    return found
+
+
+def store_segmentation(job: SegmentationJob, segmentation, memory_cache, cache_dir) -> None:
+    """Keep a computed segmentation in the memory cache and the disk cache (when given)."""
+    if memory_cache is not None:
+        memory_cache[job.key] = segmentation
+    if cache_dir is not None:
+        _write_disk_cache(_disk_cache_path(Path(cache_dir), job), segmentation)
+
+
 def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir):
     """Segmentations by job key, from the caches or computed biggest map first."""
     segmentations: dict[str, Any] = {}
-    cache_folder = None if cache_dir is None else Path(cache_dir)
     to_run = []
     for job in jobs:
-        found = None
-        if memory_cache is not None:
-            found = memory_cache.get(job.key)
-        if found is None and cache_folder is not None:
-            found = _read_disk_cache(_disk_cache_path(cache_folder, job), job)
-            if found is not None and memory_cache is not None:
-                memory_cache[job.key] = found
+        found = read_cached(job, memory_cache, cache_dir)
         if found is None:
             to_run.append(job)
         else:
@@ -164,12 +177,9 @@ def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir)
     cached = len(jobs) - len(to_run)
     # Biggest maps first so the workers finish together.
     to_run.sort(key=lambda job: -pixel_count(job.path))
-    for job, segmentation in completed(_segment_job, to_run, workers=workers):
+    for job, segmentation in completed(segment_job, to_run, workers=workers):
         segmentations[job.key] = segmentation
-        if memory_cache is not None:
-            memory_cache[job.key] = segmentation
-        if cache_folder is not None:
-            _write_disk_cache(_disk_cache_path(cache_folder, job), segmentation)
+        store_segmentation(job, segmentation, memory_cache, cache_dir)
         turned = f" {job.augment}" if job.augment else ""
         reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
     return segmentations, cached

@@ -30,6 +30,7 @@ Scoring is correct by default; ``legacy_scoring=True`` reproduces what the relea
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
@@ -100,6 +101,7 @@ def run_evaluation(
     threshold: float | None = None,
     nonzero_free: bool | None = None,
     augment: str | Sequence[Orientation] | None = None,
+    scheduler: Any = None,
 ) -> EvaluationResult:
     """Run every matcher x variant over a dataset, sweeping m, and score against every annotator.
 
@@ -151,6 +153,12 @@ def run_evaluation(
         and mirrored (new pixels are obstacle) and its ground-truth points moved alike. The
         upright orientation is always run. None (default): the sketches as they are, with an
         empty ``augment``.
+
+    scheduler : str or distributed.Client, keyword-only
+        Run the segmentations and match tasks on this Dask cluster (a scheduler address such
+        as ``'tcp://host:8786'``, or a Client) instead of ``workers`` local processes: each map
+        is segmented once and the tasks take the results (:mod:`ursim_core.evaluation.distributed`;
+        needs the ``distributed`` extra). The rows are the same as a local run's.
 
     Every run is scored by pair F1 and by place accuracy
     (:func:`ursim_core.evaluation.scoring.place_accuracy`), against a reference segmentation of
@@ -252,34 +260,51 @@ def run_evaluation(
     total_steps = len(distinct_jobs) + n_tasks + (1 if human else 0)
     reporter = Progress(progress, total_steps)
 
-    segment_started = time.perf_counter()
-    segmentations, cached = segment_all(distinct_jobs, workers, reporter, segmentation_cache, cache_dir)
-    segmentation_s = time.perf_counter() - segment_started
+    with contextlib.ExitStack() as stack:
+        # A client made here from an address is closed here, even on an error.
+        client = None
+        if scheduler is not None:
+            from ursim_core.evaluation.distributed import connect, run_tasks_dask, segment_all_dask
 
-    references, notes = references_of(instances, segmentations)
-    warnings = _missing_annotator_warnings(experiments)
-    match_started = time.perf_counter()
-    tasks = [
-        MatchTask(
-            name=instance.experiment.name,
-            model=model_label(instance.experiment),
-            sketch_key=instance.sketch_job.key,
-            metric_key=instance.metric_job.key,
-            place_key=instance.place_job.key,
-            matcher=matcher,
-            variant=variant,
-            config=_config_for(base_config, matcher, variant, released),
-            m_grid=tuple(m_grid),
-            references=reference,
-            legacy=legacy_mode,
-            auto_m=auto_m,
-            augment=instance.augment,
-        )
-        for instance, reference in zip(instances, references)
-        for matcher in matchers
-        for variant in variants
-    ]
-    rows = run_tasks(tasks, segmentations, workers, reporter)
+            client = connect(scheduler)
+            if client is not scheduler:
+                stack.callback(client.close)
+        segment_started = time.perf_counter()
+        if client is None:
+            segmentations, cached = segment_all(distinct_jobs, workers, reporter, segmentation_cache, cache_dir)
+        else:
+            segmentations, futures, cached = segment_all_dask(
+                client, distinct_jobs, reporter, segmentation_cache, cache_dir
+            )
+        segmentation_s = time.perf_counter() - segment_started
+
+        references, notes = references_of(instances, segmentations)
+        warnings = _missing_annotator_warnings(experiments)
+        match_started = time.perf_counter()
+        tasks = [
+            MatchTask(
+                name=instance.experiment.name,
+                model=model_label(instance.experiment),
+                sketch_key=instance.sketch_job.key,
+                metric_key=instance.metric_job.key,
+                place_key=instance.place_job.key,
+                matcher=matcher,
+                variant=variant,
+                config=_config_for(base_config, matcher, variant, released),
+                m_grid=tuple(m_grid),
+                references=reference,
+                legacy=legacy_mode,
+                auto_m=auto_m,
+                augment=instance.augment,
+            )
+            for instance, reference in zip(instances, references)
+            for matcher in matchers
+            for variant in variants
+        ]
+        if client is None:
+            rows = run_tasks(tasks, segmentations, workers, reporter)
+        else:
+            rows = run_tasks_dask(client, tasks, futures, reporter)
     matching_s = time.perf_counter() - match_started
 
     human_rows: list[RunRow] = []
@@ -300,6 +325,7 @@ def run_evaluation(
         "scoring": legacy_mode,
         "released": released,
         "workers": workers,
+        "scheduler": None if scheduler is None else _scheduler_address(scheduler),
         "config": _config_summary(base_config),
         "config_overrides": overrides,
         "n_experiments": len(experiments),
@@ -339,6 +365,13 @@ def _checked_orientations(augment) -> tuple[Orientation, ...]:
             raise ParameterError(f"expected Orientation values, got {item!r}", field="augment")
     # Upright first, always: every augmented run has its reference orientation.
     return tuple(dict.fromkeys((UPRIGHT, *orientations)))
+
+
+def _scheduler_address(scheduler) -> str:
+    if isinstance(scheduler, str):
+        return scheduler
+    info = getattr(scheduler, "scheduler_info", None)
+    return str((info() if callable(info) else {}).get("address", scheduler))
 
 
 def _missing_annotator_warnings(experiments) -> list[str]:

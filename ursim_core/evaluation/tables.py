@@ -206,7 +206,11 @@ def heading(result) -> list[str]:
             f"time: segmentation {timings.get('segmentation_s', 0):.1f} s "
             f"({timings.get('maps', 0)} maps, {timings.get('maps_from_cache', 0)} from cache), "
             f"matching {timings.get('matching_s', 0):.1f} s, total {timings.get('total_s', 0):.1f} s "
-            f"on {settings.get('workers', 1)} worker(s)"
+            + (
+                f"on the Dask cluster {settings['scheduler']}"
+                if settings.get("scheduler")
+                else f"on {settings.get('workers', 1)} worker(s)"
+            )
         )
     return lines
 

@@ -33,7 +33,17 @@ from ursim_core.evaluation.pool import Progress, completed
 from ursim_core.evaluation.results import AUTO, HUMAN, RunRow, m_label
 from ursim_core.evaluation.scoring import place_problem, score_cliques, score_matches, score_places
 
-__all__ = ["Instance", "Reference", "MatchTask", "model_label", "references_of", "run_tasks", "human_vs_human_rows"]
+__all__ = [
+    "Instance",
+    "Reference",
+    "MatchTask",
+    "model_label",
+    "references_of",
+    "run_task",
+    "run_tasks",
+    "sorted_rows",
+    "human_vs_human_rows",
+]
 
 
 def model_label(experiment: Experiment) -> str:
@@ -153,10 +163,10 @@ def _init_worker(segmentations: dict[str, Any]) -> None:
 
 
 def _run_task_in_worker(task: MatchTask) -> list[RunRow]:
-    return _run_task(task, _WORKER_SEGMENTATIONS)
+    return run_task(task, _WORKER_SEGMENTATIONS)
 
 
-def _run_task(task: MatchTask, segmentations: dict[str, Any]) -> list[RunRow]:
+def run_task(task: MatchTask, segmentations: dict[str, Any]) -> list[RunRow]:
     """Prepare once, match at every m (and auto), score against every annotator."""
     from ursim_core.matching import match_prepared, prepare
 
@@ -216,7 +226,7 @@ def run_tasks(tasks: list[MatchTask], segmentations: dict[str, Any], workers: in
         tasks, key=lambda t: -(segmentations[t.sketch_key].n_regions * segmentations[t.metric_key].n_regions)
     )
     if workers <= 1 or len(order) < 2:
-        finished = completed(functools.partial(_run_task, segmentations=segmentations), order, workers=1)
+        finished = completed(functools.partial(run_task, segmentations=segmentations), order, workers=1)
     else:
         finished = completed(
             _run_task_in_worker, order, workers=workers, initializer=_init_worker, initargs=(segmentations,)
@@ -226,6 +236,11 @@ def run_tasks(tasks: list[MatchTask], segmentations: dict[str, Any], workers: in
         rows.extend(task_rows)
         turned = f" {task.augment}" if task.augment else ""
         reporter.step(f"match {task.name}{turned} {task.matcher} {task.variant}")
+    return sorted_rows(tasks, rows)
+
+
+def sorted_rows(tasks: list[MatchTask], rows: list[RunRow]) -> list[RunRow]:
+    """Rows in task order, then annotator, then m in grid order (auto last): any run order gives one CSV."""
     position = {task.order_key: index for index, task in enumerate(tasks)}
     m_position = {label: i for i, label in enumerate([m_label(m) for m in tasks[0].m_grid] + [AUTO])} if tasks else {}
     rows.sort(
