@@ -1,7 +1,7 @@
 """The ``ursim`` command line: the parser and the entry point.
 
 Each subcommand is a module of this package (:mod:`~ursim_core.cli.segment`,
-:mod:`~ursim_core.cli.match`, :mod:`~ursim_core.cli.evaluate`, :mod:`~ursim_core.cli.convert`,
+:mod:`~ursim_core.cli.match`, :mod:`~ursim_core.cli.match_batch`, :mod:`~ursim_core.cli.evaluate`, :mod:`~ursim_core.cli.convert`,
 :mod:`~ursim_core.cli.bench`) with ``HELP``, ``EXAMPLES``, ``configure(parser)`` and ``run(args)``.
 Only the subcommand being run is configured, and heavy imports happen inside ``run``, so
 ``ursim --help`` loads nothing heavy.
@@ -24,6 +24,7 @@ from ursim_core.errors import UrsimError
 COMMANDS = {
     "segment": "ursim_core.cli.segment",
     "match": "ursim_core.cli.match",
+    "match-batch": "ursim_core.cli.match_batch",
     "evaluate": "ursim_core.cli.evaluate",
     "convert": "ursim_core.cli.convert",
     "bench": "ursim_core.cli.bench",
@@ -87,14 +88,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 1
     except OSError as error:
-        print(f"error: {_os_error_text(error)}", file=sys.stderr)
+        print(f"error: {os_error_text(error)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
 
 
-def _os_error_text(error: OSError) -> str:
+def os_error_text(error: OSError) -> str:
     """``PATH: problem`` of a file-system error, on one line."""
     problem = error.strerror or str(error) or type(error).__name__
     where = error.filename if error.filename is not None else None

@@ -31,12 +31,22 @@ EXAMPLES = """examples:
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    # The presets' defaults come from the matching pipeline, imported only for this subcommand.
-    from ursim_core.matching.pipeline import MATCH_PRESETS
-
     parser.add_argument("sketch", metavar="SKETCH")
     parser.add_argument("metric", metavar="METRIC")
     parser.add_argument("-o", "--output", metavar="OUT", required=True, help="output folder")
+    parser.add_argument(
+        "--reference",
+        metavar="FILE",
+        help="ground truth of this pair (.dat or .json): print precision, recall, F1 and place accuracy",
+    )
+    add_pair_options(parser)
+
+
+def add_pair_options(parser: argparse.ArgumentParser) -> None:
+    """The matching, segmentation and map-loading options of a pair (``match`` and ``match-batch``)."""
+    # The presets' defaults come from the matching pipeline, imported only for these subcommands.
+    from ursim_core.matching.pipeline import MATCH_PRESETS
+
     parser.add_argument("--m", default="auto", help="threshold m on the signature difference, or 'auto' (default)")
     parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     parser.add_argument("--matcher", choices=["planar", "hungarian", "vf2"], help="graph matcher")
@@ -53,11 +63,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)"
-    )
-    parser.add_argument(
-        "--reference",
-        metavar="FILE",
-        help="ground truth of this pair (.dat or .json): print precision, recall, F1 and place accuracy",
     )
     add_map_options(parser)
 
@@ -131,18 +136,46 @@ def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, me
     return pair_score, place
 
 
-def run(args: argparse.Namespace) -> int:
+#: The options of ``ursim match`` that a pair's run needs (also what ``match-batch`` passes on).
+OPTION_NAMES = (
+    "m",
+    "variant",
+    "matcher",
+    "released",
+    "sketch_preset",
+    "metric_preset",
+    "param",
+    "threshold",
+    "nonzero_free",
+    "max_pixels",
+)
+
+
+def options_of(args: argparse.Namespace) -> dict[str, Any]:
+    """The pair options of parsed arguments as a plain (picklable) dict."""
+    return {name: getattr(args, name) for name in OPTION_NAMES}
+
+
+def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None) -> dict[str, Any]:
+    """Match one pair and write its outputs into ``out``; a record of what was done.
+
+    The record has the counts, m, time and, with ``reference_path``, precision, recall, F1 and
+    place accuracy against that ground truth. Errors propagate (the caller decides).
+    """
+    from types import SimpleNamespace
+
     from ursim_core.cli.segment import segment_checked
     from ursim_core.correspondences.codec import Correspondences, MapRef, from_pairs, save_correspondences
     from ursim_core.matching import match
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
+    args = SimpleNamespace(**options)
     config = match_config(args)
-    out = check_output_folder(args.output)
+    out = check_output_folder(out)
     # A bad ground-truth file is reported before any work.
-    reference = None if args.reference is None else load_reference(args.reference)
-    sketch_map, metric_map = load(args.sketch, args), load(args.metric, args)
+    reference = None if reference_path is None else load_reference(reference_path)
+    sketch_map, metric_map = load(sketch, args), load(metric, args)
     params = segmentation_params(args)
     sketch_seg = segment_checked(sketch_map, preset=args.sketch_preset, params=params)
     metric_seg = segment_checked(metric_map, preset=args.metric_preset, params=params)
@@ -186,20 +219,50 @@ def run(args: argparse.Namespace) -> int:
         save_label_image(metric_seg, staging / "metric.labels.png")
         save_png(staging / "matches.png", figure)
     save_correspondences(corr, out / "correspondences.json")
-    m_text = f"{result.m:.3f}" if isinstance(result.m, (int, float)) else str(result.m)
-    print(
-        f"{len(result.pairs)} matches ({sketch_seg.n_regions} sketch regions, {metric_seg.n_regions} metric regions), "
-        f"m = {m_text}, {elapsed * 1000:.1f} ms" + (f"; {result.reason}" if result.reason else "")
-    )
-    print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
+    record: dict[str, Any] = {
+        "n_matches": len(result.pairs),
+        "n_sketch_regions": sketch_seg.n_regions,
+        "n_metric_regions": metric_seg.n_regions,
+        "m": result.m,
+        "match_ms": elapsed * 1000,
+        "reason": result.reason or "",
+        "out": out,
+    }
     if reference is not None:
         pair_score, place = reference_scores(
             result.pairs, reference, sketch_seg, metric_seg, metric_map, metric_preset=args.metric_preset, params=params
         )
-        place_text = "-" if place.accuracy != place.accuracy else f"{place.accuracy:.3f}"
+        record.update(
+            precision=pair_score.precision,
+            recall=pair_score.recall,
+            f1=pair_score.f1,
+            tp=pair_score.tp,
+            fp=pair_score.fp,
+            fn=pair_score.fn,
+            place_accuracy=place.accuracy,
+            place_points=f"{place.successes}/{place.n_points}",
+            place_cliques=place.n_cliques,
+        )
+    return record
+
+
+def run(args: argparse.Namespace) -> int:
+    record = match_pair(args.sketch, args.metric, Path(args.output), options_of(args), reference_path=args.reference)
+    out = record["out"]
+    m = record["m"]
+    m_text = f"{m:.3f}" if isinstance(m, (int, float)) else str(m)
+    print(
+        f"{record['n_matches']} matches ({record['n_sketch_regions']} sketch regions, "
+        f"{record['n_metric_regions']} metric regions), m = {m_text}, {record['match_ms']:.1f} ms"
+        + (f"; {record['reason']}" if record["reason"] else "")
+    )
+    print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
+    if args.reference is not None:
+        place = record["place_accuracy"]
+        place_text = "-" if place != place else f"{place:.3f}"
         print(
-            f"against {args.reference}: precision {pair_score.precision:.3f}, recall {pair_score.recall:.3f}, "
-            f"F1 {pair_score.f1:.3f} (tp {pair_score.tp}, fp {pair_score.fp}, fn {pair_score.fn}); "
-            f"place accuracy {place_text} ({place.successes}/{place.n_points} points, {place.n_cliques} cliques)"
+            f"against {args.reference}: precision {record['precision']:.3f}, recall {record['recall']:.3f}, "
+            f"F1 {record['f1']:.3f} (tp {record['tp']}, fp {record['fp']}, fn {record['fn']}); "
+            f"place accuracy {place_text} ({record['place_points']} points, {record['place_cliques']} cliques)"
         )
     return 0
