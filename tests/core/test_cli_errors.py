@@ -164,3 +164,16 @@ def test_match_reference_prints_pair_scores_and_place_accuracy(files, capsys):
     assert main(["match", rooms, rooms, "--m", "0.3", "-o", str(out), "--reference", str(files["dat"])]) == 0
     line = capsys.readouterr().out.strip().splitlines()[-1]
     assert "F1 1.000" in line and "place accuracy 1.000" in line and "2 cliques" in line
+
+
+def test_first_run_says_the_kernels_are_compiling(tmp_path, monkeypatch, capsys):
+    import ursim_core.cli.common as common
+    from ursim_core.segmentation import maoris
+
+    monkeypatch.setattr(common, "_announced", False)
+    monkeypatch.setattr(maoris, "kernels_cached", lambda: False, raising=False)
+    rooms = two_rooms(tmp_path / "rooms.png")
+    assert main(["segment", str(rooms), str(rooms), "--preset", "default", "-o", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    # Once per process, before the first segmentation.
+    assert err.count("Compiling the segmentation kernels (first run only") == 1

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ursim_core.cli.common import check_output_folder, progress_bar
+from ursim_core.cli.common import announce_kernel_compilation, check_output_folder, progress_bar
 
 HELP = "Run the paper's experiments on a dataset folder and write a report."
 EXAMPLES = """examples:
@@ -73,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
         # Refused now rather than after the whole run.
         check_output_folder(args.output)
     augment = None if args.augment is None else parse_augment(args.augment)
+    announce_kernel_compilation()
     progress = progress_bar(1, "evaluate")
 
     legacy: bool | str = {"none": False, "as-built": True, "fnfix": "fnfix"}[args.legacy_scoring]
