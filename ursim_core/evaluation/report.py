@@ -42,14 +42,15 @@ __all__ = ["runs_csv", "format_tables", "markdown_summary", "plot_f1_vs_m", "plo
 def runs_csv(result) -> str:
     """Every run (matcher rows, then human-vs-human rows) as CSV text, one row per RunRow.
 
-    Floats are written with 6 significant digits; a NaN (the m of a human row) is empty.
+    Floats are written with 6 significant digits; a NaN (the m of a human row, a place accuracy
+    with no scorable clique) is empty.
 
     Examples
     --------
     >>> from ursim_core.evaluation.results import EvaluationResult, RunRow
     >>> row = RunRow("00", "a", "planar", "T4", "0.1", 0.1, 1, 1, 0, 0.5, 1.0, 2 / 3, 4, 5, 6, 0.01)
     >>> runs_csv(EvaluationResult(rows=(row,))).splitlines()[1]
-    '00,a,planar,T4,0.1,0.1,1,1,0,0.5,1,0.666667,4,5,6,0.01,,0,correct,'
+    '00,a,planar,T4,0.1,0.1,1,1,0,0.5,1,0.666667,4,5,6,0.01,,0,correct,,,'
     """
 
     buffer = io.StringIO()
