@@ -17,7 +17,7 @@ from typing import Any
 
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation.cache import read_cached, segment_job, store_segmentation
-from ursim_core.evaluation.pool import Progress
+from ursim_core.evaluation.pool import Progress, pixel_count
 from ursim_core.evaluation.results import RunRow
 from ursim_core.evaluation.tasks import MatchTask, run_task, sorted_rows
 
@@ -60,6 +60,8 @@ def segment_all_dask(client, jobs, reporter: Progress, memory_cache, cache_dir):
             futures[job.key] = client.scatter(found)
             reporter.step(f"segment {job.path.name} (cached)")
     cached = len(jobs) - len(to_run)
+    # Biggest maps first, as the local pool does, so the workers finish together.
+    to_run.sort(key=lambda job: -pixel_count(job.path))
     pending = {client.submit(segment_job, job, key=f"segment-{job.key}", pure=False): job for job in to_run}
     for future in as_completed(pending):
         job = pending[future]
