@@ -24,7 +24,13 @@ def test_evaluate_prints_tables_and_writes_the_report(synthetic_dataset, tmp_pat
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "F1, oracle m" in out and "F1, automatic m" in out and "Human vs human" in out
-    assert {p.name for p in report.iterdir()} >= {"runs.csv", "summary.md", "f1_vs_m.png", "boxplots.png"}
+    assert {p.name for p in report.iterdir()} >= {
+        "runs.csv",
+        "summary.md",
+        "f1_vs_m.png",
+        "place_vs_m.png",
+        "boxplots.png",
+    }
 
 
 def test_evaluate_paper_released_and_legacy_options(synthetic_dataset, capsys):  # noqa: F811

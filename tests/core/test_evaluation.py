@@ -10,17 +10,17 @@ import pytest
 from PIL import Image
 
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation.runner import (
+from ursim_core.evaluation.results import (
     DEFAULT_M_GRID,
     POOLED,
     EvaluationResult,
     RunRow,
     m_label,
     mean_f1_by_m,
-    run_evaluation,
     summarise,
     summarise_human,
 )
+from ursim_core.evaluation.runner import run_evaluation
 
 
 def _row(name, m, f1, *, annotator="malcolm", matcher="planar", variant="T4", precision=None, recall=None, auto_m=0.05):
@@ -296,8 +296,10 @@ def test_runner_settings_and_timings(synthetic_result, synthetic_dataset):
     assert settings["m_grid"] == list(GRID) and settings["scoring"] == "correct"
     assert settings["presets_used"] == ["robot"]
     assert settings["dataset"] == str(synthetic_dataset)
-    # sketches/copy.png has the model's bytes: with the same preset it is segmented once.
-    assert synthetic_result.timings["maps"] == 2
+    # sketches/copy.png has the model's bytes: with the same preset it is segmented once; the
+    # model once more with the 'default' preset, the reference segmentation of place accuracy.
+    assert synthetic_result.timings["maps"] == 3
+    assert settings["place_reference_preset"] == "default" and settings["augment"] == []
     assert synthetic_result.notes == ()
 
 
@@ -346,16 +348,17 @@ def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_p
     first = run_evaluation(
         synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options
     )
-    total = 2 + 2 * 2 + 1  # distinct maps + (experiment x variant) tasks + human vs human
+    # distinct maps (+ the model's place-accuracy reference) + (experiment x variant) tasks + human vs human
+    total = 3 + 2 * 2 + 1
     assert [c[0] for c in calls] == list(range(1, total + 1)) and {c[1] for c in calls} == {total}
     assert any(text.startswith("segment") for _, _, text in calls) and calls[-1][2] == "human vs human"
-    assert first.timings["maps_from_cache"] == 0 and len(cache) == 2
-    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 2
+    assert first.timings["maps_from_cache"] == 0 and len(cache) == 3
+    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 3
 
     in_memory = run_evaluation(synthetic_dataset, **options)
-    assert in_memory.timings["maps_from_cache"] == 2
+    assert in_memory.timings["maps_from_cache"] == 3
     on_disk = run_evaluation(synthetic_dataset, **{**options, "segmentation_cache": None})
-    assert on_disk.timings["maps_from_cache"] == 2
+    assert on_disk.timings["maps_from_cache"] == 3
     assert [r.f1 for r in on_disk.rows] == [r.f1 for r in first.rows]
 
 
@@ -487,7 +490,7 @@ def test_disk_cache_misses_when_a_map_changes(synthetic_dataset, tmp_path):
     run_evaluation(dataset, **options)
     Image.fromarray(_plan(1.2)).save(dataset / "sketches" / "small.png")
     again = run_evaluation(dataset, **options)
-    assert again.timings["maps"] == 2 and again.timings["maps_from_cache"] == 1
+    assert again.timings["maps"] == 3 and again.timings["maps_from_cache"] == 2
 
 
 def test_an_exception_in_progress_stops_the_worker_pool(synthetic_dataset):
@@ -508,3 +511,64 @@ def test_an_exception_in_progress_stops_the_worker_pool(synthetic_dataset):
             workers=2,
             progress=cancel_when_matching,
         )
+
+
+def test_place_accuracy_is_one_where_every_clique_is_matched_right(synthetic_result):
+    for row in synthetic_result.rows:
+        assert math.isnan(row.place_accuracy) or 0.0 <= row.place_accuracy <= 1.0
+        assert row.augment == ""
+        if row.map == "copy" and row.f1 == 1.0:
+            assert row.place_accuracy == 1.0
+    # vasiliki annotated two of malcolm's three rooms: her cliques send the robot right for two
+    # of malcolm's three cliques; malcolm's cliques are right for both of hers.
+    human = synthetic_result.human_rows
+    assert human
+    for row in human:
+        assert row.place_accuracy == pytest.approx(2 / 3 if row.annotator == "malcolm" else 1.0)
+    summary = synthetic_result.summary("malcolm", "planar", "T4", "oracle")
+    assert len(summary.place) == summary.n
+
+
+def test_dihedral_augmentation_scores_each_orientation_with_its_ground_truth_turned(synthetic_dataset):
+    result = run_evaluation(
+        synthetic_dataset,
+        matchers=["planar"],
+        variants=["T4"],
+        m_grid=GRID,
+        preset="robot",
+        metric_preset="robot",
+        workers=1,
+        augment="dihedral",
+    )
+    names = ["rot0", "rot90", "rot180", "rot270", "mirror-rot0", "mirror-rot90", "mirror-rot180", "mirror-rot270"]
+    assert result.settings["augment"] == names
+    assert {row.augment for row in result.rows} == set(names)
+    assert len(result.rows) == 2 * 8 * 2 * (len(GRID) + 1)
+    for row in result.rows:
+        # The turned sketch keeps its three rooms; the metric map is not turned.
+        assert row.n_sketch_regions == 3 and row.n_metric_regions == 3
+    # The annotators' points move with the image: in every orientation they still fall in the
+    # rooms they were clicked in, so humans agree exactly as upright.
+    human = {(r.map, r.augment, r.annotator): r for r in result.human_rows}
+    assert len(human) == 2 * 8 * 2
+    for row in human.values():
+        assert row.f1 == pytest.approx(0.8)
+        assert row.place_accuracy == pytest.approx(2 / 3 if row.annotator == "malcolm" else 1.0)
+    # Each (map, orientation) is a sample of its own in the summaries.
+    summary = result.summary("malcolm", "planar", "T4", "auto")
+    assert summary.n == 16 and "copy@mirror-rot90" in summary.maps
+    assert not any("ground-truth point" in note for note in result.notes)
+
+
+def test_a_missing_annotator_file_is_reported(synthetic_dataset, tmp_path):
+    import shutil
+
+    copy = tmp_path / "dataset"
+    shutil.copytree(synthetic_dataset, copy)
+    (copy / "gt_correspondences" / "vasiliki" / "gt_small_model_simple.dat").unlink()
+    result = run_evaluation(
+        copy, matchers=["planar"], variants=["T4"], m_grid=GRID, preset="robot", metric_preset="robot", workers=1
+    )
+    assert len(result.warnings) == 1
+    assert "small" in result.warnings[0] and "vasiliki" in result.warnings[0]
+    assert "malcolm only" in result.warnings[0] and result.warnings[0] in result.notes

@@ -10,17 +10,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ursim_core.evaluation.report import (
-    PAPER_TABLE1,
-    RELEASED_KTH,
-    format_tables,
-    markdown_summary,
-    plot_boxplots,
-    plot_f1_vs_m,
-    runs_csv,
-    write_report,
-)
-from ursim_core.evaluation.runner import RUN_COLUMNS, EvaluationResult, RunRow, m_label
+from ursim_core.evaluation.plots import plot_boxplots, plot_f1_vs_m
+from ursim_core.evaluation.published import PAPER_TABLE1, RELEASED_KTH
+from ursim_core.evaluation.report import markdown_summary, runs_csv, write_report
+from ursim_core.evaluation.results import RUN_COLUMNS, EvaluationResult, RunRow, m_label
+from ursim_core.evaluation.tables import format_tables
 
 MATCHERS = ("planar", "hungarian")
 VARIANTS = ("T4", "baseline")
@@ -173,7 +167,8 @@ def test_text_tables_are_table_1_style(result):
     best_m = next(line for line in fixed_block.splitlines() if line.startswith("Planar best m"))
     assert best_m.split()[-1] == "0.1"
     assert (
-        "Human vs human (vasiliki's cliques scored against malcolm's): median 0.80, mean 0.80 ± 0.20 (3 maps)" in text
+        "Human vs human (vasiliki's cliques scored against malcolm's): F1 median 0.80, mean 0.80 ± 0.20; "
+        "place accuracy mean - (3 maps)" in text
     )
     assert "0.568/0.633" in text  # the released code's oracle, fnfix, malcolm (mean/median)
     assert "time: segmentation 1.5 s" in text
@@ -214,11 +209,13 @@ def test_plots_of_an_empty_result_still_render():
 def test_write_report_writes_the_four_files_atomically(result, tmp_path):
     out = tmp_path / "report" / "nested"
     written = write_report(result, out)
-    assert sorted(written) == ["boxplots.png", "f1_vs_m.png", "runs.csv", "summary.md"]
+    assert sorted(written) == ["boxplots.png", "f1_vs_m.png", "place_vs_m.png", "runs.csv", "summary.md"]
     for name, path in written.items():
         assert path == out / name and path.stat().st_size > 100
     assert (out / "runs.csv").read_text() == runs_csv(result)
     assert (out / "summary.md").read_text(encoding="utf-8") == markdown_summary(result)
+    with Image.open(out / "place_vs_m.png") as image:
+        assert image.format == "PNG"  # these hand-made rows have no place accuracy to plot
     for name in ("f1_vs_m.png", "boxplots.png"):
         with Image.open(out / name) as image:
             assert image.format == "PNG"

@@ -9,9 +9,45 @@ from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 __all__ = ["run_bench"]
 
 
+#: Benchmarks that other modules of this package provide (module, function), run on request.
+_OPTIONAL = {
+    "compile": ("ursim_core.bench.kernels", "bench_compile"),
+    "files": ("ursim_core.bench.files", "bench_files"),
+}
+
+
 def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats: int = 5) -> int:
-    """Run the benchmarks named by ``what`` ('segment', 'scale', 'match' or 'all') and print figures."""
+    """Run the benchmarks named by ``what`` and print figures.
+
+    ``what``: 'segment', 'scale', 'match' or 'all' (those three), 'startup' (whole-process
+    times, :mod:`ursim_core.bench.startup`), 'compile' (first-run kernel compilation) or 'files'
+    (correspondence files). Returns the exit code: 1 when the benchmark is not available.
+    """
     root = dataset_root(datasets)
+    if what == "startup":
+        from ursim_core.bench.startup import bench_startup, print_startup
+
+        kth = None if root is None else root / "ursim_kth_sketches"
+        if kth is None:
+            print(f"startup: KTH cases skipped ({MISSING_REASON})")
+        print("== whole-process start-up (issue 10 item 4 targets)")
+        print_startup(bench_startup(kth, repeats=repeats))
+        return 0
+    if what in _OPTIONAL:
+        import importlib
+        import sys
+
+        module_name, function_name = _OPTIONAL[what]
+        try:
+            function = getattr(importlib.import_module(module_name), function_name)
+        except (ImportError, AttributeError):
+            print(
+                f"error: 'ursim bench {what}' is not available in this version ({module_name}.{function_name} is missing)",
+                file=sys.stderr,
+            )
+            return 1
+        result = function()
+        return result if isinstance(result, int) else 0
     if what in ("segment", "scale", "all"):
         from ursim_core.segmentation.maoris import compile_kernels
 

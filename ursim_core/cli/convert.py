@@ -1,13 +1,41 @@
-"""Conversion between the original annotators' ``.dat`` files and the JSON correspondence format."""
+"""``ursim convert``: correspondences between the original annotators' ``.dat`` files and JSON."""
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 from pathlib import Path
 
+from ursim_core.cli.common import UsageError
 from ursim_core.errors import ParameterError
 
-__all__ = ["convert"]
+__all__ = ["convert_correspondences"]
+
+HELP = "Convert correspondences between the original .dat files and JSON."
+EXAMPLES = """examples:
+  ursim convert gt_00_model_simple.dat gt_00.json --sketch 00.png --metric model_simple.png
+  ursim convert gt_00.json gt_00.dat"""
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("input", metavar="IN", help=".dat or .json")
+    parser.add_argument("output", metavar="OUT", help=".json or .dat")
+    parser.add_argument("--sketch", help="sketch map (for .dat -> JSON: stored in the JSON, regions assigned)")
+    parser.add_argument("--metric", help="metric map (for .dat -> JSON)")
+
+
+def run(args: argparse.Namespace) -> int:
+    if (args.sketch is None) != (args.metric is None):
+        raise UsageError("give both --sketch and --metric, or neither")
+    target = Path(args.output)
+    if target.is_dir():
+        raise ParameterError("is a folder; give the file to write", path=target)
+    if not target.parent.is_dir():
+        raise ParameterError(f"no folder {target.parent} to write into", path=target)
+    convert_correspondences(Path(args.input), target, sketch=args.sketch, metric=args.metric)
+    print(f"wrote {args.output}")
+    return 0
+
 
 _KINDS = {".dat": "dat", ".json": "json"}
 
@@ -19,7 +47,7 @@ def _kind(path: Path) -> str:
         raise ParameterError("unknown correspondence file type (expected .dat or .json)", path=path) from None
 
 
-def convert(
+def convert_correspondences(
     source: Path,
     target: Path,
     *,
@@ -35,7 +63,7 @@ def convert(
 
     Examples
     --------
-    >>> convert(Path("a.dat"), Path("a.txt"))
+    >>> convert_correspondences(Path("a.dat"), Path("a.txt"))
     Traceback (most recent call last):
     ...
     ursim_core.errors.ParameterError: a.txt: unknown correspondence file type (expected .dat or .json)
@@ -55,7 +83,7 @@ def convert(
         save_dat(corr, target)
         return
     if (sketch is None) != (metric is None):
-        raise ParameterError("give both --sketch and --metric, or neither")
+        raise UsageError("give both --sketch and --metric, or neither")
     if sketch is not None and metric is not None:
         from ursim_core.io.maps import load_map
         from ursim_core.segmentation import segment

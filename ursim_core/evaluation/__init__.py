@@ -3,8 +3,13 @@
 Owns: pair scores and place accuracy (:mod:`~ursim_core.evaluation.scoring`), the dataset
 layouts and where the datasets are (:mod:`~ursim_core.evaluation.layouts`,
 :mod:`~ursim_core.evaluation.datasets`), the experiment runner behind ``ursim evaluate``
-(:mod:`~ursim_core.evaluation.runner`), the KTH protocol of the matching benchmark
-(:mod:`~ursim_core.evaluation.kth_protocol`) and the report (tables, CSV, plots).
+(:mod:`~ursim_core.evaluation.runner`, with its segmentation cache :mod:`~ursim_core.evaluation.cache`,
+process pool :mod:`~ursim_core.evaluation.pool` and scored tasks :mod:`~ursim_core.evaluation.tasks`),
+the values it produces and their summaries (:mod:`~ursim_core.evaluation.results`), the KTH protocol
+of the matching benchmark (:mod:`~ursim_core.evaluation.kth_protocol`), turned and mirrored
+sketches with their ground truth (:mod:`~ursim_core.evaluation.augment`) and the report
+(:mod:`~ursim_core.evaluation.report`: CSV and markdown; :mod:`~ursim_core.evaluation.tables`,
+:mod:`~ursim_core.evaluation.plots`, :mod:`~ursim_core.evaluation.published`).
 
 May import: :mod:`ursim_core.matching`, :mod:`ursim_core.segmentation`,
 :mod:`ursim_core.correspondences`, :mod:`ursim_core.io`, :mod:`ursim_core.errors`.
@@ -14,22 +19,52 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["datasets", "kth_protocol", "layouts", "report", "runner", "scoring"],
+    submodules=[
+        "augment",
+        "cache",
+        "datasets",
+        "formatting",
+        "kth_protocol",
+        "layouts",
+        "plots",
+        "pool",
+        "published",
+        "report",
+        "results",
+        "runner",
+        "scoring",
+        "tables",
+        "tasks",
+    ],
     submod_attrs={
-        "scoring": ["MatchScore", "score_matches", "score_cliques", "SCORING_MODES"],
+        "scoring": [
+            "MatchScore",
+            "score_matches",
+            "score_cliques",
+            "SCORING_MODES",
+            "PlaceScore",
+            "place_accuracy",
+        ],
+        "augment": ["Orientation", "DIHEDRAL", "parse_augment", "transform_image", "transform_points"],
         "layouts": ["Experiment", "discover"],
         "datasets": ["dataset_root", "DATASET_ENV", "MISSING_REASON"],
-        "runner": [
+        "results": [
+            "DEFAULT_M_GRID",
+            "MATCHERS",
+            "VARIANTS",
+            "POOLED",
+            "RUN_COLUMNS",
             "RunRow",
             "Summary",
             "EvaluationResult",
-            "run_evaluation",
             "summarise",
             "summarise_human",
             "mean_f1_by_m",
             "m_label",
-            "format_tables",
-            "write_report",
         ],
+        "runner": ["run_evaluation"],
+        "tables": ["format_tables"],
+        "report": ["write_report", "runs_csv", "markdown_summary"],
+        "plots": ["plot_f1_vs_m", "plot_boxplots"],
     },
 )

@@ -1,0 +1,34 @@
+"""``ursim bench``: the optional benchmarks and the start-up table (figures are printed, never asserted)."""
+
+from __future__ import annotations
+
+import ursim_core.bench.runner as runner
+from ursim_core.bench.startup import print_startup
+
+
+def test_a_missing_optional_benchmark_says_so(monkeypatch, capsys):
+    monkeypatch.setitem(runner._OPTIONAL, "files", ("ursim_core.bench.no_such_module", "bench_files"))
+    assert runner.run_bench("files") == 1
+    assert "not available" in capsys.readouterr().err
+
+
+def test_an_optional_benchmark_is_called(monkeypatch, capsys):
+    import types
+
+    module = types.ModuleType("fake_bench")
+    module.bench_compile = lambda: print("compiled in 1.0 s")
+    monkeypatch.setitem(__import__("sys").modules, "fake_bench", module)
+    monkeypatch.setitem(runner._OPTIONAL, "compile", ("fake_bench", "bench_compile"))
+    assert runner.run_bench("compile") == 0
+    assert "compiled in 1.0 s" in capsys.readouterr().out
+
+
+def test_startup_table_states_each_target(capsys):
+    print_startup(
+        [
+            {"case": "ursim --help", "median_s": 0.1, "min_s": 0.09, "n": 5, "target_s": 0.15},
+            {"case": "ursim match (KTH 00 vs model)", "median_s": 1.0, "min_s": 0.9, "n": 5, "target_s": 0.5},
+        ]
+    )
+    out = capsys.readouterr().out
+    assert "meets target" in out and "2.0x over target" in out

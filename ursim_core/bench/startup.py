@@ -1,0 +1,96 @@
+"""Whole-process start-up timings: what a user waits for when running ``ursim`` from a shell.
+
+Each command is run ``repeats`` times as a fresh process (after one warm-up run, so the OS file
+cache and numba's kernel cache are warm) and the median wall time is printed beside its target
+(issue 10 item 4): ``ursim --help`` <= 0.15 s, ``ursim match`` of a KTH pair <= 0.5 s, and
+faster than the authors' C++ MAORIS, which took 1.04 s as a whole process on the KTH model map.
+"""
+
+from __future__ import annotations
+
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+__all__ = ["STARTUP_TARGETS", "bench_startup", "print_startup"]
+
+#: Target whole-process seconds by case (None: no target, printed for reference).
+STARTUP_TARGETS: dict[str, float | None] = {
+    "python -c pass": None,
+    "ursim --help": 0.15,
+    "ursim match (KTH 00 vs model)": 0.5,
+    "ursim segment (KTH model)": 1.04,
+}
+_TARGET_NOTES = {
+    "ursim segment (KTH model)": "the authors' C++ MAORIS, whole process",
+}
+
+
+def _ursim_command() -> list[str]:
+    script = Path(sys.executable).with_name("ursim")
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "ursim_core.cli"]
+
+
+def _time(command: list[str], repeats: int) -> list[float]:
+    subprocess.run(command, check=True, capture_output=True)  # warm-up
+    times = []
+    for _ in range(repeats):
+        started = time.perf_counter()
+        subprocess.run(command, check=True, capture_output=True)
+        times.append(time.perf_counter() - started)
+    return times
+
+
+def bench_startup(kth: Path | None, *, repeats: int = 5) -> list[dict]:
+    """Median whole-process seconds of each case; the KTH cases are left out when ``kth`` is None."""
+    ursim = _ursim_command()
+    cases: list[tuple[str, list[str]]] = [("python -c pass", [sys.executable, "-c", "pass"])]
+    cases.append(("ursim --help", [*ursim, "--help"]))
+    out = Path(tempfile.mkdtemp(prefix="ursim-bench-startup-"))
+    try:
+        if kth is not None:
+            model = kth / "model" / "model_simple.png"
+            sketch = kth / "sketches" / "00.png"
+            cases.append(
+                ("ursim match (KTH 00 vs model)", [*ursim, "match", str(sketch), str(model), "-o", str(out / "m")])
+            )
+            cases.append(
+                (
+                    "ursim segment (KTH model)",
+                    [*ursim, "segment", str(model), "--preset", "default", "-o", str(out / "s")],
+                )
+            )
+        rows = []
+        for name, command in cases:
+            times = _time(command, repeats)
+            rows.append(
+                {
+                    "case": name,
+                    "median_s": statistics.median(times),
+                    "min_s": min(times),
+                    "n": len(times),
+                    "target_s": STARTUP_TARGETS.get(name),
+                }
+            )
+        return rows
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
+def print_startup(rows: list[dict]) -> None:
+    print(f"{'case':<32} {'median s':>9} {'min s':>7} {'target s':>9}  verdict")
+    for row in rows:
+        target = row["target_s"]
+        if target is None:
+            verdict, target_text = "(reference)", "-"
+        else:
+            verdict = "meets target" if row["median_s"] <= target else f"{row['median_s'] / target:.1f}x over target"
+            target_text = f"{target:.2f}"
+            if row["case"] in _TARGET_NOTES:
+                verdict += f" ({_TARGET_NOTES[row['case']]})"
+        print(f"{row['case']:<32} {row['median_s']:>9.3f} {row['min_s']:>7.3f} {target_text:>9}  {verdict}")
+    print(f"(median of {rows[0]['n'] if rows else 0} fresh processes after one warm-up run)")

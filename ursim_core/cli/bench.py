@@ -1,0 +1,33 @@
+"""``ursim bench``: print speed and memory figures (never asserted; see :mod:`ursim_core.bench`)."""
+
+from __future__ import annotations
+
+import argparse
+
+HELP = "Print speed and memory figures."
+EXAMPLES = """examples:
+  ursim bench segment
+  ursim bench startup --repeats 7
+  ursim bench all --datasets ../shared/datasets"""
+
+#: Benchmarks by name; "all" runs segment, scale and match (the others on request).
+BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "all")
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "what",
+        choices=BENCHMARKS,
+        nargs="?",
+        default="all",
+        help="startup: whole-process times of ursim --help / match / segment; compile: first-run kernel "
+        "compilation; files: correspondence file load/save; all: segment, scale and match",
+    )
+    parser.add_argument("--datasets", help="datasets folder (default: $URSIM_DATASETS or ../shared/datasets)")
+    parser.add_argument("--repeats", type=int, default=5)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ursim_core.bench.runner import run_bench
+
+    return run_bench(args.what, datasets=args.datasets, repeats=args.repeats)

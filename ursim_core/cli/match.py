@@ -1,0 +1,268 @@
+"""``ursim match``: match a sketch map to a metric map, write correspondences and a figure.
+
+With ``--reference FILE`` (a ground-truth .dat or correspondence JSON of the same pair) the result
+is also scored: precision, recall, F1 (:func:`ursim_core.evaluation.scoring.score_matches`) and
+place accuracy (:func:`ursim_core.evaluation.scoring.place_accuracy`, places in the MAORIS
+``default`` segmentation of the metric map).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+from ursim_core.cli.common import (
+    add_map_options,
+    check_output_folder,
+    load,
+    segmentation_params,
+    staged_folder,
+)
+from ursim_core.errors import ParameterError
+
+HELP = "Match a sketch map to a metric map and write correspondences and a figure."
+EXAMPLES = """examples:
+  ursim match resources/example/sketch.png resources/example/metric.png -o out/
+  ursim match sketch.png metric.yaml --m 0.1 --variant T2 --matcher hungarian -o out/
+  ursim match 00.png model_simple.png -o out/ --reference gt_00_model_simple.dat"""
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("sketch", metavar="SKETCH")
+    parser.add_argument("metric", metavar="METRIC")
+    parser.add_argument("-o", "--output", metavar="OUT", required=True, help="output folder")
+    parser.add_argument(
+        "--reference",
+        metavar="FILE",
+        help="ground truth of this pair (.dat or .json): print precision, recall, F1 and place accuracy",
+    )
+    add_pair_options(parser)
+
+
+def add_pair_options(parser: argparse.ArgumentParser) -> None:
+    """The matching, segmentation and map-loading options of a pair (``match`` and ``match-batch``)."""
+    # The presets' defaults come from the matching pipeline, imported only for these subcommands.
+    from ursim_core.matching.pipeline import MATCH_PRESETS
+
+    parser.add_argument("--m", default="auto", help="threshold m on the signature difference, or 'auto' (default)")
+    parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
+    parser.add_argument("--matcher", choices=["planar", "hungarian", "vf2"], help="graph matcher")
+    parser.add_argument("--released", action="store_true", help="start from the released C++ code's options")
+    parser.add_argument(
+        "--sketch-preset",
+        default=MATCH_PRESETS["sketch"],
+        help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)",
+    )
+    parser.add_argument(
+        "--metric-preset",
+        default=MATCH_PRESETS["metric"],
+        help=f"segmentation preset for the metric map (default {MATCH_PRESETS['metric']})",
+    )
+    parser.add_argument(
+        "--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)"
+    )
+    add_map_options(parser)
+
+
+def match_config(args: argparse.Namespace):
+    from ursim_core.matching import MatchConfig
+
+    m: Any = args.m
+    if m != "auto":
+        try:
+            m = float(m)
+        except ValueError:
+            raise ParameterError(f"--m expects 'auto' or a number, got '{args.m}'") from None
+    base = MatchConfig.released() if args.released else MatchConfig()
+    overrides: dict[str, Any] = {"m": m}
+    if args.variant:
+        overrides["variant"] = args.variant
+    if args.matcher:
+        overrides["matcher"] = args.matcher
+    return base.replace(**overrides)
+
+
+def matcher_record(config, result) -> dict[str, Any]:
+    """What produced the automatic cliques, JSON-safe (kept in the file as an unknown key)."""
+    import dataclasses
+    import math
+
+    def safe(value: Any) -> Any:
+        if isinstance(value, float) and not math.isfinite(value):
+            return None
+        return value
+
+    return {
+        "config": json.loads(json.dumps(dataclasses.asdict(config), default=str)),
+        "m": safe(float(result.m)) if result.m is not None else None,
+        "cost": safe(float(result.cost)) if result.cost is not None else None,
+        "anchors": [[int(a), int(b)] for a, b in result.anchors],
+        "reason": result.reason or "",
+    }
+
+
+def load_reference(path: str | Path):
+    """A ground-truth file of either format, by its suffix."""
+    from ursim_core.correspondences.codec import load_correspondences, load_dat
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".dat":
+        return load_dat(path)
+    if suffix == ".json":
+        return load_correspondences(path)
+    raise ParameterError("unknown ground-truth file type (expected .dat or .json)", path=path)
+
+
+def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, metric_preset: str, params: dict):
+    """Pair score and place score of ``pairs`` against a ground truth with points."""
+    from ursim_core.correspondences.codec import assign_regions
+    from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, place_accuracy, score_matches
+
+    assigned = assign_regions(reference, sketch_seg.labels, metric_seg.labels, tolerance=10)
+    pair_score = score_matches(pairs, assigned)
+    if metric_preset == PLACE_REFERENCE_PRESET and not params:
+        place_labels = metric_seg.labels
+    else:
+        from ursim_core.cli.segment import segment_checked
+
+        place_labels = segment_checked(metric_map, preset=PLACE_REFERENCE_PRESET, params={}).labels
+    place = place_accuracy(
+        pairs, reference, sketch_seg.labels, metric_seg.labels, place_labels, metric_seg.graph, tolerance=10
+    )
+    return pair_score, place
+
+
+#: The options of ``ursim match`` that a pair's run needs (also what ``match-batch`` passes on).
+OPTION_NAMES = (
+    "m",
+    "variant",
+    "matcher",
+    "released",
+    "sketch_preset",
+    "metric_preset",
+    "param",
+    "threshold",
+    "nonzero_free",
+    "max_pixels",
+)
+
+
+def options_of(args: argparse.Namespace) -> dict[str, Any]:
+    """The pair options of parsed arguments as a plain (picklable) dict."""
+    return {name: getattr(args, name) for name in OPTION_NAMES}
+
+
+def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None) -> dict[str, Any]:
+    """Match one pair and write its outputs into ``out``; a record of what was done.
+
+    The record has the counts, m, time and, with ``reference_path``, precision, recall, F1 and
+    place accuracy against that ground truth. Errors propagate (the caller decides).
+    """
+    from types import SimpleNamespace
+
+    from ursim_core.cli.segment import segment_checked
+    from ursim_core.correspondences.codec import Correspondences, MapRef, from_pairs, save_correspondences
+    from ursim_core.matching import match
+    from ursim_core.render.figures import save_png, side_by_side_matches
+    from ursim_core.segmentation import save_label_image
+
+    args = SimpleNamespace(**options)
+    config = match_config(args)
+    out = check_output_folder(out)
+    # A bad ground-truth file is reported before any work.
+    reference = None if reference_path is None else load_reference(reference_path)
+    sketch_map, metric_map = load(sketch, args), load(metric, args)
+    params = segmentation_params(args)
+    sketch_seg = segment_checked(sketch_map, preset=args.sketch_preset, params=params)
+    metric_seg = segment_checked(metric_map, preset=args.metric_preset, params=params)
+    started = time.perf_counter()
+    result = match(sketch_seg, metric_seg, config=config)
+    elapsed = time.perf_counter() - started
+
+    def ref(the_map, seg, labels_name):
+        return MapRef(
+            path=Path(the_map.path).resolve() if the_map.path else None,
+            sha256=the_map.sha256,
+            size=tuple(the_map.shape),
+            segmentation_method=seg.method,
+            segmentation_params=dict(seg.params),
+            labels_path=(out / labels_name).resolve(),
+            extra={},
+        )
+
+    cliques = from_pairs(
+        result.pairs,
+        sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
+        metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
+        source="auto",
+    )
+    corr = Correspondences(
+        sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
+        metric=ref(metric_map, metric_seg, "metric.labels.png"),
+        cliques=cliques,
+        extra={"matcher": matcher_record(config, result)},
+    )
+    figure = side_by_side_matches(
+        (sketch_seg.labels, sketch_seg.graph, sketch_map.image),
+        (metric_seg.labels, metric_seg.graph, metric_map.image),
+        result.pairs,
+        anchors=result.anchors,
+    )
+    # The images are staged and moved in together; the JSON, which names them, is written last
+    # (atomically, in place, so the paths it stores are relative to its own folder).
+    with staged_folder(out) as staging:
+        save_label_image(sketch_seg, staging / "sketch.labels.png")
+        save_label_image(metric_seg, staging / "metric.labels.png")
+        save_png(staging / "matches.png", figure)
+    save_correspondences(corr, out / "correspondences.json")
+    record: dict[str, Any] = {
+        "n_matches": len(result.pairs),
+        "n_sketch_regions": sketch_seg.n_regions,
+        "n_metric_regions": metric_seg.n_regions,
+        "m": result.m,
+        "match_ms": elapsed * 1000,
+        "reason": result.reason or "",
+        "out": out,
+    }
+    if reference is not None:
+        pair_score, place = reference_scores(
+            result.pairs, reference, sketch_seg, metric_seg, metric_map, metric_preset=args.metric_preset, params=params
+        )
+        record.update(
+            precision=pair_score.precision,
+            recall=pair_score.recall,
+            f1=pair_score.f1,
+            tp=pair_score.tp,
+            fp=pair_score.fp,
+            fn=pair_score.fn,
+            place_accuracy=place.accuracy,
+            place_points=f"{place.successes}/{place.n_points}",
+            place_cliques=place.n_cliques,
+        )
+    return record
+
+
+def run(args: argparse.Namespace) -> int:
+    record = match_pair(args.sketch, args.metric, Path(args.output), options_of(args), reference_path=args.reference)
+    out = record["out"]
+    m = record["m"]
+    m_text = f"{m:.3f}" if isinstance(m, (int, float)) else str(m)
+    print(
+        f"{record['n_matches']} matches ({record['n_sketch_regions']} sketch regions, "
+        f"{record['n_metric_regions']} metric regions), m = {m_text}, {record['match_ms']:.1f} ms"
+        + (f"; {record['reason']}" if record["reason"] else "")
+    )
+    print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
+    if args.reference is not None:
+        place = record["place_accuracy"]
+        place_text = "-" if place != place else f"{place:.3f}"
+        print(
+            f"against {args.reference}: precision {record['precision']:.3f}, recall {record['recall']:.3f}, "
+            f"F1 {record['f1']:.3f} (tp {record['tp']}, fp {record['fp']}, fn {record['fn']}); "
+            f"place accuracy {place_text} ({record['place_points']} points, {record['place_cliques']} cliques)"
+        )
+    return 0

@@ -1,0 +1,208 @@
+"""``ursim match-batch``: match many sketch/metric pairs listed in a manifest, on a pool or a cluster.
+
+The manifest is a CSV with a header (columns ``sketch``, ``metric`` and optionally ``reference``
+and ``name``) or a JSON list of objects with those keys. Relative paths are taken from the
+manifest's folder. Each pair's outputs go to ``OUT/NAME/`` exactly as ``ursim match`` writes
+them; ``OUT/summary.csv`` has one row per pair, with its status and, for a failed pair, the
+error. A failed pair does not stop the others; the exit code is 1 when any failed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ursim_core.cli.common import check_output_folder, progress_bar
+from ursim_core.errors import FormatError, ParameterError, UrsimError
+
+HELP = "Match every sketch/metric pair of a manifest (CSV or JSON) and write one summary CSV."
+EXAMPLES = """examples:
+  ursim match-batch pairs.csv -o out/
+  ursim match-batch pairs.json -o out/ --workers 2 --matcher planar
+  ursim match-batch pairs.csv -o out/ --scheduler tcp://host:8786
+
+pairs.csv:
+  sketch,metric,reference,name
+  sketches/00.png,model/model_simple.png,gt/gt_00_model_simple.dat,00"""
+
+#: Columns of summary.csv, in order.
+SUMMARY_COLUMNS = (
+    "name",
+    "sketch",
+    "metric",
+    "status",
+    "error",
+    "n_matches",
+    "n_sketch_regions",
+    "n_metric_regions",
+    "m",
+    "match_ms",
+    "precision",
+    "recall",
+    "f1",
+    "place_accuracy",
+    "reason",
+)
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    from ursim_core.cli import match
+
+    parser.add_argument("manifest", metavar="MANIFEST", help="CSV (sketch,metric[,reference][,name]) or JSON list")
+    parser.add_argument("-o", "--output", metavar="OUT", required=True, help="output folder")
+    parser.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="run the pairs on a Dask cluster instead")
+    # The options of `ursim match`, applied to every pair.
+    match.add_pair_options(parser)
+
+
+def read_manifest(path: str | Path) -> list[dict[str, Any]]:
+    """The pairs of a manifest: dicts with ``name``, ``sketch``, ``metric``, ``reference`` (or None).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "p.csv").write_text("sketch,metric\\na/map.png,m.png\\nb/map.png,m.png\\n")
+    >>> [(p["name"], p["sketch"].name) for p in read_manifest(folder / "p.csv")]
+    [('001-map', 'map.png'), ('002-map', 'map.png')]
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ParameterError("manifest not found", path=path) from None
+    except UnicodeDecodeError:
+        raise FormatError("not UTF-8 text", path=path) from None
+    if path.suffix.lower() == ".json":
+        try:
+            items = json.loads(text)
+        except (ValueError, RecursionError) as error:
+            raise FormatError(f"not valid JSON ({str(error)[:80]})", path=path) from None
+        if not isinstance(items, list) or not all(isinstance(item, dict) for item in items):
+            raise FormatError("expected a JSON list of objects with 'sketch' and 'metric'", path=path)
+    else:
+        reader = csv.DictReader(io.StringIO(text))
+        if not reader.fieldnames or not {"sketch", "metric"} <= set(reader.fieldnames):
+            raise FormatError("expected a CSV header with the columns sketch and metric", path=path)
+        items = list(reader)
+    if not items:
+        raise FormatError("the manifest lists no pair", path=path)
+    pairs, names = [], set()
+    for index, item in enumerate(items, start=1):
+        for key in ("sketch", "metric"):
+            if not isinstance(item.get(key), str) or not item[key].strip():
+                raise FormatError(f"pair {index}: '{key}' must be a path", path=path)
+        reference = item.get("reference")
+        if reference is not None and not isinstance(reference, str):
+            raise FormatError(f"pair {index}: 'reference' must be a path", path=path)
+        sketch = path.parent / item["sketch"].strip()
+        name = str(item.get("name") or "").strip() or f"{index:03d}-{sketch.stem}"
+        if name in names or "/" in name or name in (".", ".."):
+            raise FormatError(f"pair {index}: the name '{name}' is taken or not a folder name", path=path)
+        names.add(name)
+        pairs.append(
+            {
+                "name": name,
+                "sketch": sketch,
+                "metric": path.parent / item["metric"].strip(),
+                "reference": path.parent / reference.strip() if reference and reference.strip() else None,
+            }
+        )
+    return pairs
+
+
+def run_pair(pair: dict[str, Any], out: Path, options: dict[str, Any]) -> dict[str, Any]:
+    """One pair, its failure turned into a record (runs in a worker process or on a Dask worker)."""
+    from ursim_core.cli.match import match_pair
+
+    record: dict[str, Any] = {"name": pair["name"], "sketch": str(pair["sketch"]), "metric": str(pair["metric"])}
+    try:
+        result = match_pair(
+            pair["sketch"], pair["metric"], out / pair["name"], options, reference_path=pair["reference"]
+        )
+    except UrsimError as error:
+        return {**record, "status": "failed", "error": str(error)}
+    except OSError as error:
+        from ursim_core.cli.main import os_error_text
+
+        return {**record, "status": "failed", "error": os_error_text(error)}
+    result.pop("out", None)
+    return {**record, **result, "status": "ok", "error": ""}
+
+
+def _summary_csv(records: list[dict[str, Any]]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(SUMMARY_COLUMNS)
+    for record in records:
+        row = []
+        for column in SUMMARY_COLUMNS:
+            value = record.get(column, "")
+            if isinstance(value, float):
+                value = "" if value != value else format(value, ".6g")
+            row.append(value)
+        writer.writerow(row)
+    return buffer.getvalue()
+
+
+def _run_local(pairs, out, options, workers, progress):
+    import concurrent.futures
+    import functools
+
+    function = functools.partial(run_pair, out=out, options=options)
+    if workers <= 1 or len(pairs) < 2:
+        for index, pair in enumerate(pairs, start=1):
+            yield function(pair)
+            progress(index, text=pair["name"])
+        return
+    with concurrent.futures.ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(function, pair) for pair in pairs]
+        for index, future in enumerate(concurrent.futures.as_completed(futures), start=1):
+            record = future.result()
+            progress(index, text=record["name"])
+            yield record
+
+
+def _run_dask(pairs, out, options, scheduler, progress):
+    from distributed import as_completed
+
+    from ursim_core.evaluation.distributed import connect
+
+    client = connect(scheduler)
+    try:
+        futures = [client.submit(run_pair, pair, out, options, pure=False) for pair in pairs]
+        for index, future in enumerate(as_completed(futures), start=1):
+            record = future.result()
+            progress(index, text=record["name"])
+            yield record
+    finally:
+        client.close()
+
+
+def run(args: argparse.Namespace) -> int:
+    from ursim_core.cli.match import options_of
+    from ursim_core.io.atomic import atomic_write_text
+
+    out = check_output_folder(args.output)
+    pairs = read_manifest(args.manifest)
+    options = options_of(args)
+    progress = progress_bar(len(pairs), "match-batch")
+    out.mkdir(parents=True, exist_ok=True)
+    if args.scheduler:
+        records = list(_run_dask(pairs, out, options, args.scheduler, progress))
+    else:
+        records = list(_run_local(pairs, out, options, max(1, args.workers), progress))
+    order = {pair["name"]: index for index, pair in enumerate(pairs)}
+    records.sort(key=lambda record: order[record["name"]])
+    atomic_write_text(out / "summary.csv", _summary_csv(records))
+    failed = [record for record in records if record["status"] != "ok"]
+    for record in failed:
+        print(f"error: {record['name']}: {record['error']}", file=sys.stderr)
+    print(f"{len(records) - len(failed)} of {len(records)} pairs matched; wrote {out / 'summary.csv'}")
+    return 1 if failed else 0

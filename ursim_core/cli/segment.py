@@ -1,0 +1,179 @@
+"""``ursim segment``: segment maps into regions and write label images, overlays and region tables."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ursim_core.cli.common import (
+    UsageError,
+    add_map_options,
+    announce_kernel_compilation,
+    check_output_folder,
+    load,
+    progress_bar,
+    segmentation_params,
+    staged_folder,
+)
+from ursim_core.errors import ParameterError, SegmentationError, UrsimError
+
+HELP = "Segment maps into regions (MAORIS) and write labels, overlays and region tables."
+EXAMPLES = """examples:
+  ursim segment resources/example/sketch.png -o out/
+  ursim segment maps/*.png --preset robot --param threshold=0.4 -o out/
+  ursim segment --evaluate GT_DIR MAPS_DIR --preset sketch
+
+Two maps with the same file name (a/map.png b/map.png) are written as map.* and map-2.*
+(a note on stderr says so). Outputs of a map appear in OUT only when all of them are written."""
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("maps", nargs="*", metavar="MAP", help="map images or ROS map YAML files")
+    parser.add_argument("-o", "--output", metavar="OUT", help="output folder")
+    parser.add_argument(
+        "--preset", default="sketch", help="parameter preset: sketch, robot, default, icra, ursim-released"
+    )
+    parser.add_argument("--param", action="append", metavar="NAME=VALUE", help="override one parameter (repeatable)")
+    parser.add_argument(
+        "--evaluate",
+        nargs=2,
+        metavar=("GT_DIR", "MAPS_DIR"),
+        help="score the segmentation of MAPS_DIR against separator-line ground truth in GT_DIR",
+    )
+    add_map_options(parser)
+
+
+def output_names(paths: list[str]) -> list[str]:
+    """The output name of each map: its file name without extension, numbered when taken.
+
+    Examples
+    --------
+    >>> output_names(["a/map.png", "b/map.png", "c.png", "d/map.yaml"])
+    ['map', 'map-2', 'c', 'map-3']
+    """
+    names: list[str] = []
+    taken: set[str] = set()
+    for path in paths:
+        stem = Path(path).stem
+        name, number = stem, 1
+        while name in taken:
+            number += 1
+            name = f"{stem}-{number}"
+        taken.add(name)
+        names.append(name)
+    return names
+
+
+def region_records(segmentation) -> list[dict[str, Any]]:
+    graph = segmentation.graph
+    return [
+        {
+            "id": int(region),
+            "size": int(data["size"]),
+            "centroid": [round(v, 2) for v in data["centroid"]],
+            "interior": [int(v) for v in data["interior"]],
+            "bbox": [int(v) for v in data["bbox"]],
+            "pca_shape": round(float(data["pca_shape"]), 6),
+            "neighbours": sorted(int(n) for n in graph.neighbors(region)),
+        }
+        for region, data in sorted(graph.nodes(data=True))
+    ]
+
+
+def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, preset: str | None) -> None:
+    from ursim_core.io.atomic import atomic_write_text
+    from ursim_core.render.figures import overlay_segmentation, save_png
+    from ursim_core.segmentation import save_label_image
+
+    save_label_image(segmentation, out / f"{name}.labels.png")
+    save_png(
+        out / f"{name}.overlay.png",
+        overlay_segmentation(segmentation.labels, segmentation.graph, image=the_map.image, free=the_map.free),
+    )
+    document = {
+        "map": str(the_map.path) if the_map.path else None,
+        "sha256": the_map.sha256,
+        "size": list(the_map.shape),
+        "segmentation": {"method": segmentation.method, "preset": preset, "params": segmentation.params},
+        "regions": region_records(segmentation),
+    }
+    atomic_write_text(out / f"{name}.regions.json", json.dumps(document, indent=2) + "\n")
+
+
+def segment_checked(the_map, *, preset: str, params: dict[str, Any]):
+    """Segment a map; a segmentation with no region is an error that names the map."""
+    from ursim_core.segmentation import segment
+
+    announce_kernel_compilation()
+    segmentation = segment(the_map, preset=preset, params=params)
+    if segmentation.n_regions == 0:
+        free = int(the_map.free.sum())
+        why = (
+            "every pixel is free: there are no walls to find rooms between"
+            if free == the_map.free.size
+            else f"{free} free pixel(s), but no room of the preset's minimum size"
+        )
+        raise SegmentationError(f"0 regions: {why}", path=the_map.path)
+    return segmentation
+
+
+def run(args: argparse.Namespace) -> int:
+    from ursim_core.segmentation import resolve_params
+
+    params = segmentation_params(args)
+    resolve_params("maoris", args.preset, params)  # fail on a bad option before any work
+    if args.evaluate:
+        return _evaluate(args, params)
+    if not args.maps:
+        raise UsageError("give at least one MAP (or --evaluate GT_DIR MAPS_DIR)")
+    if args.output is None:
+        raise UsageError("give an output folder with -o OUT")
+    out = check_output_folder(args.output)
+    names = output_names(args.maps)
+    for path, name in zip(args.maps, names):
+        if name != Path(path).stem:
+            print(f"note: {path} is written as {name}.* (another map has the same name)", file=sys.stderr)
+    progress = progress_bar(len(args.maps), "segment")
+    failures = 0
+    for index, (path, name) in enumerate(zip(args.maps, names), start=1):
+        try:
+            the_map = load(path, args)
+            segmentation = segment_checked(the_map, preset=args.preset, params=params)
+            with staged_folder(out) as staging:
+                write_segmentation_outputs(the_map, segmentation, staging, name=name, preset=args.preset)
+            print(f"{path}: {segmentation.n_regions} regions, {segmentation.graph.number_of_edges()} edges")
+        except UrsimError as error:
+            failures += 1
+            print(f"error: {error}", file=sys.stderr)
+        progress(index, text=Path(path).name)
+    return 1 if failures else 0
+
+
+def _evaluate(args: argparse.Namespace, params: dict[str, Any]) -> int:
+    from ursim_core.segmentation.scoring import gt_labels_from_separator_image, score_segmentation
+
+    gt_dir, maps_dir = (Path(p) for p in args.evaluate)
+    for folder in (gt_dir, maps_dir):
+        if not folder.is_dir():
+            raise ParameterError("not a folder", path=folder)
+    pairs = [(m, gt_dir / m.name) for m in sorted(maps_dir.iterdir()) if (gt_dir / m.name).is_file()]
+    if not pairs:
+        raise ParameterError(f"no map in {maps_dir} has a ground truth of the same name in {gt_dir}")
+    progress = progress_bar(len(pairs), "evaluate")
+    rows = []
+    for index, (map_path, gt_path) in enumerate(pairs, start=1):
+        the_map = load(map_path, args)
+        segmentation = segment_checked(the_map, preset=args.preset, params=params)
+        score = score_segmentation(segmentation.labels, gt_labels_from_separator_image(gt_path))
+        rows.append((map_path.stem, segmentation.n_regions, score.precision, score.recall, score.f1))
+        progress(index, text=map_path.name)
+    print(f"{'map':<24} {'regions':>7} {'precision':>9} {'recall':>7} {'F1':>6}")
+    for name, n, p, r, f in rows:
+        print(f"{name:<24} {n:>7} {p:>9.3f} {r:>7.3f} {f:>6.3f}")
+    count = len(rows)
+    means = [sum(row[i] for row in rows) / count for i in (2, 3, 4)]
+    print(f"{'mean':<24} {'':>7} {means[0]:>9.3f} {means[1]:>7.3f} {means[2]:>6.3f}")
+    return 0

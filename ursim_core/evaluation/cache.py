@@ -1,0 +1,185 @@
+"""Segmenting the maps of an evaluation once: jobs keyed by file content, memory and disk caches.
+
+A job is one map with its preset and loading options; equal jobs share a result. Cached
+segmentations are kept in a caller-owned dict and, optionally, as ``.npz`` label images in a
+folder whose file names hash the file's SHA-256, the resolved parameters and the segmenter's
+source, so an edited map or a changed segmenter is segmented again.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import io
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ursim_core.evaluation.pool import Progress, completed, pixel_count
+
+__all__ = ["SegmentationJob", "segment_job", "segment_all", "read_cached", "store_segmentation"]
+
+
+@dataclass(frozen=True)
+class SegmentationJob:
+    """One map to segment. Equal jobs (same file content, preset, loading and orientation) share
+    a result, so a model stored under two names (Halmstad: GT/Malcolm/model_simple.png =
+    E5_08.png) and a map used by several experiments are segmented once.
+
+    ``orientation`` (an :class:`~ursim_core.evaluation.augment.Orientation`, None for the map as
+    it is) turns and mirrors the loaded map before it is segmented."""
+
+    path: Path = field(compare=False)
+    digest: str
+    preset: str
+    load_key: str
+    augment: str = ""
+    orientation: Any = field(default=None, compare=False)
+
+    @classmethod
+    def of(
+        cls, path: Path, preset: str, load: dict, digests: dict[Path, str], orientation: Any = None
+    ) -> SegmentationJob:
+        path = Path(path)
+        if path not in digests:
+            try:
+                digests[path] = hashlib.sha256(path.read_bytes()).hexdigest()
+            except OSError:
+                # load_map reports the real problem, naming the file, when the map is loaded.
+                digests[path] = f"unreadable:{path.resolve()}"
+        if orientation is not None and orientation.is_identity:
+            orientation = None
+        return cls(
+            path=path,
+            digest=digests[path],
+            preset=preset,
+            load_key=json.dumps(load, sort_keys=True),
+            augment="" if orientation is None else orientation.name,
+            orientation=orientation,
+        )
+
+    @property
+    def key(self) -> str:
+        return f"{self.digest}|{self.preset}|{self.load_key}" + (f"|{self.augment}" if self.augment else "")
+
+    @property
+    def load(self) -> dict:
+        return json.loads(self.load_key)
+
+
+def segment_job(job: SegmentationJob):
+    """Load and segment one map (runs in a worker process)."""
+    from ursim_core.io.maps import load_map
+    from ursim_core.segmentation import segment
+
+    the_map = load_map(job.path, **job.load)
+    if job.orientation is not None:
+        from ursim_core.evaluation.augment import transform_map
+
+        the_map = transform_map(the_map, job.orientation)
+    return segment(the_map, preset=job.preset)
+
+
+@functools.lru_cache(maxsize=1)
+def _segmenter_code_digest() -> str:
+    """Digest of every source file of the segmentation package: a cached result is stale when any changes."""
+    import ursim_core.segmentation as package
+
+    digest = hashlib.sha256()
+    root = Path(package.__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()
+
+
+def _disk_cache_path(cache_dir: Path, job: SegmentationJob) -> Path:
+    from ursim_core.segmentation import resolve_params
+
+    # The resolved parameters (not only the preset name) and the segmenter's source go in the
+    # key, so a changed preset definition or a changed MAORIS implementation invalidates the cache.
+    identity = json.dumps(
+        {
+            "sha256": job.digest,
+            "params": resolve_params("maoris", job.preset),
+            "load": job.load,
+            "version": 1,
+            "code": _segmenter_code_digest(),
+            # Only augmented jobs carry the key, so the cache files of upright maps keep their names.
+            **({"augment": job.augment} if job.augment else {}),
+        },
+        sort_keys=True,
+    )
+    return cache_dir / f"{job.path.stem}-{hashlib.sha256(identity.encode()).hexdigest()[:24]}.npz"
+
+
+def _read_disk_cache(path: Path, job: SegmentationJob):
+    from ursim_core.segmentation import Segmentation, resolve_params
+    from ursim_core.segmentation.graph import region_graph
+
+    try:
+        with np.load(path) as stored:
+            labels = stored["labels"].astype(np.int32)
+    except (OSError, KeyError, ValueError):
+        # A missing, damaged or foreign cache file is only a cache miss.
+        return None
+    return Segmentation(
+        labels=labels, graph=region_graph(labels), method="maoris", params=resolve_params("maoris", job.preset)
+    )
+
+
+def _write_disk_cache(path: Path, segmentation) -> None:
+    from ursim_core.io.atomic import atomic_write_bytes
+
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, labels=segmentation.labels)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(path, buffer.getvalue())
+    except OSError:
+        # A read-only or full cache folder must not fail the evaluation.
+        pass
+
+
+def read_cached(job: SegmentationJob, memory_cache, cache_dir):
+    """The job's segmentation from the memory cache, else the disk cache (kept in memory), or None."""
+    found = None
+    if memory_cache is not None:
+        found = memory_cache.get(job.key)
+    if found is None and cache_dir is not None:
+        found = _read_disk_cache(_disk_cache_path(Path(cache_dir), job), job)
+        if found is not None and memory_cache is not None:
+            memory_cache[job.key] = found
+    return found
+
+
+def store_segmentation(job: SegmentationJob, segmentation, memory_cache, cache_dir) -> None:
+    """Keep a computed segmentation in the memory cache and the disk cache (when given)."""
+    if memory_cache is not None:
+        memory_cache[job.key] = segmentation
+    if cache_dir is not None:
+        _write_disk_cache(_disk_cache_path(Path(cache_dir), job), segmentation)
+
+
+def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir):
+    """Segmentations by job key, from the caches or computed biggest map first."""
+    segmentations: dict[str, Any] = {}
+    to_run = []
+    for job in jobs:
+        found = read_cached(job, memory_cache, cache_dir)
+        if found is None:
+            to_run.append(job)
+        else:
+            segmentations[job.key] = found
+            reporter.step(f"segment {job.path.name} (cached)")
+    cached = len(jobs) - len(to_run)
+    # Biggest maps first so the workers finish together.
+    to_run.sort(key=lambda job: -pixel_count(job.path))
+    for job, segmentation in completed(segment_job, to_run, workers=workers):
+        segmentations[job.key] = segmentation
+        store_segmentation(job, segmentation, memory_cache, cache_dir)
+        turned = f" {job.augment}" if job.augment else ""
+        reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
+    return segmentations, cached

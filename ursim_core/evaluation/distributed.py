@@ -1,0 +1,102 @@
+"""Running an evaluation's segmentations and match tasks on a Dask cluster (``dask.distributed``).
+
+Used by :func:`ursim_core.evaluation.runner.run_evaluation` when given ``scheduler=ADDRESS``.
+Each distinct map is segmented once, as a Dask task; the match tasks take those results as
+arguments (Dask moves them between workers), so no segmentation is computed twice. The
+segmentations also come back to the caller, which maps the ground truth onto them. Results are
+those of the local run: the same functions run on the same inputs, only elsewhere.
+
+Needs the optional extra: ``pip install 'ursim-studio[distributed]'``. Start a cluster with
+``dask scheduler`` on one machine and ``dask worker tcp://HOST:8786`` on each worker machine
+(each with this package installed), then ``ursim evaluate DATASET --scheduler tcp://HOST:8786``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ursim_core.errors import ParameterError
+from ursim_core.evaluation.cache import read_cached, segment_job, store_segmentation
+from ursim_core.evaluation.pool import Progress, pixel_count
+from ursim_core.evaluation.results import RunRow
+from ursim_core.evaluation.tasks import MatchTask, run_task, sorted_rows
+
+__all__ = ["connect", "segment_all_dask", "run_tasks_dask"]
+
+
+def connect(scheduler: Any):
+    """A ``distributed.Client`` for ``scheduler``: an address (``tcp://host:8786``) or a Client."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError(
+            "needs Dask: pip install 'ursim-studio[distributed]' (dask[distributed])", field="scheduler"
+        ) from None
+    if isinstance(scheduler, Client):
+        return scheduler
+    try:
+        return Client(str(scheduler), timeout="10s")
+    except (OSError, TimeoutError) as error:
+        raise ParameterError(f"cannot reach the Dask scheduler {scheduler}: {error}", field="scheduler") from None
+
+
+def _run_task_with(task: MatchTask, sketch, metric, place) -> list[RunRow]:
+    return run_task(task, {task.sketch_key: sketch, task.metric_key: metric, task.place_key: place})
+
+
+def segment_all_dask(client, jobs, reporter: Progress, memory_cache, cache_dir):
+    """Segmentations by job key and their futures on the cluster (cached ones are scattered)."""
+    from distributed import as_completed
+
+    segmentations: dict[str, Any] = {}
+    futures: dict[str, Any] = {}
+    to_run = []
+    for job in jobs:
+        found = read_cached(job, memory_cache, cache_dir)
+        if found is None:
+            to_run.append(job)
+        else:
+            segmentations[job.key] = found
+            futures[job.key] = client.scatter(found)
+            reporter.step(f"segment {job.path.name} (cached)")
+    cached = len(jobs) - len(to_run)
+    # Biggest maps first, as the local pool does, so the workers finish together.
+    to_run.sort(key=lambda job: -pixel_count(job.path))
+    pending = {client.submit(segment_job, job, key=f"segment-{job.key}", pure=False): job for job in to_run}
+    for future in as_completed(pending):
+        job = pending[future]
+        segmentation = future.result()
+        segmentations[job.key] = segmentation
+        futures[job.key] = future
+        store_segmentation(job, segmentation, memory_cache, cache_dir)
+        turned = f" {job.augment}" if job.augment else ""
+        reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
+    return segmentations, futures, cached
+
+
+def run_tasks_dask(client, tasks: list[MatchTask], futures: dict[str, Any], reporter: Progress) -> list[RunRow]:
+    """Every match task as a Dask task on the segmentation futures; rows in the local run's order."""
+    from distributed import as_completed
+
+    pending = {
+        client.submit(
+            _run_task_with,
+            task,
+            futures[task.sketch_key],
+            futures[task.metric_key],
+            futures[task.place_key],
+            pure=False,
+        ): task
+        for task in tasks
+    }
+    rows: list[RunRow] = []
+    try:
+        for future in as_completed(pending):
+            task = pending[future]
+            rows.extend(future.result())
+            turned = f" {task.augment}" if task.augment else ""
+            reporter.step(f"match {task.name}{turned} {task.matcher} {task.variant}")
+    except BaseException:
+        client.cancel(list(pending))
+        raise
+    return sorted_rows(tasks, rows)

@@ -1,0 +1,55 @@
+"""Running work on a process pool: results as each item finishes, progress steps, cancellation."""
+
+from __future__ import annotations
+
+import concurrent.futures
+from collections.abc import Callable
+from pathlib import Path
+
+__all__ = ["ProgressCallback", "Progress", "completed", "pixel_count"]
+
+ProgressCallback = Callable[[int, int, str], None]
+
+
+class Progress:
+    def __init__(self, callback: ProgressCallback | None, total: int):
+        self.callback = callback
+        self.total = total
+        self.done = 0
+
+    def step(self, text: str) -> None:
+        self.done += 1
+        if self.callback is not None:
+            self.callback(self.done, self.total, text)
+
+
+def completed(function, items, *, workers: int, initializer=None, initargs=()):
+    """Yield ``(item, function(item))`` as each finishes, on ``workers`` processes.
+
+    With one worker (or one item) everything runs here, in order, with no process start-up
+    cost; ``initializer`` only concerns worker processes. On an error or an interruption the
+    pending items are cancelled before it propagates, so a failure does not wait for the rest.
+    """
+    if workers <= 1 or len(items) < 2:
+        for item in items:
+            yield item, function(item)
+        return
+    pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, initializer=initializer, initargs=initargs)
+    try:
+        futures = {pool.submit(function, item): item for item in items}
+        for future in concurrent.futures.as_completed(futures):
+            yield futures[future], future.result()
+    except BaseException:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
+def pixel_count(path: Path) -> int:
+    try:
+        from PIL import Image
+
+        with Image.open(path) as image:
+            return image.width * image.height
+    except Exception:
+        return 0
