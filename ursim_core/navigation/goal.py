@@ -24,25 +24,13 @@ from typing import Any
 import numpy as np
 
 from ursim_core.correspondences.codec import regions_at_points
+from ursim_core.correspondences.exporters import LABEL_KEY, clique_label
 from ursim_core.errors import ParameterError
 
 __all__ = ["Goal", "NearestMatch", "MatchTable", "match_table", "locate", "LABEL_KEY", "TARGETS", "clique_label"]
 
-#: Key of a clique's semantic label (room name / type) in its unknown keys (``Clique.extra``).
-LABEL_KEY = "label"
 #: Where inside the matched metric region the goal goes.
 TARGETS = ("interior", "mirror")
-
-
-def clique_label(clique: Any) -> str | None:
-    """The semantic label of a clique (``clique.extra["label"]``), or None.
-
-    >>> from ursim_core.correspondences.codec import Clique
-    >>> clique_label(Clique(id=1, extra={"label": "kitchen"}))
-    'kitchen'
-    """
-    value = getattr(clique, "extra", {}).get(LABEL_KEY)
-    return value if isinstance(value, str) and value.strip() else None
 
 
 @dataclass(frozen=True)
