@@ -160,19 +160,6 @@ def goal_document(goal, *, frame_id: str = "map") -> dict[str, Any]:
     return document
 
 
-def failure_line(goal) -> str:
-    """One line saying why a point has no goal, with the nearest matched region when known."""
-    row, col = goal.sketch_point
-    text = f"sketch point ({row}, {col}): {goal.reason}"
-    if goal.nearest is not None:
-        near = goal.nearest
-        text += (
-            f"; the nearest matched region is {near.sketch_region}, at ({near.point[0]}, {near.point[1]}), "
-            f"{near.distance:.1f} px away"
-        )
-    return text
-
-
 def write_json(document: Any, output: str | None) -> None:
     """Print ``document`` and, with ``-o``, write it atomically to the file."""
     text = json.dumps(document, indent=2) + "\n"
@@ -212,5 +199,5 @@ def cmd_goal(args: argparse.Namespace) -> int:
         )
     failures = [goal for goal in goals if not goal.ok]
     for goal in failures:
-        print(f"error: {failure_line(goal)}", file=sys.stderr)
+        print(f"error: {goal.failure_message()}", file=sys.stderr)
     return 1 if failures else 0

@@ -168,6 +168,18 @@ class Goal:
         """True when the tap gives a goal."""
         return self.pixel is not None
 
+    def failure_message(self) -> str:
+        """One line saying why there is no goal, with the nearest matched region when known."""
+        row, col = self.sketch_point
+        text = f"sketch point ({row}, {col}): {self.reason}"
+        if self.nearest is not None:
+            near = self.nearest
+            text += (
+                f"; the nearest matched region is {near.sketch_region}, at ({near.point[0]}, {near.point[1]}), "
+                f"{near.distance:.1f} px away"
+            )
+        return text
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe details (what ``ursim goal`` prints under ``"ursim"``)."""
         return {
