@@ -17,10 +17,11 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["goal", "route", "nav2_files"],
+    submodules=["goal", "route", "nav2_files", "session"],
     submod_attrs={
         "goal": ["Goal", "NearestMatch", "MatchTable", "match_table", "locate", "clique_label", "LABEL_KEY", "TARGETS"],
         "route": ["Route", "Waypoint", "plan_route", "sample_polyline"],
+        "session": ["NavigationSession", "NAVIGATION_FORMAT"],
         "nav2_files": [
             "pose_stamped",
             "waypoints_yaml",
