@@ -38,6 +38,7 @@ __all__ = [
     "correspondences_to_qgis_points",
     "export_correspondences",
     "export_format_of",
+    "export_file",
 ]
 
 #: Formats of :func:`export_correspondences`, by name.
@@ -354,3 +355,61 @@ def export_correspondences(
         text = correspondences_to_qgis_points(corr, metric_map=metric_map)
     atomic_write_text(Path(path), text if text.endswith("\n") else text + "\n")
     return kind
+
+
+def export_file(
+    source: str | Path,
+    target: str | Path,
+    *,
+    format: str | None = None,
+    side: str = "metric",
+) -> str:
+    """Export a correspondence file (.json or .dat) to ``target``; what ``ursim convert`` calls.
+
+    The maps and label images the file references are used when they exist: the label image
+    of ``side`` gives the region polygons (GeoJSON, labelme), a map_server YAML map gives world
+    coordinates (GeoJSON of that side; the metric side of QGIS points). Returns the format.
+
+    Raises
+    ------
+    ParameterError
+        Unknown format or side. FormatError / MapError / SegmentationError for unreadable
+        inputs, naming the file.
+    """
+    from ursim_core.correspondences.codec import load_correspondences, load_dat
+
+    _check_side(side)
+    kind = export_format_of(target, format)
+    source = Path(source)
+    corr = load_dat(source) if source.suffix.lower() == ".dat" else load_correspondences(source)
+    ref = getattr(corr, side)
+    labels = _read_labels(ref.labels_path, ref.size) if ref.labels_path is not None else None
+    the_map, metric_map = _georeferenced_map(ref.path), _georeferenced_map(corr.metric.path)
+    return export_correspondences(
+        corr, target, format=kind, side=side, labels=labels, the_map=the_map, metric_map=metric_map
+    )
+
+
+def _georeferenced_map(path: Path | None):
+    if path is None or path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
+        return None
+    from ursim_core.io.maps import load_map
+
+    return load_map(path)
+
+
+def _read_labels(path: Path, size) -> np.ndarray | None:
+    import cv2
+
+    from ursim_core.errors import SegmentationError
+
+    if not Path(path).is_file():
+        return None
+    labels = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if labels is None or labels.ndim != 2:
+        raise SegmentationError("not a single-channel label image", path=path)
+    if size is not None and tuple(labels.shape) != tuple(size):
+        raise SegmentationError(
+            f"label image is {labels.shape[0]}x{labels.shape[1]} but the map is {size[0]}x{size[1]}", path=path
+        )
+    return labels.astype(np.int32)

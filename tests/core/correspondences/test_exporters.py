@@ -129,3 +129,30 @@ def test_export_by_file_name(tmp_path):
         export_format_of(tmp_path / "c.txt", "kml")
     with pytest.raises(ParameterError, match="side"):
         correspondences_to_geojson(corr, side="both")
+
+
+def test_export_file_uses_the_referenced_labels_and_yaml_map(tmp_path):
+    import cv2
+
+    from ursim_core.correspondences.exporters import export_file
+    from ursim_core.io.maps import load_map
+    from ursim_core.io.occupancy_grid import save_map_yaml
+
+    labels = labels_with_hole()
+    cv2.imwrite(str(tmp_path / "metric.labels.png"), labels.astype(np.uint16))
+    save_map_yaml(Map(free=labels > 0), tmp_path / "metric.yaml", resolution=0.1, origin=(1.0, 2.0, 0.0))
+    corr = sample_corr()
+    corr = Correspondences(
+        sketch=corr.sketch,
+        metric=MapRef(path=tmp_path / "metric.yaml", size=(20, 30), labels_path=tmp_path / "metric.labels.png"),
+        cliques=corr.cliques,
+    )
+    save_correspondences(corr, tmp_path / "c.json")
+    assert export_file(tmp_path / "c.json", tmp_path / "out.geojson") == "geojson"
+    document = json.loads((tmp_path / "out.geojson").read_text())
+    assert document["ursim"]["units"] == "metre"
+    assert sum(f["properties"]["kind"] == "region" for f in document["features"]) == 2
+    assert export_file(tmp_path / "c.json", tmp_path / "out.points") == "qgis-points"
+    the_map = load_map(tmp_path / "metric.yaml")
+    x, y = pixel_to_world(the_map, 4, 4)
+    assert (tmp_path / "out.points").read_text().splitlines()[2].startswith(f"{x:g},{y:g},")
