@@ -32,6 +32,7 @@ __all__ = [
     "EXPORT_FORMATS",
     "LABEL_KEY",
     "clique_label",
+    "with_clique_label",
     "region_polygons",
     "correspondences_to_geojson",
     "correspondences_to_labelme",
@@ -60,6 +61,25 @@ def clique_label(clique) -> str | None:
     """
     value = getattr(clique, "extra", {}).get(LABEL_KEY)
     return value if isinstance(value, str) and value.strip() else None
+
+
+def with_clique_label(clique, label: str | None):
+    """A copy of ``clique`` with its semantic label set (None or blank removes it).
+
+    What the GUI's label editor calls; the label is kept in the JSON under ``"label"``.
+
+    >>> from ursim_core.correspondences.codec import Clique
+    >>> clique_label(with_clique_label(Clique(id=1), "  corridor "))
+    'corridor'
+    >>> with_clique_label(Clique(id=1, extra={"label": "x"}), "").extra
+    {}
+    """
+    import dataclasses
+
+    extra = {key: value for key, value in clique.extra.items() if key != LABEL_KEY}
+    if label is not None and label.strip():
+        extra[LABEL_KEY] = label.strip()
+    return dataclasses.replace(clique, extra=extra)
 
 
 def region_polygons(labels: np.ndarray, region: int) -> list[list[list[tuple[float, float]]]]:
