@@ -202,3 +202,30 @@ def test_bad_save_options_raise_parameter_error(tmp_path, options, problem):
     with pytest.raises(ParameterError, match=problem):
         save_map_yaml(grid, tmp_path / "x.yaml", **options)
     assert not list(Path(tmp_path).iterdir())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("mode", ["trinary", "raw"])
+def test_generated_floor_plans_survive_grid_and_yaml_round_trips(tmp_path, seed, mode):
+    from scipy import ndimage
+
+    from ursim_core.io.maps import Map
+    from ursim_core.synth.generator import generate_floor_plan, sketchify
+
+    plan = generate_floor_plan(seed=seed)
+    # A robot's view of the plan: free inside, walls occupied, what lies beyond the walls unknown.
+    building = ndimage.binary_fill_holes(ndimage.binary_closing(plan.free, iterations=6))
+    occupancy = np.where(plan.free, 0, np.where(building, 100, -1)).astype(np.int8)
+    robot_map = Map(free=plan.free, occupancy=occupancy, resolution=0.05, origin=(-12.5, 3.0, 0.1 * seed))
+    grid = occupancy_grid_from_map(robot_map)
+    assert (
+        occupancy_grid_from_map(map_from_occupancy_grid(grid.data, grid.width, grid.height, 0.05, grid.origin)) == grid
+    )
+    save_map_yaml(grid, tmp_path / "plan.yaml", mode=mode)
+    loaded = load_map(tmp_path / "plan.yaml")
+    assert occupancy_grid_from_map(loaded) == grid
+    assert np.array_equal(loaded.free, plan.free)
+    # A sketch drawn from the plan (a grid without unknown space) too.
+    sketch = sketchify(plan, seed=seed)
+    save_map_yaml(map_from_array(sketch.free), tmp_path / "sketch.yaml", mode=mode, resolution=0.02)
+    assert np.array_equal(load_map(tmp_path / "sketch.yaml").free, sketch.free)
