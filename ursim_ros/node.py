@@ -112,12 +112,13 @@ class UrsimSketchNode(Node):
             return
         pose = self.pose_message(goal.pose)
         self.get_logger().info(f"goal in region {goal.metric_region}: x {goal.pose[0]:.2f} y {goal.pose[1]:.2f}")
-        if self.use_action:
+        if self.use_action and self.to_pose.server_is_ready():
             request = NavigateToPose.Goal()
             request.pose = pose
-            self.to_pose.wait_for_server(timeout_sec=2.0)
             self.to_pose.send_goal_async(request)
         else:
+            if self.use_action:
+                self.get_logger().warning("no navigate_to_pose action server: publishing goal_pose instead")
             self.goal_publisher.publish(pose)
 
     def on_route(self, message) -> None:
@@ -132,12 +133,15 @@ class UrsimSketchNode(Node):
         if not poses:
             self.get_logger().warning("the route crosses no matched sketch region")
             return
-        if self.use_action:
+        if self.use_action and self.through_poses.server_is_ready():
             request = NavigateThroughPoses.Goal()
-            request.poses = poses
-            self.through_poses.wait_for_server(timeout_sec=2.0)
+            try:
+                request.poses = poses
+            except (AssertionError, TypeError):  # newer nav2 wraps the poses in nav_msgs/Goals
+                request.poses.goals = poses
             self.through_poses.send_goal_async(request)
         else:
+            self.get_logger().warning("no navigate_through_poses action server: publishing the last pose on goal_pose")
             self.goal_publisher.publish(poses[-1])
         self.get_logger().info(f"route through regions {list(route.metric_regions)}")
 
