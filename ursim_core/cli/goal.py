@@ -1,0 +1,203 @@
+"""``ursim goal``: a sketch point becomes a goal pose in the robot's map (PoseStamped-like JSON).
+
+Registered by ``ursim_core.cli.main.build_parser`` with ``goal.add_parser(commands)``. The
+loading, segmenting and matching shared with ``ursim route`` (:func:`prepare_navigation`) lives
+here so that both commands read maps and correspondences the same way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ursim_core.errors import ParameterError
+
+__all__ = ["add_parser", "cmd_goal", "prepare_navigation", "Navigation", "add_navigation_options", "parse_point"]
+
+EXAMPLES = """examples:
+  ursim goal sketch.png map.yaml --at 120,340
+  ursim goal sketch.png map.yaml --at 120,340 --correspondences corr.json --target mirror
+  ursim goal sketch.png map.yaml --at 120,340 --at 60,80 -o goals.json
+
+Prints a PoseStamped-like JSON object (frame_id "map"; a list for several --at). The pose is in
+metres when METRIC is a map_server YAML; for a plain image it is null and "ursim.pixel" gives
+the goal in (row, col) pixels. Exit code 1 when a point has no goal (the reason and the nearest
+matched region are printed on stderr)."""
+
+
+@dataclass(frozen=True)
+class Navigation:
+    """Everything a goal or route needs: both maps, their segmentations and the match table."""
+
+    sketch_map: Any
+    metric_map: Any
+    sketch_seg: Any
+    metric_seg: Any
+    table: Any
+    source: str
+
+
+def parse_point(text: str) -> tuple[float, float]:
+    """``"ROW,COL"`` -> (row, col); argparse type of ``--at``."""
+    parts = text.replace(" ", "").split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return float(parts[0]), float(parts[1])
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected ROW,COL (two numbers), got '{text}'") from None
+
+
+def add_navigation_options(parser: argparse.ArgumentParser) -> None:
+    """Map, segmentation and correspondence options shared by ``ursim goal`` and ``ursim route``."""
+    from ursim_core.matching.pipeline import MATCH_PRESETS
+
+    parser.add_argument("sketch", metavar="SKETCH", help="the sketch image")
+    parser.add_argument("metric", metavar="METRIC", help="the robot's map: map_server YAML (or an image: pixels only)")
+    parser.add_argument(
+        "--correspondences",
+        metavar="FILE",
+        help="use these cliques (JSON) instead of matching; their label images are used when present",
+    )
+    parser.add_argument(
+        "--sketch-preset",
+        default=MATCH_PRESETS["sketch"],
+        help=f"sketch segmentation (default {MATCH_PRESETS['sketch']})",
+    )
+    parser.add_argument(
+        "--metric-preset",
+        default=MATCH_PRESETS["metric"],
+        help=f"metric segmentation (default {MATCH_PRESETS['metric']})",
+    )
+    parser.add_argument(
+        "--tolerance", type=float, default=10, help="px from a region a point still counts (default 10)"
+    )
+    parser.add_argument("-o", "--output", metavar="FILE", help="also write the JSON to FILE")
+    group = parser.add_argument_group("map loading")
+    group.add_argument("--threshold", type=int, default=250, help="images: grey above which a pixel is free (250)")
+    group.add_argument("--nonzero-free", action="store_true", help="images: every non-zero pixel is free")
+    group.add_argument("--max-pixels", type=int, default=64_000_000, help="refuse larger maps (default 64 Mpx)")
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add ``goal`` to the ``ursim`` sub-commands (``subparsers`` from ``add_subparsers``)."""
+    description = "Turn a point on the sketch into a goal pose in the robot's map (PoseStamped-like JSON)."
+    parser = subparsers.add_parser(
+        "goal",
+        help=description,
+        description=description,
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_navigation_options(parser)
+    parser.add_argument(
+        "--at",
+        action="append",
+        required=True,
+        type=parse_point,
+        metavar="ROW,COL",
+        help="the sketch point in pixels (repeatable)",
+    )
+    parser.add_argument(
+        "--target",
+        choices=["interior", "mirror"],
+        default="interior",
+        help="interior point of the matched region (default) or the point mirroring the tap's place in its region",
+    )
+    parser.add_argument("--yaw", type=float, default=0.0, help="heading of the goal in the map frame, radians")
+    parser.set_defaults(handler=cmd_goal)
+    return parser
+
+
+def prepare_navigation(args: argparse.Namespace) -> Navigation:
+    """Load both maps, segment them (or load the correspondence file's label images) and match."""
+    from ursim_core.io.maps import load_map
+    from ursim_core.navigation.goal import match_table
+    from ursim_core.segmentation import segment
+
+    def load(path):
+        return load_map(path, threshold=args.threshold, nonzero_free=args.nonzero_free, max_pixels=args.max_pixels)
+
+    sketch_map, metric_map = load(args.sketch), load(args.metric)
+    if args.correspondences:
+        from ursim_core.correspondences.codec import assign_regions, load_correspondences
+
+        corr = load_correspondences(Path(args.correspondences))
+        sketch_seg = _labels_or_segment(corr.sketch, sketch_map, args.sketch_preset)
+        metric_seg = _labels_or_segment(corr.metric, metric_map, args.metric_preset)
+        # Points are authoritative: region ids follow the segmentations used here.
+        corr = assign_regions(corr, sketch_seg.labels, metric_seg.labels, tolerance=args.tolerance)
+        return Navigation(sketch_map, metric_map, sketch_seg, metric_seg, match_table(corr), "correspondences")
+    from ursim_core.matching.pipeline import match
+
+    sketch_seg = segment(sketch_map, preset=args.sketch_preset)
+    metric_seg = segment(metric_map, preset=args.metric_preset)
+    result = match(sketch_seg, metric_seg)
+    return Navigation(sketch_map, metric_map, sketch_seg, metric_seg, match_table(result), "match")
+
+
+def _labels_or_segment(ref, the_map, preset: str):
+    from ursim_core.segmentation import load_label_image, segment
+
+    if ref.labels_path is not None and Path(ref.labels_path).is_file():
+        return load_label_image(ref.labels_path, shape=the_map.shape)
+    return segment(the_map, preset=preset)
+
+
+def goal_document(goal, *, frame_id: str = "map") -> dict[str, Any]:
+    """The PoseStamped-like object ``ursim goal`` prints for one goal."""
+    from ursim_core.navigation.nav2_files import pose_stamped
+
+    if goal.pose is not None:
+        document = pose_stamped(goal.pose, frame_id=frame_id)
+    else:
+        document = {"header": {"frame_id": frame_id, "stamp": {"sec": 0, "nanosec": 0}}, "pose": None}
+    document["ursim"] = goal.to_dict()
+    return document
+
+
+def write_json(document: Any, output: str | None) -> None:
+    """Print ``document`` and, with ``-o``, write it atomically to the file."""
+    text = json.dumps(document, indent=2) + "\n"
+    sys.stdout.write(text)
+    if output:
+        from ursim_core.io.atomic import atomic_write_text
+
+        atomic_write_text(Path(output), text)
+
+
+def cmd_goal(args: argparse.Namespace) -> int:
+    from ursim_core.navigation.goal import locate
+
+    if args.tolerance < 0:
+        raise ParameterError(f"--tolerance must be >= 0, got {args.tolerance}")
+    nav = prepare_navigation(args)
+    goals = [
+        locate(
+            nav.table,
+            nav.sketch_seg,
+            nav.metric_seg,
+            nav.metric_map,
+            row,
+            col,
+            target=args.target,
+            tolerance=args.tolerance,
+            yaw=args.yaw,
+        )
+        for row, col in args.at
+    ]
+    documents = [goal_document(goal) for goal in goals]
+    write_json(documents[0] if len(documents) == 1 else documents, args.output)
+    if nav.metric_map.resolution is None:
+        print(
+            f"note: {args.metric} has no resolution (not a map_server YAML): goals are in pixels only (ursim.pixel)",
+            file=sys.stderr,
+        )
+    failures = [goal for goal in goals if not goal.ok]
+    for goal in failures:
+        print(f"error: {goal.failure_message()}", file=sys.stderr)
+    return 1 if failures else 0

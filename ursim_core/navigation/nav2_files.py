@@ -1,0 +1,108 @@
+"""Goals and routes as ROS / nav2 data: PoseStamped-like JSON and nav2's waypoint file.
+
+- :func:`pose_stamped` gives the fields of a ``geometry_msgs/PoseStamped`` as plain data (frame
+  "map"), what ``ursim goal`` prints and what the ROS node publishes.
+- :func:`waypoints_yaml` writes the YAML that nav2's RViz panel saves and loads ("Save WPs" /
+  "Load WPs" of ``nav2_rviz_plugins``): a ``waypoints`` map of ``waypoint0``, ``waypoint1``, ...
+  each with ``pose: [x, y, z]`` and ``orientation: [w, x, y, z]`` (the panel's order, w first).
+  The panel appends ``.yaml`` to the name it is given; give it the name without the suffix.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from ursim_core.errors import FormatError, ParameterError
+from ursim_core.io.atomic import atomic_write_text
+
+__all__ = ["pose_stamped", "waypoints_yaml", "save_waypoints_yaml", "load_waypoints_yaml", "quaternion_xyzw"]
+
+
+def quaternion_xyzw(yaw: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a rotation by ``yaw`` about z.
+
+    >>> quaternion_xyzw(0.0)
+    (0.0, 0.0, 0.0, 1.0)
+    """
+    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+
+
+def pose_stamped(pose: Sequence[float], *, frame_id: str = "map", stamp: dict | None = None) -> dict[str, Any]:
+    """A ``geometry_msgs/PoseStamped`` as plain data, from (x, y, yaw).
+
+    Examples
+    --------
+    >>> pose_stamped((1.0, 2.0, 0.0))["pose"]
+    {'position': {'x': 1.0, 'y': 2.0, 'z': 0.0}, 'orientation': {'x': 0.0, 'y': 0.0, 'z': 0.0, 'w': 1.0}}
+    """
+    x, y, yaw = (float(v) for v in pose)
+    qx, qy, qz, qw = quaternion_xyzw(yaw)
+    return {
+        "header": {"frame_id": frame_id, "stamp": stamp or {"sec": 0, "nanosec": 0}},
+        "pose": {"position": {"x": x, "y": y, "z": 0.0}, "orientation": {"x": qx, "y": qy, "z": qz, "w": qw}},
+    }
+
+
+def waypoints_yaml(poses: Iterable[Sequence[float]]) -> str:
+    """The text of a nav2 RViz-panel waypoint file for (x, y, yaw) poses.
+
+    >>> print(waypoints_yaml([(1.0, 2.0, 0.0)]), end="")
+    waypoints:
+      waypoint0:
+        pose: [1.0, 2.0, 0.0]
+        orientation: [1.0, 0.0, 0.0, 0.0]
+    """
+    lines = ["waypoints:"]
+    count = 0
+    for index, pose in enumerate(poses):
+        x, y, yaw = (float(v) for v in pose)
+        qx, qy, qz, qw = quaternion_xyzw(yaw)
+        lines += [
+            f"  waypoint{index}:",
+            f"    pose: [{x!r}, {y!r}, 0.0]",
+            f"    orientation: [{qw!r}, {qx!r}, {qy!r}, {qz!r}]",
+        ]
+        count += 1
+    if count == 0:
+        raise ParameterError("no pose to write: a waypoint file needs at least one georeferenced goal")
+    return "\n".join(lines) + "\n"
+
+
+def save_waypoints_yaml(poses: Iterable[Sequence[float]], path: str | Path) -> None:
+    """Write :func:`waypoints_yaml` to ``path`` atomically."""
+    atomic_write_text(Path(path), waypoints_yaml(poses))
+
+
+def load_waypoints_yaml(path: str | Path) -> list[tuple[float, float, float]]:
+    """Read a nav2 RViz-panel waypoint file back as (x, y, yaw) poses, in file order.
+
+    Raises :class:`~ursim_core.errors.FormatError` naming the file and the field on bad input.
+    """
+    import yaml
+
+    from ursim_core.io.occupancy_grid import yaw_from_quaternion
+
+    path = Path(path)
+    try:
+        document = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as error:
+        raise FormatError(f"cannot read the waypoint file: {error}", path=path) from None
+    waypoints = document.get("waypoints") if isinstance(document, dict) else None
+    if not isinstance(waypoints, dict):
+        raise FormatError("not a nav2 waypoint file: no 'waypoints' map", path=path, field="waypoints")
+    poses = []
+    for index in range(len(waypoints)):
+        name = f"waypoint{index}"
+        item = waypoints.get(name)
+        try:
+            x, y, _z = (float(v) for v in item["pose"])
+            w, qx, qy, qz = (float(v) for v in item["orientation"])
+        except (TypeError, KeyError, ValueError):
+            raise FormatError(
+                "expected pose: [x, y, z] and orientation: [w, x, y, z]", path=path, field=f"waypoints.{name}"
+            ) from None
+        poses.append((x, y, yaw_from_quaternion(qx, qy, qz, w)))
+    return poses
