@@ -83,16 +83,11 @@ def add_navigation_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--max-pixels", type=int, default=64_000_000, help="refuse larger maps (default 64 Mpx)")
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Add ``goal`` to the ``ursim`` sub-commands (``subparsers`` from ``add_subparsers``)."""
-    description = "Turn a point on the sketch into a goal pose in the robot's map (PoseStamped-like JSON)."
-    parser = subparsers.add_parser(
-        "goal",
-        help=description,
-        description=description,
-        epilog=EXAMPLES,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "Turn a point on the sketch into a goal pose in the robot's map (PoseStamped-like JSON)."
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """The options of ``ursim goal`` (called by :func:`ursim_core.cli.main.build_parser`)."""
     add_navigation_options(parser)
     parser.add_argument(
         "--at",
@@ -109,6 +104,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="interior point of the matched region (default) or the point mirroring the tap's place in its region",
     )
     parser.add_argument("--yaw", type=float, default=0.0, help="heading of the goal in the map frame, radians")
+
+
+def run(args: argparse.Namespace) -> int:
+    return cmd_goal(args)
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add ``goal`` to a set of sub-commands (``subparsers`` from ``add_subparsers``), on its own."""
+    parser = subparsers.add_parser(
+        "goal", help=HELP, description=HELP, epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    configure(parser)
     parser.set_defaults(handler=cmd_goal)
     return parser
 

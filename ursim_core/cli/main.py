@@ -27,6 +27,8 @@ COMMANDS = {
     "match-batch": "ursim_core.cli.match_batch",
     "evaluate": "ursim_core.cli.evaluate",
     "convert": "ursim_core.cli.convert",
+    "goal": "ursim_core.cli.goal",
+    "route": "ursim_core.cli.route",
     "bench": "ursim_core.cli.bench",
 }
 

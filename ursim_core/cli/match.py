@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from pathlib import Path
 from typing import Any
@@ -48,6 +49,18 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
     from ursim_core.matching.pipeline import MATCH_PRESETS
 
     parser.add_argument("--m", default="auto", help="threshold m on the signature difference, or 'auto' (default)")
+    parser.add_argument(
+        "--orientation",
+        type=orientation_value,
+        metavar="any|upright|DEGREES",
+        help="how the sketch is turned: 'any' (default: unknown, the matcher finds it), 'upright', or the degrees "
+        "to turn it counter-clockwise (after --mirrored yes) to bring it to the metric map",
+    )
+    parser.add_argument(
+        "--mirrored",
+        choices=["yes", "no", "unknown"],
+        help="whether the sketch is a mirror image of the map (default: unknown with 'any', no otherwise)",
+    )
     parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     parser.add_argument("--matcher", choices=["planar", "hungarian", "vf2"], help="graph matcher")
     parser.add_argument("--released", action="store_true", help="start from the released C++ code's options")
@@ -67,6 +80,19 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
     add_map_options(parser)
 
 
+def orientation_value(text: str):
+    """``--orientation``: 'any', 'upright' or a finite number of degrees (else a usage error)."""
+    if text in ("any", "upright"):
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expects 'any', 'upright' or a number of degrees, got '{text}'")
+    return value
+
+
 def match_config(args: argparse.Namespace):
     from ursim_core.matching import MatchConfig
 
@@ -78,6 +104,10 @@ def match_config(args: argparse.Namespace):
             raise ParameterError(f"--m expects 'auto' or a number, got '{args.m}'") from None
     base = MatchConfig.released() if args.released else MatchConfig()
     overrides: dict[str, Any] = {"m": m}
+    if getattr(args, "orientation", None) is not None:
+        overrides["orientation"] = args.orientation
+    if getattr(args, "mirrored", None) is not None:
+        overrides["mirrored"] = {"yes": True, "no": False, "unknown": None}[args.mirrored]
     if args.variant:
         overrides["variant"] = args.variant
     if args.matcher:
@@ -101,6 +131,8 @@ def matcher_record(config, result) -> dict[str, Any]:
         "cost": safe(float(result.cost)) if result.cost is not None else None,
         "anchors": [[int(a), int(b)] for a, b in result.anchors],
         "reason": result.reason or "",
+        # How the sketch was turned to match (chosen when config.orientation is 'any').
+        "orientation": {"degrees": round(float(result.orientation[0]), 6), "mirrored": bool(result.orientation[1])},
     }
 
 
@@ -139,6 +171,8 @@ def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, me
 #: The options of ``ursim match`` that a pair's run needs (also what ``match-batch`` passes on).
 OPTION_NAMES = (
     "m",
+    "orientation",
+    "mirrored",
     "variant",
     "matcher",
     "released",
@@ -177,7 +211,9 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
     reference = None if reference_path is None else load_reference(reference_path)
     sketch_map, metric_map = load(sketch, args), load(metric, args)
     params = segmentation_params(args)
-    sketch_seg = segment_checked(sketch_map, preset=args.sketch_preset, params=params)
+    # The sketch is segmented in its canonical pose unless the matcher is told it is upright.
+    canonical = config.orientation != "upright"
+    sketch_seg = segment_checked(sketch_map, preset=args.sketch_preset, params=params, canonical=canonical)
     metric_seg = segment_checked(metric_map, preset=args.metric_preset, params=params)
     started = time.perf_counter()
     result = match(sketch_seg, metric_seg, config=config)
@@ -226,6 +262,7 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
         "m": result.m,
         "match_ms": elapsed * 1000,
         "reason": result.reason or "",
+        "orientation": result.orientation,
         "out": out,
     }
     if reference is not None:
@@ -253,8 +290,9 @@ def run(args: argparse.Namespace) -> int:
     m_text = f"{m:.3f}" if isinstance(m, (int, float)) else str(m)
     print(
         f"{record['n_matches']} matches ({record['n_sketch_regions']} sketch regions, "
-        f"{record['n_metric_regions']} metric regions), m = {m_text}, {record['match_ms']:.1f} ms"
-        + (f"; {record['reason']}" if record["reason"] else "")
+        f"{record['n_metric_regions']} metric regions), m = {m_text}, sketch turned "
+        f"{record['orientation'][0]:.1f} deg{' mirrored' if record['orientation'][1] else ''}, "
+        f"{record['match_ms']:.1f} ms" + (f"; {record['reason']}" if record["reason"] else "")
     )
     print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
     if args.reference is not None:

@@ -25,22 +25,29 @@ metric regions, one PoseStamped-like object per waypoint (frame "map") and the d
 writes the file nav2's RViz panel loads ("Load WPs") for FollowWaypoints / NavigateThroughPoses."""
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Add ``route`` to the ``ursim`` sub-commands (``subparsers`` from ``add_subparsers``)."""
-    description = "Turn a route drawn on the sketch into connected metric regions and nav2 waypoints."
-    parser = subparsers.add_parser(
-        "route",
-        help=description,
-        description=description,
-        epilog=EXAMPLES,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "Turn a route drawn on the sketch into connected metric regions and nav2 waypoints."
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """The options of ``ursim route`` (called by :func:`ursim_core.cli.main.build_parser`)."""
     add_navigation_options(parser)
     parser.add_argument("--points", required=True, metavar="FILE", help="the polyline (JSON or ROW,COL lines)")
     parser.add_argument("--waypoints", metavar="FILE", help="write a nav2 RViz-panel waypoint YAML (needs a YAML map)")
     parser.add_argument(
         "--no-fill", action="store_true", help="do not connect non-adjacent regions along the region graph"
     )
+
+
+def run(args: argparse.Namespace) -> int:
+    return cmd_route(args)
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add ``route`` to a set of sub-commands (``subparsers`` from ``add_subparsers``), on its own."""
+    parser = subparsers.add_parser(
+        "route", help=HELP, description=HELP, epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    configure(parser)
     parser.set_defaults(handler=cmd_route)
     return parser
 

@@ -103,12 +103,18 @@ def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, p
     atomic_write_text(out / f"{name}.regions.json", json.dumps(document, indent=2) + "\n")
 
 
-def segment_checked(the_map, *, preset: str, params: dict[str, Any]):
-    """Segment a map; a segmentation with no region is an error that names the map."""
+def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: bool = False):
+    """Segment a map; a segmentation with no region is an error that names the map.
+
+    ``canonical``: in the map's canonical pose (:mod:`ursim_core.segmentation.canonical`), for a
+    sketch whose orientation the matcher does not assume.
+    """
     from ursim_core.segmentation import segment
+    from ursim_core.segmentation.canonical import segment_canonical
 
     announce_kernel_compilation()
-    segmentation = segment(the_map, preset=preset, params=params)
+    segmenter = segment_canonical if canonical else segment
+    segmentation = segmenter(the_map, preset=preset, params=params)
     if segmentation.n_regions == 0:
         free = int(the_map.free.sum())
         why = (

@@ -30,7 +30,9 @@ class SegmentationJob:
     E5_08.png) and a map used by several experiments are segmented once.
 
     ``orientation`` (an :class:`~ursim_core.evaluation.augment.Orientation`, None for the map as
-    it is) turns and mirrors the loaded map before it is segmented."""
+    it is) turns and mirrors the loaded map before it is segmented. ``canonical`` segments it with
+    :func:`ursim_core.segmentation.canonical.segment_canonical` (sketches, whose orientation is
+    unknown to the matcher), else with ``segment``."""
 
     path: Path = field(compare=False)
     digest: str
@@ -38,10 +40,18 @@ class SegmentationJob:
     load_key: str
     augment: str = ""
     orientation: Any = field(default=None, compare=False)
+    canonical: bool = False
 
     @classmethod
     def of(
-        cls, path: Path, preset: str, load: dict, digests: dict[Path, str], orientation: Any = None
+        cls,
+        path: Path,
+        preset: str,
+        load: dict,
+        digests: dict[Path, str],
+        orientation: Any = None,
+        *,
+        canonical: bool = False,
     ) -> SegmentationJob:
         path = Path(path)
         if path not in digests:
@@ -59,11 +69,16 @@ class SegmentationJob:
             load_key=json.dumps(load, sort_keys=True),
             augment="" if orientation is None else orientation.name,
             orientation=orientation,
+            canonical=canonical,
         )
 
     @property
     def key(self) -> str:
-        return f"{self.digest}|{self.preset}|{self.load_key}" + (f"|{self.augment}" if self.augment else "")
+        return (
+            f"{self.digest}|{self.preset}|{self.load_key}"
+            + (f"|{self.augment}" if self.augment else "")
+            + ("|canonical" if self.canonical else "")
+        )
 
     @property
     def load(self) -> dict:
@@ -80,6 +95,10 @@ def segment_job(job: SegmentationJob):
         from ursim_core.evaluation.augment import transform_map
 
         the_map = transform_map(the_map, job.orientation)
+    if job.canonical:
+        from ursim_core.segmentation.canonical import segment_canonical
+
+        return segment_canonical(the_map, preset=job.preset)
     return segment(the_map, preset=job.preset)
 
 
@@ -109,6 +128,7 @@ def _disk_cache_path(cache_dir: Path, job: SegmentationJob) -> Path:
             "code": _segmenter_code_digest(),
             # Only augmented jobs carry the key, so the cache files of upright maps keep their names.
             **({"augment": job.augment} if job.augment else {}),
+            **({"canonical": True} if job.canonical else {}),
         },
         sort_keys=True,
     )

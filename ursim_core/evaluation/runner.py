@@ -235,15 +235,19 @@ def run_evaluation(
     # Per experiment and orientation: the segmentation jobs of the instance.
     instances: list[Instance] = []
     digests: dict[Path, str] = {}
+    # A sketch whose orientation the matcher does not assume is segmented in its canonical pose.
+    canonical = base_config.orientation != "upright"
     for experiment in experiments:
-        upright = SegmentationJob.of(experiment.sketch, input_preset, load_options, digests)
+        upright = SegmentationJob.of(experiment.sketch, input_preset, load_options, digests, canonical=canonical)
         metric_job = SegmentationJob.of(experiment.metric, model_preset, load_options, digests)
         place_job = SegmentationJob.of(experiment.metric, PLACE_REFERENCE_PRESET, PLACE_REFERENCE_LOAD, digests)
         for orientation in orientations or (None,):
             instances.append(
                 Instance(
                     experiment=experiment,
-                    sketch_job=SegmentationJob.of(experiment.sketch, input_preset, load_options, digests, orientation),
+                    sketch_job=SegmentationJob.of(
+                        experiment.sketch, input_preset, load_options, digests, orientation, canonical=canonical
+                    ),
                     metric_job=metric_job,
                     place_job=place_job,
                     upright_job=upright,

@@ -17,7 +17,18 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["auto_m", "baselines", "descriptors", "edit_distance", "pipeline", "planar"],
+    submodules=[
+        "auto_m",
+        "baselines",
+        "config",
+        "descriptors",
+        "edit_distance",
+        "orientation",
+        "pipeline",
+        "planar",
+        "results",
+        "single",
+    ],
     submod_attrs={
         "pipeline": [
             "MATCH_PRESETS",

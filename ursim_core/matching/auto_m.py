@@ -46,6 +46,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from ursim_core.matching.config import AUTO_RULE_NAMES
+
 __all__ = ["AUTO_RULES", "choose_m", "sweep"]
 
 
@@ -68,7 +70,7 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
     >>> [r.m for r in sweep(prepare(g, g.copy()), [0.0, 0.1])]
     [0.0, 0.1]
     """
-    from ursim_core.matching.pipeline import match_prepared
+    from ursim_core.matching.single import match_at
 
     grid = prepared.config.m_grid if grid is None else grid
     c_matrix = prepared.c_matrix
@@ -79,7 +81,7 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
         if previous_mask is not None and np.array_equal(mask, previous_mask) and results:
             results.append(replace(results[-1], m=float(m)))
         else:
-            results.append(match_prepared(prepared, float(m)))
+            results.append(match_at(prepared, float(m)))
             previous_mask = mask
         if progress is not None:
             progress(index / len(grid), f"matching at m = {float(m):.3f}")
@@ -110,6 +112,7 @@ def _rule_structure(prepared, results) -> list[float]:
 
 
 AUTO_RULES = {"score": _rule_score, "structure": _rule_structure}
+assert tuple(AUTO_RULES) == AUTO_RULE_NAMES, "config.AUTO_RULE_NAMES must list the rules defined here"
 
 
 def choose_m(prepared, *, progress=None):

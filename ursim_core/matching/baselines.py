@@ -19,8 +19,6 @@ from dataclasses import dataclass
 
 import networkx as nx
 import numpy as np
-from networkx.algorithms import isomorphism
-from scipy.optimize import linear_sum_assignment
 
 __all__ = ["hungarian_match", "vf2_match", "Vf2Result"]
 
@@ -49,6 +47,8 @@ def hungarian_match(c_matrix: np.ndarray, m: float) -> list[tuple[int, int]]:
     c_matrix = np.asarray(c_matrix, dtype=np.float64)
     if c_matrix.size == 0:
         return []
+    from scipy.optimize import linear_sum_assignment
+
     rows, cols = linear_sum_assignment(c_matrix)
     return [(int(r), int(k)) for r, k in zip(rows, cols) if c_matrix[r, k] <= m]
 
@@ -133,6 +133,8 @@ def vf2_match(
         a, b = big_attributes["key"], small_attributes["key"]
         sketch_node, metric_node = (b, a) if sketch_is_pattern else (a, b)
         return bool(compatible[sketch_index[sketch_node[1]], metric_index[metric_node[1]]])
+
+    from networkx.algorithms import isomorphism
 
     matcher = isomorphism.GraphMatcher(big, small, node_match=node_match)
     try:

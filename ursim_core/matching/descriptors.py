@@ -53,9 +53,18 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 import numpy as np
-import scipy.sparse as sparse
-from scipy.optimize import linear_sum_assignment
-from scipy.sparse.linalg import expm_multiply
+
+from ursim_core.matching.positions import blend_positions, position_distance, region_positions, region_types
+from ursim_core.matching.signatures import (
+    DEFAULT_TIMES,
+    DENSE_LIMIT,
+    heat_kernel_signatures,
+    signature_distance,
+    weighted_laplacian,
+)
+
+# scipy.sparse and scipy.optimize are imported where they are used: together they cost about
+# 0.4 s at start-up, and sketch-sized graphs need neither the sparse path nor (often) anchors.
 
 __all__ = [
     "ATTRIBUTES",
@@ -83,10 +92,6 @@ __all__ = [
 ]
 
 ATTRIBUTES = ("size", "pca_shape")
-#: t = i * 0.2 for i = 0..14, as the paper and the released driver (15 samples, 0 .. 2.8).
-DEFAULT_TIMES = tuple(round(0.2 * i, 10) for i in range(15))
-#: Largest graph handled by dense eigendecomposition; larger graphs use expm_multiply.
-DENSE_LIMIT = 100
 #: Added to ``z_size - min(z_size)`` so that no vertex gets weight 0 (see module docstring).
 SIZE_WEIGHT_FLOOR = 0.1
 VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
@@ -257,6 +262,8 @@ def anchor_pairs(cost: np.ndarray) -> list[tuple[int, int]]:
     cost = np.asarray(cost, dtype=np.float64)
     if cost.size == 0:
         return []
+    from scipy.optimize import linear_sum_assignment
+
     rows, cols = linear_sum_assignment(cost)
     return [(int(r), int(c)) for r, c in zip(rows, cols)]
 
@@ -291,228 +298,6 @@ def vertex_weights(z: np.ndarray, *, kind: str = "size", floor: float = SIZE_WEI
     if kind == "uniqueness":
         return uniqueness_score(z[:, 0], z[:, 1])
     raise ValueError(f"weights must be 'size', 'uniqueness' or 'equal', not {kind!r}")
-
-
-def weighted_laplacian(
-    graph: nx.Graph, weights: np.ndarray, *, nodes: Sequence | None = None, dense: bool | None = None
-):
-    """Vertex-weighted Laplacian (Chung and Langlands).
-
-    ``L(u,u) = sum_{v~u} w_v``, ``L(u,v) = -sqrt(w_u w_v)`` when u ~ v, else 0.
-    It is symmetric positive semi-definite and ``L @ sqrt(w) = 0``.
-
-    Parameters
-    ----------
-    graph : networkx.Graph
-    weights : ndarray, shape (n,)
-        Non-negative vertex weights in ``nodes`` order.
-    nodes : sequence, optional
-        Row order; default ascending node ids.
-    dense : bool, optional
-        Return a dense ndarray (default when ``n <= DENSE_LIMIT``) or a CSR matrix.
-
-    Examples
-    --------
-    >>> g = nx.path_graph(3)
-    >>> weighted_laplacian(g, np.array([1.0, 4.0, 1.0])).tolist()
-    [[4.0, -2.0, 0.0], [-2.0, 2.0, -2.0], [0.0, -2.0, 4.0]]
-    """
-    nodes = sorted(graph.nodes) if nodes is None else list(nodes)
-    weights = np.asarray(weights, dtype=np.float64)
-    if np.any(weights < 0):
-        raise ValueError("vertex weights must be non-negative")
-    n = len(nodes)
-    if dense is None:
-        dense = n <= DENSE_LIMIT
-    index = {node: i for i, node in enumerate(nodes)}
-    edges = np.array([(index[a], index[b]) for a, b in graph.edges() if a != b], dtype=np.int64).reshape(-1, 2)
-    rows = np.concatenate([edges[:, 0], edges[:, 1]])
-    cols = np.concatenate([edges[:, 1], edges[:, 0]])
-    root = np.sqrt(weights)
-    adjacency = sparse.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
-    degree_weights = adjacency @ weights
-    off_diagonal = sparse.csr_matrix((-root[rows] * root[cols], (rows, cols)), shape=(n, n))
-    laplacian = (off_diagonal + sparse.diags(degree_weights)).tocsr()
-    return laplacian.toarray() if dense else laplacian
-
-
-def _uniform_grid(times: np.ndarray) -> bool:
-    if times.size < 3:
-        return True
-    steps = np.diff(times)
-    return bool(np.allclose(steps, steps[0], rtol=1e-9, atol=1e-12))
-
-
-def _expm_apply(laplacian, vectors: np.ndarray, times: np.ndarray) -> np.ndarray:
-    """``exp(-t L) @ vectors`` for every t: array of shape (len(times), n, k)."""
-    operator = sparse.csr_matrix(laplacian)
-    if _uniform_grid(times) and times.size > 1:
-        return np.asarray(
-            expm_multiply(
-                -operator, vectors, start=float(times[0]), stop=float(times[-1]), num=times.size, endpoint=True
-            )
-        )
-    return np.stack([expm_multiply(-float(t) * operator, vectors) for t in times])
-
-
-def heat_kernel_signatures(
-    laplacian,
-    *,
-    anchors: Sequence[int] | None = None,
-    times: Sequence[float] = DEFAULT_TIMES,
-    method: str = "auto",
-    block: int = 256,
-) -> np.ndarray:
-    """Heat-kernel signatures of every vertex.
-
-    Parameters
-    ----------
-    laplacian : ndarray or sparse matrix, shape (n, n)
-        From :func:`weighted_laplacian`.
-    anchors : sequence of int, optional
-        Row indices of the anchor vertices. Given: anchor signature
-        ``s_u(t) = sum_a H_t(u, a)`` (an empty list gives zeros). None: plain heat
-        kernel signature ``H_t(u, u)``.
-    times : sequence of float
-        Sample times.
-    method : {'auto', 'eigh', 'expm'}
-        ``'eigh'``: dense eigendecomposition (tiny negative eigenvalues from rounding
-        are clipped to 0). ``'expm'``: ``scipy.sparse.linalg.expm_multiply`` on the
-        anchor indicator vector (anchor signature) or on blocks of identity columns
-        keeping only the diagonal (plain HKS). ``'auto'``: eigh up to
-        ``DENSE_LIMIT`` vertices.
-    block : int
-        Identity columns per expm_multiply call for the plain HKS.
-
-    Returns
-    -------
-    ndarray, shape (n, len(times))
-
-    Examples
-    --------
-    >>> L = weighted_laplacian(nx.path_graph(3), np.ones(3))
-    >>> s = heat_kernel_signatures(L, anchors=[0], times=[0.0, 1.0])
-    >>> (s[:, 0].round(12) + 0.0).tolist()
-    [1.0, 0.0, 0.0]
-    >>> bool(np.allclose(s, heat_kernel_signatures(L, anchors=[0], times=[0.0, 1.0], method="expm")))
-    True
-    """
-    times = np.asarray(times, dtype=np.float64)
-    n = laplacian.shape[0]
-    if n == 0:
-        return np.zeros((0, times.size))
-    if method == "auto":
-        method = "eigh" if n <= DENSE_LIMIT else "expm"
-    if method == "eigh":
-        dense = laplacian.toarray() if sparse.issparse(laplacian) else np.asarray(laplacian, dtype=np.float64)
-        eigenvalues, eigenvectors = np.linalg.eigh(dense)
-        decay = np.exp(-np.outer(np.clip(eigenvalues, 0.0, None), times))  # (k, T)
-        if anchors is None:
-            return np.square(eigenvectors) @ decay
-        indicator = np.zeros(n)
-        indicator[list(anchors)] = 1.0
-        projection = eigenvectors.T @ indicator  # (k,)
-        return eigenvectors @ (projection[:, None] * decay)
-    if method == "expm":
-        if anchors is not None:
-            indicator = np.zeros((n, 1))
-            indicator[list(anchors), 0] = 1.0
-            if not indicator.any():
-                return np.zeros((n, times.size))
-            return _expm_apply(laplacian, indicator, times)[:, :, 0].T
-        diagonal = np.empty((n, times.size))
-        for start in range(0, n, block):
-            stop = min(n, start + block)
-            columns = np.zeros((n, stop - start))
-            columns[np.arange(start, stop), np.arange(stop - start)] = 1.0
-            heat = _expm_apply(laplacian, columns, times)  # (T, n, b)
-            diagonal[start:stop] = heat[:, np.arange(start, stop), np.arange(stop - start)].T
-        return diagonal
-    raise ValueError(f"method must be 'auto', 'eigh' or 'expm', not {method!r}")
-
-
-def signature_distance(first: np.ndarray, second: np.ndarray, *, chunk_bytes: int = 32 << 20) -> np.ndarray:
-    """``c(v, v') = mean_t |s_v(t) - s_v'(t)|`` for every pair of rows.
-
-    Computed in row chunks so that large graphs do not build an (n, n', T) array at once.
-
-    Examples
-    --------
-    >>> signature_distance(np.array([[1.0, 0.0]]), np.array([[1.0, 0.0], [0.0, 0.0]])).tolist()
-    [[0.0, 0.5]]
-    """
-    first = np.asarray(first, dtype=np.float64)
-    second = np.asarray(second, dtype=np.float64)
-    n, n2 = first.shape[0], second.shape[0]
-    result = np.empty((n, n2))
-    if n == 0 or n2 == 0:
-        return result
-    samples = max(1, first.shape[1])
-    rows_per_chunk = max(1, chunk_bytes // (8 * samples * max(1, n2)))
-    for start in range(0, n, rows_per_chunk):
-        stop = min(n, start + rows_per_chunk)
-        result[start:stop] = np.abs(first[start:stop, None, :] - second[None, :, :]).mean(axis=2)
-    return result
-
-
-def region_types(graph: nx.Graph, *, nodes: Sequence | None = None) -> np.ndarray:
-    """The "old method" region type: 1 for a crossing (degree > 1), 0 for a dead end.
-
-    Examples
-    --------
-    >>> region_types(nx.path_graph(3)).tolist()
-    [0, 1, 0]
-    """
-    nodes = sorted(graph.nodes) if nodes is None else list(nodes)
-    return np.array([1 if graph.degree(node) > 1 else 0 for node in nodes], dtype=np.int64)
-
-
-def region_positions(graph: nx.Graph, *, nodes: Sequence | None = None) -> np.ndarray:
-    """Region centroids normalised to the map's extent, in [0, 1] x [0, 1].
-
-    The extent is the union of the regions' bounding boxes (``bbox`` node attribute;
-    the centroids' own range when absent), so the positions do not depend on the
-    image's margins or scale. A zero extent on an axis gives 0.5 on that axis.
-
-    Returns
-    -------
-    ndarray, shape (n, 2)
-        (row, col) per region in ``nodes`` order.
-
-    Examples
-    --------
-    >>> g = nx.Graph()
-    >>> g.add_node(1, centroid=(5.0, 10.0), bbox=(0, 0, 10, 20))
-    >>> g.add_node(2, centroid=(15.0, 30.0), bbox=(10, 20, 20, 40))
-    >>> region_positions(g).tolist()
-    [[0.25, 0.25], [0.75, 0.75]]
-    """
-    nodes = sorted(graph.nodes) if nodes is None else list(nodes)
-    if not nodes:
-        return np.zeros((0, 2))
-    centroids = np.array([graph.nodes[node]["centroid"] for node in nodes], dtype=np.float64).reshape(-1, 2)
-    if all("bbox" in graph.nodes[node] for node in nodes):
-        boxes = np.array([graph.nodes[node]["bbox"] for node in nodes], dtype=np.float64).reshape(-1, 4)
-        low = boxes[:, :2].min(axis=0)
-        high = boxes[:, 2:].max(axis=0)
-    else:
-        low, high = centroids.min(axis=0), centroids.max(axis=0)
-    extent = high - low
-    safe = np.where(extent > 0, extent, 1.0)
-    return np.where(extent > 0, (centroids - low) / safe, 0.5)
-
-
-def position_distance(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """Euclidean distances between every pair of normalised positions.
-
-    Examples
-    --------
-    >>> position_distance(np.array([[0.0, 0.0]]), np.array([[0.6, 0.8], [0.0, 0.5]])).tolist()
-    [[1.0, 0.5]]
-    """
-    first = np.asarray(first, dtype=np.float64).reshape(-1, 2)
-    second = np.asarray(second, dtype=np.float64).reshape(-1, 2)
-    return np.sqrt(np.square(first[:, None, :] - second[None, :, :]).sum(axis=2))
 
 
 @dataclass(frozen=True, eq=False)
@@ -706,13 +491,3 @@ def pair_descriptors(
         notes,
         signature_c,
     )
-
-
-def blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight):
-    """``(c + beta * d_position) / (1 + beta)`` with beta = ``position_weight`` (c itself when 0)."""
-    if not position_weight:
-        return c_matrix
-    distances = position_distance(
-        region_positions(sketch_graph, nodes=sketch_nodes), region_positions(metric_graph, nodes=metric_nodes)
-    )
-    return (c_matrix + position_weight * distances) / (1.0 + position_weight)

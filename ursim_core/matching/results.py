@@ -1,0 +1,96 @@
+"""The values of a match: :class:`Prepared` (everything that does not depend on m) and :class:`MatchResult`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from ursim_core.matching.config import MatchConfig
+from ursim_core.matching.descriptors import PairDescriptors
+from ursim_core.matching.planar import PlanarGraph
+
+__all__ = ["Prepared", "MatchResult"]
+
+
+@dataclass(frozen=True, eq=False)
+class Prepared:
+    """Everything of a map pair that does not depend on m (see :func:`prepare`)."""
+
+    config: MatchConfig
+    sketch_graph: nx.Graph
+    metric_graph: nx.Graph
+    descriptors: PairDescriptors | None
+    sketch_planar: PlanarGraph
+    metric_planar: PlanarGraph
+    notes: tuple = ()
+    #: ``(degrees, mirrored)`` applied to the sketch's positions (see ``MatchConfig.orientation``).
+    orientation: tuple = (0.0, False)
+    #: For ``orientation='any'``: the score of every candidate tried, ``{(degrees, mirrored): score}``.
+    orientation_scan: dict = field(default_factory=dict)
+    #: The automatic-m answer found while choosing the orientation (reused by :func:`match_prepared`).
+    chosen: Any = None
+
+    @property
+    def c_matrix(self) -> np.ndarray:
+        if self.descriptors is None:
+            return np.zeros((self.sketch_planar.n_vertices, self.metric_planar.n_vertices))
+        return self.descriptors.c_matrix
+
+
+@dataclass(frozen=True, eq=False)
+class MatchResult:
+    """Correspondences found between a sketch and a metric map.
+
+    Attributes
+    ----------
+    pairs : list of (sketch_region, metric_region)
+    anchors : list of (sketch_region, metric_region)
+        Hungarian pairs of unique regions used as heat sources.
+    unique_sketch, unique_metric : list
+        Unique regions of each map.
+    m : float
+        The threshold used (the chosen one when ``config.m == 'auto'``).
+    cost : float
+        Planar hypothesis cost of the answer (``inf`` when nothing was matched; for the
+        Hungarian and VF2 matchers the same cost formula applied to their pairs).
+    normalised_cost : float
+        ``cost / (n1 + n2 + e1 + e2)``: 1 when nothing is matched, 0 for a perfect match.
+    signatures : tuple of ndarray or None
+        (sketch, metric) signatures, rows in ascending region-id order.
+    c_matrix : ndarray
+        ``c`` for every (sketch, metric) pair, rows/columns in ascending region-id order.
+    seeds_count : int
+        Pairs with ``c <= m`` used as seeds (after the ``max_seeds`` cap).
+    hypotheses : int
+        Hypotheses scored by the planar matcher.
+    reason : str
+        Non-empty when the input or the result is degenerate.
+    config : MatchConfig
+    m_scan : dict
+        For ``m='auto'``: the statistic of the rule for each m of the grid.
+    orientation : (float, bool)
+        The turn (degrees counter-clockwise) and mirroring that brought the sketch to the
+        metric map, chosen or given (``MatchConfig.orientation``).
+    orientation_scan : dict
+        With ``orientation='any'``: the normalised score of each candidate tried.
+    """
+
+    pairs: list
+    anchors: list
+    unique_sketch: list
+    unique_metric: list
+    m: float
+    cost: float
+    normalised_cost: float
+    signatures: tuple | None
+    c_matrix: np.ndarray
+    seeds_count: int
+    hypotheses: int
+    reason: str
+    config: MatchConfig
+    m_scan: dict = field(default_factory=dict)
+    orientation: tuple = (0.0, False)
+    orientation_scan: dict = field(default_factory=dict)

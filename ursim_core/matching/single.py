@@ -1,0 +1,161 @@
+"""One run of the configured matcher at one fixed m: seeds, the planar matcher or a baseline, the score."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ursim_core.matching.baselines import hungarian_match, vf2_match
+from ursim_core.matching.config import MatchConfig
+from ursim_core.matching.planar import hypothesis_cost, planar_match
+from ursim_core.matching.results import MatchResult, Prepared
+
+__all__ = ["seed_pairs", "seed_cap", "pair_cost_matrix", "match_at"]
+
+
+def seed_pairs(c_matrix: np.ndarray, m: float, *, max_seeds: int | None = None) -> list[tuple[int, int]]:
+    """All index pairs with ``c <= m``, sketch outer loop, metric inner loop.
+
+    With ``max_seeds``, only the ``max_seeds`` pairs of lowest c are kept (ties by order),
+    still returned in loop order.
+
+    Examples
+    --------
+    >>> seed_pairs(np.array([[0.0, 0.2], [0.1, 0.5]]), 0.2)
+    [(0, 0), (0, 1), (1, 0)]
+    >>> seed_pairs(np.array([[0.0, 0.2], [0.1, 0.5]]), 0.2, max_seeds=2)
+    [(0, 0), (1, 0)]
+    """
+    c_matrix = np.asarray(c_matrix)
+    rows, cols = np.nonzero(c_matrix <= m)
+    if max_seeds is not None and rows.size > max_seeds:
+        keep = np.sort(np.argsort(c_matrix[rows, cols], kind="stable")[:max_seeds])
+        rows, cols = rows[keep], cols[keep]
+    return list(zip(rows.tolist(), cols.tolist()))
+
+
+def seed_cap(max_seeds, n_sketch: int, n_metric: int) -> int | None:
+    """Resolve ``MatchConfig.max_seeds`` for graphs of the given sizes.
+
+    Examples
+    --------
+    >>> seed_cap("auto", 15, 8), seed_cap("auto", 1000, 1000), seed_cap(None, 5, 5)
+    (6666, 100, None)
+    """
+    if max_seeds == "auto":
+        return max(64, 100_000 // max(1, n_sketch, n_metric))
+    return max_seeds
+
+
+def pair_cost_matrix(config: MatchConfig, c_matrix: np.ndarray, m: float) -> np.ndarray | None:
+    """Per-pair term of the hypothesis score for ``config.hypothesis_score`` (None for 'structure').
+
+    Examples
+    --------
+    >>> pair_cost_matrix(MatchConfig(hypothesis_score="substitutions"), np.array([[0.1, 0.3]]), 0.2).tolist()
+    [[0.0, 1.0]]
+    """
+    if config.hypothesis_score == "structure" or config.score_weight == 0:
+        return None
+    if config.hypothesis_score == "substitutions":
+        return (np.asarray(c_matrix) > m).astype(np.float64)
+    return np.asarray(c_matrix, dtype=np.float64)
+
+
+def _cost_of(prepared: Prepared, index_pairs, pair_costs) -> tuple[float, float]:
+    first, second = prepared.sketch_planar, prepared.metric_planar
+    total = first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges)
+    if not index_pairs:
+        return math.inf, 1.0
+    cost = float(hypothesis_cost(first, second, index_pairs))
+    if pair_costs is not None:
+        cost += prepared.config.score_weight * float(sum(pair_costs[i, j] for i, j in index_pairs))
+    return cost, (cost / total if total else 0.0)
+
+
+def match_at(prepared: Prepared, m: float) -> MatchResult:
+    """Run the configured matcher at one fixed m.
+
+    Examples
+    --------
+    >>> import networkx as nx
+    >>> from ursim_core.matching.pipeline import prepare
+    >>> g = nx.cycle_graph(4)
+    >>> nx.set_node_attributes(g, {0: 90, 1: 10, 2: 20, 3: 30}, "size")
+    >>> nx.set_node_attributes(g, {0: 0.1, 1: 0.5, 2: 0.3, 3: 0.2}, "pca_shape")
+    >>> nx.set_node_attributes(g, {0: (0, 0), 1: (0, 10), 2: (10, 10), 3: (10, 0)}, "centroid")
+    >>> sorted(match_at(prepare(g, g.copy()), 0.01).pairs)
+    [(0, 0), (1, 1), (2, 2), (3, 3)]
+    """
+    config = prepared.config
+    m = float(m)
+    descriptors = prepared.descriptors
+    c_matrix = prepared.c_matrix
+    reasons = list(prepared.notes)
+    anchors = list(descriptors.anchors) if descriptors else []
+    unique_sketch = list(descriptors.unique_sketch) if descriptors else []
+    unique_metric = list(descriptors.unique_metric) if descriptors else []
+    signatures = None
+    if descriptors is not None and descriptors.sketch_signatures is not None:
+        signatures = (descriptors.sketch_signatures, descriptors.metric_signatures)
+    if config.variant in ("T2", "T4") and descriptors is not None and not anchors:
+        reasons.append("no anchors: anchor signatures are all zero, matching is structural only")
+    index_pairs: list = []
+    seeds_count = 0
+    hypotheses = 0
+    pair_costs = pair_cost_matrix(config, c_matrix, m) if descriptors is not None else None
+    if descriptors is not None:
+        if config.matcher == "planar":
+            seeds = seed_pairs(c_matrix, m, max_seeds=seed_cap(config.max_seeds, *c_matrix.shape))
+            seeds_count = len(seeds)
+            if not seeds:
+                reasons.append(f"no seeds: no pair of regions has c <= m = {m:g}")
+            else:
+                same = (c_matrix <= m).tolist()
+                outcome = planar_match(
+                    prepared.sketch_planar,
+                    prepared.metric_planar,
+                    same,
+                    seeds=seeds,
+                    rotation_search=config.rotation_search,
+                    reflections=config.reflections,
+                    pair_costs=None if pair_costs is None else pair_costs.tolist(),
+                    pair_cost_weight=config.score_weight,
+                )
+                index_pairs = outcome.pairs
+                hypotheses = outcome.hypotheses
+        elif config.matcher == "hungarian":
+            index_pairs = hungarian_match(c_matrix, m)
+            if not index_pairs:
+                reasons.append(f"no assigned pair has c <= m = {m:g}")
+        else:
+            sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
+            found = vf2_match(prepared.sketch_graph, prepared.metric_graph, c_matrix, m, timeout=config.vf2_timeout)
+            sketch_index = {n: i for i, n in enumerate(sketch_nodes)}
+            metric_index = {n: i for i, n in enumerate(metric_nodes)}
+            index_pairs = [(sketch_index[a], metric_index[b]) for a, b in found.pairs]
+            if found.gave_up:
+                reasons.append(found.gave_up)
+            elif not index_pairs:
+                reasons.append(f"no subgraph isomorphism with c <= m = {m:g}")
+    cost, normalised = _cost_of(prepared, index_pairs, pair_costs)
+    sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
+    pairs = [(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs]
+    return MatchResult(
+        pairs=pairs,
+        anchors=anchors,
+        unique_sketch=unique_sketch,
+        unique_metric=unique_metric,
+        m=m,
+        cost=cost,
+        normalised_cost=normalised,
+        signatures=signatures,
+        c_matrix=c_matrix,
+        seeds_count=seeds_count,
+        hypotheses=hypotheses,
+        reason="; ".join(dict.fromkeys(reasons)),
+        config=config,
+        orientation=prepared.orientation,
+        orientation_scan=prepared.orientation_scan,
+    )
