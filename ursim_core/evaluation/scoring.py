@@ -386,11 +386,11 @@ def score_places(pairs: Iterable[tuple[int, int]], problem: PlaceProblem, metric
         matched.setdefault(operator.index(sketch), []).append(operator.index(metric))
     labels = problem.reference_metric_labels
     target_label: dict[int, int] = {}
+    from ursim_core.navigation.goal import interior_target
+
     for sketch, metrics in matched.items():
-        # The largest matched metric region (smallest id on ties), and the reference region
-        # under its interior point: where the robot is sent.
-        largest = min(metrics, key=lambda region: (-int(metric_graph.nodes[region]["size"]), region))
-        row, col = (int(v) for v in metric_graph.nodes[largest]["interior"])
+        # Where the robot is sent (the rule of ``ursim goal``), then the reference region under it.
+        _, (row, col) = interior_target(metric_graph, metrics)
         target_label[sketch] = int(labels[row, col]) if 0 <= row < labels.shape[0] and 0 <= col < labels.shape[1] else 0
 
     per_clique, successes, n_points = [], 0, 0

@@ -27,7 +27,17 @@ from ursim_core.correspondences.codec import regions_at_points
 from ursim_core.correspondences.exporters import LABEL_KEY, clique_label
 from ursim_core.errors import ParameterError
 
-__all__ = ["Goal", "NearestMatch", "MatchTable", "match_table", "locate", "LABEL_KEY", "TARGETS", "clique_label"]
+__all__ = [
+    "interior_target",
+    "Goal",
+    "NearestMatch",
+    "MatchTable",
+    "match_table",
+    "locate",
+    "LABEL_KEY",
+    "TARGETS",
+    "clique_label",
+]
 
 #: Where inside the matched metric region the goal goes.
 TARGETS = ("interior", "mirror")
@@ -201,6 +211,25 @@ class Goal:
         }
 
 
+def interior_target(metric_graph: Any, metric_regions: Any) -> tuple[int, tuple[int, int]]:
+    """Where the robot is sent for a sketch region matched to ``metric_regions``.
+
+    The largest of them (pixel count; the smallest id on ties) and its interior point, the pixel
+    farthest from its border. Place accuracy (:func:`ursim_core.evaluation.scoring.place_accuracy`)
+    and :func:`locate` both call this, so a goal and the score of goals are one rule.
+
+    Examples
+    --------
+    >>> import networkx as nx
+    >>> g = nx.Graph(); g.add_node(1, size=10, interior=(2, 3)); g.add_node(2, size=40, interior=(8, 9))
+    >>> interior_target(g, [1, 2])
+    (2, (8, 9))
+    """
+    chosen = max(metric_regions, key=lambda r: (metric_graph.nodes[r]["size"], -r))
+    row, col = metric_graph.nodes[chosen]["interior"]
+    return int(chosen), (int(row), int(col))
+
+
 def locate(
     match: Any,
     sketch_seg: Any,
@@ -281,8 +310,7 @@ def locate(
             nearest=_nearest_matched(table, sketch_seg.labels, point) if suggest_nearest else None,
         )
     if target == "interior":
-        chosen = max(metric_regions, key=lambda r: (metric_graph.nodes[r]["size"], -r))
-        pixel = tuple(int(v) for v in metric_graph.nodes[chosen]["interior"])
+        chosen, pixel = interior_target(metric_graph, metric_regions)
     else:
         pixel = _mirrored_pixel(table, sketch_seg, metric_seg, sketch_region, metric_regions, point)
         chosen = int(metric_seg.labels[pixel])
