@@ -8,7 +8,7 @@ records a fixed timestamp so that running this again changes no file.
 
 from pathlib import Path
 
-from ursim_core.synth.generator import make_pair, save_example
+from ursim_core.synth import make_pair, save_example
 
 SEED = 7
 TIMESTAMP = "2026-11-22T00:00:00Z"

@@ -15,7 +15,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match
 from ursim_core.segmentation import segment
-from ursim_core.synth.generator import (
+from ursim_core.synth import (
     Sketch,
     generate_floor_plan,
     ground_truth_correspondences,

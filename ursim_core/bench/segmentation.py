@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ursim_core.segmentation.maoris import PRESETS, MaorisParams, maoris_labels
-from ursim_core.synth.generator import make_large_building
+from ursim_core.synth import make_large_building
 
 __all__ = [
     "bench_segmentation",
@@ -105,7 +105,7 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
 def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, preset: str = "robot") -> list[dict]:
     """Time and peak memory of segmenting generated buildings of growing size.
 
-    The buildings come from :func:`ursim_core.synth.generator.make_large_building` (bands of rooms along
+    The buildings come from :func:`ursim_core.synth.make_large_building` (bands of rooms along
     corridors; about a thousand rooms at 4000 x 4000).
 
     Returns

@@ -32,7 +32,7 @@ The released C++ measured on the same data: oracle .568 / .562, best fixed m .48
 
 Hyper-parameters: beta = ``position_weight`` = 2 and w = ``score_weight`` = 8 were chosen on
 data the KTH figures do not contain: generated pairs with exactly known ground truth
-(``ursim_core.synth.generator.make_pair``, seeds 0-11). With the generator as it was then, (2, 8) scored mean
+(``ursim_core.synth.make_pair``, seeds 0-11). With the generator as it was then, (2, 8) scored mean
 F1 .897 against .801 for the earlier (0.5, 4) and .967 for (2, 16); with the current generator
 (bends, crossings, dropped dead ends) .996 against .951 and .996. On KTH the three lie on a flat
 plateau (.677, .659 and .629 mean of the two annotators), so (2, 8) was kept as the setting good on

@@ -1,8 +1,10 @@
 """Generated floor plans, their sketches and their ground truth.
 
-Owns: the floor-plan generator, ``sketchify`` (a plan drawn as a person would: wobbly walls,
-missing doors, another scale), the ground-truth cliques of a generated pair, the large
-buildings of the scale benchmark and the bundled example pair.
+Owns: the floor-plan generator (:mod:`~ursim_core.synth.floor_plans`, with the large buildings of
+the scale benchmark), ``sketchify`` (a plan drawn as a person would: wobbly walls, missing doors,
+another scale; :mod:`~ursim_core.synth.drawing`), the exact ground-truth cliques of a generated
+pair (:mod:`~ursim_core.synth.ground_truth`) and the bundled example pair
+(:mod:`~ursim_core.synth.example`).
 
 May import: :mod:`ursim_core.correspondences`, :mod:`ursim_core.io`, :mod:`ursim_core.errors`.
 """
@@ -11,20 +13,11 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["generator"],
+    submodules=["drawing", "example", "floor_plans", "generator", "ground_truth"],
     submod_attrs={
-        "generator": [
-            "Place",
-            "FloorPlan",
-            "Sketch",
-            "generate_floor_plan",
-            "sketchify",
-            "interior_points",
-            "ground_truth_pairs",
-            "ground_truth_correspondences",
-            "make_pair",
-            "make_large_building",
-            "save_example",
-        ],
+        "floor_plans": ["Place", "FloorPlan", "generate_floor_plan", "make_large_building", "interior_points"],
+        "drawing": ["Sketch", "sketchify"],
+        "ground_truth": ["ground_truth_pairs", "ground_truth_correspondences"],
+        "example": ["make_pair", "save_example"],
     },
 )

@@ -210,7 +210,7 @@ def test_generated_floor_plans_survive_grid_and_yaml_round_trips(tmp_path, seed,
     from scipy import ndimage
 
     from ursim_core.io.maps import Map
-    from ursim_core.synth.generator import generate_floor_plan, sketchify
+    from ursim_core.synth import generate_floor_plan, sketchify
 
     plan = generate_floor_plan(seed=seed)
     # A robot's view of the plan: free inside, walls occupied, what lies beyond the walls unknown.
