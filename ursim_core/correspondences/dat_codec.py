@@ -1,0 +1,204 @@
+"""The original annotators' ``.dat`` format (points only), kept for the published ground truth.
+
+Read with :func:`load_dat`, written with :func:`save_dat`.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import urllib.parse
+from pathlib import Path
+
+from ursim_core.correspondences.json_codec import read_file_bytes
+from ursim_core.correspondences.values import Clique, Correspondences, MapRef
+from ursim_core.errors import FormatError
+from ursim_core.io.atomic import atomic_write_text
+
+__all__ = ["load_dat", "save_dat"]
+
+
+_DAT_SET = re.compile(r"^#\s*(\d+)\s*match set$")
+_DAT_SIDE = re.compile(r"^#\s*map([12])$")
+_DAT_POINT = re.compile(r"^(\d+)\s+(\d+)$")
+_DAT_NO_PATH = "-"
+
+
+def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspondences:
+    """Read a ground-truth file in the original annotators' ``.dat`` format.
+
+    The layout is a header ``# <map1 path> <map2 path>`` then match sets, each
+    ``# Kmatch set``, ``# map1``, ``ROW COL`` lines, ``# map2``, ``ROW COL`` lines;
+    blank lines are ignored. map1 is the sketch, map2 the metric map. Clique ids
+    are 1, 2, ... in file order (the ``K`` numbers are not kept). The header's
+    paths are kept as written: in ``MapRef.path`` (not resolved; ``-`` means
+    none) and verbatim in ``MapRef.extra["dat_path"]``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.dat`` file.
+    drop_empty : bool, optional
+        Drop match sets without any point. False by default because the legacy
+        scorer counts the trailing empty set of the published files.
+
+    Returns
+    -------
+    Correspondences
+        Cliques with points only (``source="manual"``); fill the regions with
+        :func:`assign_regions`.
+
+    Raises
+    ------
+    FormatError
+        Missing or unreadable file, or a malformed line (the message gives its number).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "gt.dat"
+    >>> _ = target.write_text("# a.png b.png\\n# 0match set\\n# map1\\n228 302\\n# map2\\n166 308\\n\\n")
+    >>> corr = load_dat(target)
+    >>> corr.sketch.path.name, corr.cliques[0].sketch_points, corr.cliques[0].metric_points
+    ('a.png', ((228, 302),), ((166, 308),))
+    """
+    path = Path(path)
+    lines = _read_dat_lines(path)
+    if not lines:
+        raise FormatError("empty file; expected a '# <map1 path> <map2 path>' header", path=path)
+    sketch_ref, metric_ref = _parse_dat_header(lines[0], path)
+
+    sets: list[dict] = []
+    current: dict | None = None
+    for number, raw in enumerate(lines[1:], start=2):
+        line = raw.strip()
+        if not line:
+            continue
+        if _DAT_SET.match(line):
+            _finish_dat_set(current, number, path)
+            current = {"line": number, "side": None, "points": {"1": [], "2": []}}
+            sets.append(current)
+            continue
+        side = _DAT_SIDE.match(line)
+        if side:
+            if current is None:
+                raise FormatError(f"line {number}: {line!r} before the first '# Kmatch set' line", path=path)
+            if current["side"] == "2":
+                raise FormatError(f"line {number}: {line!r} after '# map2' in the same match set", path=path)
+            expected = "1" if current["side"] is None else "2"
+            if side.group(1) != expected:
+                raise FormatError(f"line {number}: expected '# map{expected}', got {line!r}", path=path)
+            current["side"] = expected
+            continue
+        point = _DAT_POINT.match(line)
+        if point:
+            if current is None or current["side"] is None:
+                raise FormatError(f"line {number}: point {line!r} before '# map1' or '# map2'", path=path)
+            current["points"][current["side"]].append((int(point.group(1)), int(point.group(2))))
+            continue
+        raise FormatError(
+            f"line {number}: expected 'ROW COL' (two non-negative integers), '# Kmatch set', "
+            f"'# map1' or '# map2', got {raw.strip()!r}",
+            path=path,
+        )
+    _finish_dat_set(current, len(lines) + 1, path)
+
+    cliques = []
+    for match_set in sets:
+        sketch_points, metric_points = match_set["points"]["1"], match_set["points"]["2"]
+        if drop_empty and not sketch_points and not metric_points:
+            continue
+        cliques.append(Clique(id=len(cliques) + 1, sketch_points=sketch_points, metric_points=metric_points))
+    return Correspondences(sketch=sketch_ref, metric=metric_ref, cliques=tuple(cliques))
+
+
+def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
+    """Write ``corr`` in the original annotators' ``.dat`` format, atomically.
+
+    Only points are written (the format has nothing else); match sets are
+    numbered 0, 1, ... in clique order and each is followed by a blank line, as
+    in the published files. Header paths are ``MapRef.extra["dat_path"]`` when it
+    still names ``MapRef.path``, else the path itself, ``-`` for none;
+    white space and ``%`` inside a path are %-escaped so the two-token header
+    stays readable (:func:`load_dat` decodes them).
+
+    Parameters
+    ----------
+    corr : Correspondences
+        What to write.
+    path : str or path-like
+        Destination ``.dat`` file.
+
+    Raises
+    ------
+    OSError
+        Writing failed; an existing file is left unchanged.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "gt.dat"
+    >>> corr = Correspondences(MapRef(path="a.png"), MapRef(path="b.png"),
+    ...                        cliques=(Clique(id=1, sketch_points=[(1, 2)], metric_points=[(3, 4)]),))
+    >>> save_dat(corr, target)
+    >>> print(target.read_text(), end="")
+    # a.png b.png
+    # 0match set
+    # map1
+    1 2
+    # map2
+    3 4
+    <BLANKLINE>
+    """
+    lines = [f"# {_dat_header_token(corr.sketch)} {_dat_header_token(corr.metric)}"]
+    for index, clique in enumerate(corr.cliques):
+        lines.append(f"# {index}match set")
+        lines.append("# map1")
+        lines.extend(f"{row} {col}" for row, col in clique.sketch_points)
+        lines.append("# map2")
+        lines.extend(f"{row} {col}" for row, col in clique.metric_points)
+        lines.append("")
+    atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def _read_dat_lines(path: Path) -> list[str]:
+    raw = read_file_bytes(path, what="a .dat file")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = raw[: error.start].count(b"\n") + 1
+        raise FormatError(f"line {line}: not text (undecodable byte); not a .dat file", path=path) from None
+    return text.splitlines()
+
+
+def _parse_dat_header(line: str, path: Path) -> tuple[MapRef, MapRef]:
+    tokens = line.strip().lstrip("#").split() if line.strip().startswith("#") else None
+    if tokens is None or len(tokens) != 2:
+        raise FormatError(f"line 1: expected '# <map1 path> <map2 path>', got {line.strip()!r}", path=path)
+    refs = []
+    for token in tokens:
+        if token == _DAT_NO_PATH:
+            refs.append(MapRef())
+        else:
+            text = urllib.parse.unquote(token)
+            refs.append(MapRef(path=Path(text), extra={"dat_path": text}))
+    return refs[0], refs[1]
+
+
+def _finish_dat_set(current: dict | None, number: int, path: Path) -> None:
+    if current is not None and current["side"] != "2":
+        missing = "'# map1' and '# map2'" if current["side"] is None else "'# map2'"
+        raise FormatError(
+            f"line {number}: the match set started on line {current['line']} has no {missing} line", path=path
+        )
+
+
+def _dat_header_token(ref: MapRef) -> str:
+    if ref.path is None:
+        return _DAT_NO_PATH
+    written = ref.extra.get("dat_path")
+    text = written if isinstance(written, str) and Path(written) == ref.path else ref.path.as_posix()
+    if text == _DAT_NO_PATH:
+        return "%2D"  # a file really named "-", not to be read back as "no path"
+    # Escape only what breaks the header, so ordinary paths stay readable.
+    return "".join(urllib.parse.quote(char, safe="") if char.isspace() or char == "%" else char for char in text)

@@ -1,0 +1,389 @@
+"""The JSON correspondence file (``"format": "ursim-correspondences"``, versioned).
+
+:func:`load_correspondences` reads, upgrades (``_MIGRATIONS``) and validates a file against the
+schema shipped in ``schemas/`` (:mod:`ursim_core.correspondences.schema`);
+:func:`save_correspondences` writes one atomically. Unknown keys are preserved on re-save. See
+the "Correspondence format" section of README.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import re
+from collections.abc import Callable, Sequence
+from pathlib import Path, PurePath
+from typing import Any
+
+from ursim_core.correspondences.schema import CURRENT_VERSION, FORMAT_NAME, json_type, short, validate
+from ursim_core.correspondences.values import (
+    CLIQUE_KEYS,
+    MAP_KEYS,
+    MAPS_KEYS,
+    SEGMENTATION_KEYS,
+    TOP_KEYS,
+    Clique,
+    Correspondences,
+    MapRef,
+    utc_timestamp,
+)
+from ursim_core.errors import FormatError
+from ursim_core.io.atomic import atomic_write_text
+
+__all__ = [
+    "SUPPORTED_VERSIONS",
+    "load_correspondences",
+    "save_correspondences",
+    "correspondences_to_json",
+    "read_file_bytes",
+]
+
+# version n -> function turning a version-n document (a dict) into a version n+1
+# document. Version 1 is the first, so there is nothing to migrate yet; a
+# version 2 adds `_MIGRATIONS[1] = _migrate_1_to_2`, bumps CURRENT_VERSION and
+# ships correspondences-2.schema.json, and every old file keeps loading.
+_MIGRATIONS: dict[int, Callable[[dict], dict]] = {}
+SUPPORTED_VERSIONS = tuple(sorted({CURRENT_VERSION, *_MIGRATIONS}))
+
+
+def load_correspondences(path: str | os.PathLike) -> Correspondences:
+    """Read and validate a correspondence JSON file.
+
+    Map and label paths, stored relative to the file's folder, come back absolute.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.json`` file.
+
+    Returns
+    -------
+    Correspondences
+
+    Raises
+    ------
+    FormatError
+        The file is missing or unreadable, not JSON (the message gives line and
+        column), not an object, not a URSIM correspondence file, of an
+        unsupported version, violates the schema (the error's ``field`` names the
+        place, e.g. ``cliques[2].sketch_points[0]``) or repeats a clique id.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "pair.json"
+    >>> save_correspondences(Correspondences(cliques=(Clique(id=1, sketch_points=[(1, 2)]),)), target)
+    >>> load_correspondences(target).cliques[0].sketch_points
+    ((1, 2),)
+    """
+    path = Path(path)
+    document = _read_json_object(path)
+    document = _upgrade(document, path)
+    validate(document, path)
+    _check_unique_ids(document, path)
+    folder = Path(os.path.abspath(path)).parent
+    return _from_document(document, folder)
+
+
+def save_correspondences(corr: Correspondences, path: str | os.PathLike, *, now: str | None = None) -> None:
+    """Write ``corr`` as a version-1 correspondence JSON file, atomically.
+
+    ``modified`` is set to the current time (and ``created`` too if it is
+    empty). Paths are stored relative to the file's folder (absolute when that
+    is impossible, e.g. another Windows drive). Keys are written in a fixed
+    order, then the unknown keys in their original order; the text is indented
+    by 2 with short number lists kept on one line. The document is validated
+    against the schema first, so an invalid file is never written.
+
+    Parameters
+    ----------
+    corr : Correspondences
+        What to write.
+    path : str or path-like
+        Destination ``.json`` file; its folder must exist.
+    now : str, optional
+        Timestamp to record instead of the current time (reproducible output).
+
+    Raises
+    ------
+    FormatError
+        The content cannot be represented (e.g. a non-JSON value in ``extra``).
+    OSError
+        Writing failed; an existing file is left unchanged.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "pair.json"
+    >>> save_correspondences(Correspondences(annotator="ana"), target, now="2024-05-01T12:00:00Z")
+    >>> load_correspondences(target).modified
+    '2024-05-01T12:00:00Z'
+    """
+    path = Path(path)
+    timestamp = utc_timestamp() if now is None else now
+    stamped = dataclasses.replace(corr, created=corr.created or timestamp, modified=timestamp)
+    text = correspondences_to_json(stamped, folder=Path(os.path.abspath(path)).parent, path=path)
+    atomic_write_text(path, text)
+
+
+def correspondences_to_json(
+    corr: Correspondences, *, folder: str | os.PathLike | None = None, path: str | os.PathLike | None = None
+) -> str:
+    """The JSON text :func:`save_correspondences` writes (timestamps as they are in ``corr``).
+
+    Parameters
+    ----------
+    corr : Correspondences
+        What to serialise.
+    folder : str or path-like, optional
+        Folder that stored paths are made relative to; the current directory by default.
+    path : str or path-like, optional
+        File named in error messages.
+
+    Raises
+    ------
+    FormatError
+        The document would not be a valid version-1 file.
+
+    Examples
+    --------
+    >>> print(correspondences_to_json(Correspondences()).splitlines()[1])
+      "format": "ursim-correspondences",
+    """
+    folder = Path(os.path.abspath(os.getcwd() if folder is None else folder))
+    document = _to_document(corr, folder)
+    try:
+        text = json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False)
+    except (TypeError, ValueError) as error:
+        raise FormatError(f"cannot be written as JSON: {error}", path=path) from None
+    # Round-trip through the parser so the schema sees exactly what a reader will.
+    validate(json.loads(text), path)
+    return _collapse_number_lists(text) + "\n"
+
+
+def read_file_bytes(path: Path, *, what: str) -> bytes:
+    """The file's bytes, or a FormatError naming the file and why it cannot be read."""
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise FormatError("file not found", path=path) from None
+    except IsADirectoryError:
+        raise FormatError(f"is a folder, not {what}", path=path) from None
+    except OSError as error:
+        raise FormatError(f"cannot read file: {error.strerror or error}", path=path) from None
+
+
+def _read_json_object(path: Path) -> dict:
+    raw = read_file_bytes(path, what="a correspondence file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        raise FormatError(f"not UTF-8 text (byte {error.start}): not a JSON file", path=path) from None
+    try:
+        document = json.loads(text, object_pairs_hook=_reject_duplicate_keys, parse_constant=_reject_constant)
+    except json.JSONDecodeError as error:
+        raise FormatError(
+            f"not valid JSON: {error.msg} at line {error.lineno}, column {error.colno}", path=path
+        ) from None
+    except _InvalidJsonValue as error:
+        raise FormatError(f"not valid JSON for URSIM: {error}", path=path) from None
+    if not isinstance(document, dict):
+        raise FormatError(f"expected a JSON object at the top level, got {json_type(document)}", path=path)
+    return document
+
+
+class _InvalidJsonValue(ValueError):
+    pass
+
+
+def _reject_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict:
+    # json.loads silently keeps the last of two equal keys; a hand-edited file
+    # would lose data without notice.
+    result: dict = {}
+    for key, value in pairs:
+        if key in result:
+            raise _InvalidJsonValue(f"key {key!r} appears twice in one object")
+        result[key] = value
+    return result
+
+
+def _reject_constant(name: str) -> Any:
+    raise _InvalidJsonValue(f"{name} is not a JSON number")
+
+
+def _upgrade(document: dict, path: Path) -> dict:
+    if "format" not in document:
+        raise FormatError("required field is missing; not a URSIM correspondence file", path=path, field="format")
+    if document["format"] != FORMAT_NAME:
+        raise FormatError(
+            f"expected {FORMAT_NAME!r}, got {short(document['format'])}: not a URSIM correspondence file",
+            path=path,
+            field="format",
+        )
+    if "version" not in document:
+        raise FormatError("required field is missing", path=path, field="version")
+    version = document["version"]
+    if isinstance(version, bool) or not isinstance(version, int):
+        raise FormatError(f"expected an integer, got {short(version)}", path=path, field="version")
+    supported = ", ".join(str(number) for number in SUPPORTED_VERSIONS)
+    while version != CURRENT_VERSION:
+        migrate = _MIGRATIONS.get(version)
+        if migrate is None:
+            newer = " (written by a newer URSIM Studio?)" if version > CURRENT_VERSION else ""
+            raise FormatError(
+                f"unsupported version {version}{newer}; this URSIM Studio reads version(s) {supported}",
+                path=path,
+                field="version",
+            )
+        document = migrate(document)
+        version = document["version"]
+    return document
+
+
+def _check_unique_ids(document: dict, path: Path) -> None:
+    first_index: dict[int, int] = {}
+    for index, clique in enumerate(document["cliques"]):
+        clique_id = clique["id"]
+        if clique_id in first_index:
+            raise FormatError(
+                f"duplicate clique id {clique_id} (also used by cliques[{first_index[clique_id]}])",
+                path=path,
+                field=f"cliques[{index}].id",
+            )
+        first_index[clique_id] = index
+
+
+def _from_document(document: dict, folder: Path) -> Correspondences:
+    maps = document["maps"]
+    return Correspondences(
+        sketch=_map_from_json(maps["sketch"], folder),
+        metric=_map_from_json(maps["metric"], folder),
+        cliques=tuple(_clique_from_json(clique) for clique in document["cliques"]),
+        annotator=document.get("annotator", ""),
+        created=document.get("created", ""),
+        modified=document.get("modified", ""),
+        extra=_unknown(document, TOP_KEYS),
+        maps_extra=_unknown(maps, MAPS_KEYS),
+    )
+
+
+def _map_from_json(item: dict, folder: Path) -> MapRef:
+    segmentation = item.get("segmentation") or {}
+    size = item.get("size")
+    return MapRef(
+        path=_resolve(item.get("path"), folder),
+        sha256=item.get("sha256"),
+        size=None if size is None else tuple(size),
+        segmentation_method=segmentation.get("method"),
+        segmentation_params=segmentation.get("params", {}),
+        labels_path=_resolve(segmentation.get("labels"), folder),
+        segmentation_extra=_unknown(segmentation, SEGMENTATION_KEYS),
+        extra=_unknown(item, MAP_KEYS),
+    )
+
+
+def _clique_from_json(item: dict) -> Clique:
+    return Clique(
+        id=item["id"],
+        sketch_points=item["sketch_points"],
+        metric_points=item["metric_points"],
+        sketch_regions=item.get("sketch_regions", ()),
+        metric_regions=item.get("metric_regions", ()),
+        source=item.get("source", "manual"),
+        score=item.get("score"),
+        note=item.get("note", ""),
+        status=item.get("status"),
+        extra=_unknown(item, CLIQUE_KEYS),
+    )
+
+
+def _unknown(item: dict, known: Sequence[str]) -> dict:
+    return {key: value for key, value in item.items() if key not in known}
+
+
+def _resolve(text: str | None, folder: Path) -> Path | None:
+    if text is None:
+        return None
+    candidate = Path(text)
+    if not candidate.is_absolute():
+        candidate = folder / candidate
+    return Path(os.path.normpath(candidate))
+
+
+def _relative(path: Path | None, folder: Path) -> str | None:
+    if path is None:
+        return None
+    absolute = os.path.abspath(path)
+    try:
+        relative = os.path.relpath(absolute, folder)
+    except ValueError:
+        # Another drive on Windows: no relative path exists.
+        return PurePath(absolute).as_posix()
+    # Forward slashes read back on every platform.
+    return PurePath(relative).as_posix()
+
+
+def _to_document(corr: Correspondences, folder: Path) -> dict:
+    maps = {
+        "sketch": _map_to_json(corr.sketch, folder),
+        "metric": _map_to_json(corr.metric, folder),
+        **corr.maps_extra,
+    }
+    return {
+        "format": FORMAT_NAME,
+        "version": CURRENT_VERSION,
+        "annotator": corr.annotator,
+        "created": corr.created,
+        "modified": corr.modified,
+        "maps": maps,
+        "cliques": [_clique_to_json(clique) for clique in corr.cliques],
+        **corr.extra,
+    }
+
+
+def _map_to_json(ref: MapRef, folder: Path) -> dict:
+    return {
+        "path": _relative(ref.path, folder),
+        "sha256": ref.sha256,
+        "size": None if ref.size is None else list(ref.size),
+        "segmentation": {
+            "method": ref.segmentation_method,
+            "params": ref.segmentation_params,
+            "labels": _relative(ref.labels_path, folder),
+            **ref.segmentation_extra,
+        },
+        **ref.extra,
+    }
+
+
+def _clique_to_json(clique: Clique) -> dict:
+    item: dict[str, Any] = {
+        "id": clique.id,
+        "sketch_points": [list(point) for point in clique.sketch_points],
+        "metric_points": [list(point) for point in clique.metric_points],
+        "sketch_regions": list(clique.sketch_regions),
+        "metric_regions": list(clique.metric_regions),
+        "source": clique.source,
+    }
+    # Optional keys are written only when set, which keeps files short and diffs small.
+    if clique.score is not None:
+        item["score"] = clique.score
+    if clique.note:
+        item["note"] = clique.note
+    if clique.status is not None:
+        item["status"] = clique.status
+    item.update(clique.extra)
+    return item
+
+
+# A JSON array holding only numbers, as json.dumps(indent=...) spreads it over
+# several lines. Raw newlines never occur inside JSON strings (they are escaped),
+# so requiring them keeps this from touching string content.
+_NUMBER = r"-?[0-9]+(?:\.[0-9]+)?(?:[eE][-+]?[0-9]+)?"
+_NUMBER_LIST = re.compile(r"\[\n\s*(" + _NUMBER + r"(?:,\n\s*" + _NUMBER + r")*)\n\s*\]")
+
+
+def _collapse_number_lists(text: str) -> str:
+    # [row, col] points and region lists on one line each: a file a person can read.
+    return _NUMBER_LIST.sub(lambda match: "[" + ", ".join(re.split(r",\n\s*", match.group(1))) + "]", text)
