@@ -25,10 +25,12 @@ from pathlib import Path
 import numpy as np
 
 from ursim_core.errors import MapError
+from ursim_core.io.reading import read_regular_file
 
 __all__ = [
     "Pixels",
     "read_file_bytes",
+    "max_image_bytes",
     "decode_image",
     "pixels_from_array",
     "row_blocks",
@@ -70,19 +72,79 @@ class Pixels:
 # Reading and decoding files
 
 
-def read_file_bytes(path: Path, *, empty_problem: str) -> bytes:
+def max_image_bytes(max_pixels: int) -> int:
+    """The largest file accepted for an image of at most ``max_pixels`` pixels.
+
+    16 bytes a pixel (uncompressed 16-bit RGBA is 8; a PNG's filter bytes and a TIFF's strips
+    add little) plus 64 MiB of metadata: no real image within the pixel limit is refused,
+    and nothing much larger than it is ever read into memory.
+    """
+    return 16 * max_pixels + 64 * 1024**2
+
+
+def read_file_bytes(path: Path, *, empty_problem: str, max_pixels: int) -> bytes:
+    """The bytes of an image file, refused early when its size or header says it is unusable.
+
+    The size comes from ``stat`` (see :mod:`ursim_core.io.reading`); the pixel count from
+    the header in the first MiB, before the rest is read.
+    """
     # Reading everything once means the digest describes exactly the bytes that get decoded.
-    if path.is_dir():
-        raise MapError("is a directory, not a map file", path=path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise MapError("file not found", path=path) from None
-    except OSError as error:
-        raise MapError(f"cannot read the file: {error.strerror or error}", path=path) from error
-    if not data:
-        raise MapError(empty_problem, path=path)
-    return data
+    return read_regular_file(
+        path,
+        max_bytes=max_image_bytes(max_pixels),
+        error=MapError,
+        what="map file",
+        empty_problem=empty_problem,
+        limit_reason=f" (an image of at most max_pixels={max_pixels} pixels)",
+        check_head=lambda head, complete: _check_header(head, path, max_pixels=max_pixels, complete=complete),
+    )
+
+
+# Formats whose header Pillow may need more than the first MiB to read (a TIFF's first
+# directory can sit at the end of the file; a JPEG may carry large APP segments first).
+_LATE_HEADER_SIGNATURES = (b"II*\x00", b"MM\x00*", b"\xff\xd8", b"\x89PNG", b"8BPS")
+
+
+def _check_header(head: bytes, path: Path, *, max_pixels: int, complete: bool) -> None:
+    """Refuse from the first bytes alone: not an image, zero size, or too many pixels."""
+    from PIL import Image
+
+    with _quiet_pillow(max_pixels):
+        try:
+            width, height = Image.open(io.BytesIO(head)).size
+        except Image.DecompressionBombError:
+            raise MapError(_too_many_pixels(head, max_pixels), path=path) from None
+        except Exception:
+            if complete or head.startswith(_LATE_HEADER_SIGNATURES):
+                return  # the full decode gives the precise message
+            raise MapError("not an image (or a format Pillow cannot read)", path=path) from None
+    _check_dimensions(width, height, path, max_pixels=max_pixels)
+
+
+def _check_dimensions(width: int, height: int, path: Path, *, max_pixels: int) -> None:
+    if width == 0 or height == 0:
+        raise MapError(f"zero-size image ({width} x {height} pixels)", path=path)
+    if width * height > max_pixels:
+        raise MapError(
+            f"image has {width * height} pixels ({width} x {height}), more than the limit "
+            f"max_pixels={max_pixels} (checked from the header before decoding)",
+            path=path,
+        )
+
+
+def _too_many_pixels(data: bytes, max_pixels: int) -> str:
+    declared = _declared_size(data)
+    size = f"{declared[0] * declared[1]} pixels ({declared[0]} x {declared[1]}), " if declared else ""
+    return f"image has {size}more than the limit max_pixels={max_pixels} (checked from the header before decoding)"
+
+
+@contextlib.contextmanager
+def _quiet_pillow(max_pixels: int) -> Iterator[None]:
+    """Our pixel limit, and no Pillow warning on the console: our errors say what is wrong."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with _pillow_pixel_limit(max_pixels):
+            yield
 
 
 @contextlib.contextmanager
@@ -134,14 +196,11 @@ def _declared_size(data: bytes) -> tuple[int, int] | None:
 def decode_image(data: bytes, path: Path, *, max_pixels: int, apply_exif_orientation: bool) -> Pixels:
     from PIL import Image, UnidentifiedImageError
 
-    with _pillow_pixel_limit(max_pixels):
+    with _quiet_pillow(max_pixels):
         try:
             image = Image.open(io.BytesIO(data))
-        except Image.DecompressionBombError as error:
-            raise MapError(
-                f"image larger than the limit max_pixels={max_pixels} (checked from the header before decoding: {error})",
-                path=path,
-            ) from None
+        except Image.DecompressionBombError:
+            raise MapError(_too_many_pixels(data, max_pixels), path=path) from None
         except UnidentifiedImageError:
             declared = _declared_size(data)
             if declared is not None and 0 in declared:
@@ -153,27 +212,20 @@ def decode_image(data: bytes, path: Path, *, max_pixels: int, apply_exif_orienta
             raise MapError(f"corrupt image header: {error}", path=path) from error
 
     width, height = image.size
-    if width == 0 or height == 0:
-        raise MapError(f"zero-size image ({width} x {height} pixels)", path=path)
-    if width * height > max_pixels:
-        raise MapError(
-            f"image has {width * height} pixels ({width} x {height}), more than the limit "
-            f"max_pixels={max_pixels} (checked from the header before decoding)",
-            path=path,
-        )
-    try:
-        if image.format == "PNG":
-            # Pillow stops decoding once it has all rows, so a PNG cut inside its last
-            # chunk loads silently; verify() walks every chunk and checks its CRC.
-            with _pillow_pixel_limit(max_pixels):
+    _check_dimensions(width, height, path, max_pixels=max_pixels)
+    with _quiet_pillow(max_pixels):
+        try:
+            if image.format == "PNG":
+                # Pillow stops decoding once it has all rows, so a PNG cut inside its last
+                # chunk loads silently; verify() walks every chunk and checks its CRC.
                 Image.open(io.BytesIO(data)).verify()
-        image.load()
-    except MemoryError:
-        raise
-    except Exception as error:
-        raise MapError(f"truncated or corrupt image data: {error}", path=path) from error
-    if apply_exif_orientation:
-        image = _exif_oriented(image)
+            image.load()
+        except MemoryError:
+            raise
+        except Exception as error:
+            raise MapError(f"truncated or corrupt image data: {error}", path=path) from error
+        if apply_exif_orientation:
+            image = _exif_oriented(image)
     return _pixels_from_pillow(image, path)
 
 

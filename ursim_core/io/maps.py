@@ -205,7 +205,7 @@ def load_map(
             occupancy=ros.occupancy,
             image=ros.image,
         )
-    data = read_file_bytes(path, empty_problem="empty file (0 bytes): zero-size image")
+    data = read_file_bytes(path, empty_problem="empty file (0 bytes): zero-size image", max_pixels=max_pixels)
     pixels = decode_image(data, path, max_pixels=max_pixels, apply_exif_orientation=True)
     return _binary_map(
         pixels,
@@ -396,12 +396,22 @@ def _binary_map(pixels: Pixels, *, threshold: float, nonzero_free: bool, path: P
 
     grey = display_grey(pixels)
     transparent = transparent_mask(pixels.alpha)
+    hidden = 0
     if transparent is not None:
+        # Free-looking pixels that are transparent: the usual surprise of a palette PNG whose
+        # white entry carries tRNS transparency.
+        hidden = int(np.count_nonzero(transparent & (grey > threshold)))
         grey[transparent] = 0
     free = grey > threshold
     if not free.any():
         if transparent is not None and transparent.all():
             reason = "every pixel is transparent"
+        elif hidden:
+            reason = (
+                f"the {hidden} pixels brighter than threshold {threshold} are all transparent "
+                "(alpha < 50 %, e.g. a palette whose white entry is marked transparent), "
+                "and transparent pixels are outside the map"
+            )
         else:
             reason = f"no grey value above threshold {threshold} (the brightest is {int(grey.max())})"
         raise MapError(f"no free pixel: {reason}", path=path)

@@ -9,9 +9,11 @@ as GraphicsMagick Q16 computes it. :func:`ursim_core.io.load_map` turns the resu
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import numbers
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -19,6 +21,7 @@ import numpy as np
 
 from ursim_core.errors import MapError
 from ursim_core.io.images import Pixels, decode_image, display_grey, read_file_bytes, row_blocks, transparent_mask
+from ursim_core.io.reading import read_regular_file
 
 __all__ = [
     "RosMap",
@@ -63,13 +66,7 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
     MapError
         The YAML or its image is unreadable or invalid, or the map has no free cell.
     """
-    import yaml
-
-    text = read_file_bytes(yaml_path, empty_problem="empty file (0 bytes): not a ROS map YAML")
-    try:
-        document = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        raise MapError(f"not valid YAML: {error}", path=yaml_path) from None
+    document = _parse_yaml(yaml_path)
     if not isinstance(document, dict):
         raise MapError(
             "not a ROS map_server YAML file: expected a mapping with keys image, resolution, "
@@ -81,14 +78,15 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
     image_path = Path(settings["image"])
     if not image_path.is_absolute():
         image_path = yaml_path.parent / image_path
-    if not image_path.exists():
-        raise MapError(f"image file not found: {image_path}", path=yaml_path, field="image")
+    shown = _cut(str(image_path), 200)
+    if not os.path.lexists(image_path):
+        raise MapError(f"image file not found: {shown}", path=yaml_path, field="image")
     try:
-        data = read_file_bytes(image_path, empty_problem="empty file (0 bytes): zero-size image")
+        data = read_file_bytes(image_path, empty_problem="empty file (0 bytes): zero-size image", max_pixels=max_pixels)
         # nav2 loads through GraphicsMagick without auto-orientation, so EXIF is ignored here.
         pixels = decode_image(data, image_path, max_pixels=max_pixels, apply_exif_orientation=False)
     except MapError as error:
-        raise MapError(f"cannot load the image {image_path}: {error.problem}", path=yaml_path, field="image") from error
+        raise MapError(f"cannot load the image {shown}: {error.problem}", path=yaml_path, field="image") from error
 
     occupancy = _nav2_occupancy(
         pixels,
@@ -120,6 +118,124 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
     )
 
 
+# A map_server YAML file is a handful of keys: these bounds are far above any real one and far
+# below what an alias bomb or a deeply nested file needs to hurt (seconds, gigabytes).
+MAX_YAML_BYTES = 1024**2
+MAX_YAML_DEPTH = 32
+MAX_YAML_NODES = 100_000
+
+
+class _YamlRefused(Exception):
+    def __init__(self, problem: str, mark=None):
+        super().__init__(problem)
+        self.problem = problem
+        self.mark = mark
+
+
+@functools.cache
+def _bounded_loader():
+    """A ``yaml.SafeLoader`` that refuses aliases and bounds depth and size while composing."""
+    import yaml
+
+    class BoundedLoader(yaml.SafeLoader):
+        depth = 0
+        nodes = 0
+
+        def compose_node(self, parent, index):
+            if self.check_event(yaml.AliasEvent):
+                event = self.peek_event()
+                raise _YamlRefused(
+                    f"YAML aliases (*{_cut(event.anchor, 40)}) are not accepted in a map file", event.start_mark
+                )
+            self.nodes += 1
+            if self.nodes > MAX_YAML_NODES:
+                raise _YamlRefused(f"more than {MAX_YAML_NODES} YAML values", self.peek_event().start_mark)
+            self.depth += 1
+            try:
+                if self.depth > MAX_YAML_DEPTH:
+                    raise _YamlRefused(f"nested deeper than {MAX_YAML_DEPTH} levels", self.peek_event().start_mark)
+                return super().compose_node(parent, index)
+            finally:
+                self.depth -= 1
+
+    return BoundedLoader
+
+
+def _parse_yaml(yaml_path: Path):
+    """The YAML document of ``yaml_path``, or a one-line MapError naming the file."""
+    import yaml
+
+    raw = read_regular_file(
+        yaml_path,
+        max_bytes=MAX_YAML_BYTES,
+        error=MapError,
+        what="ROS map YAML file",
+        empty_problem="empty file (0 bytes): not a ROS map YAML",
+    )
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line = raw[: error.start].count(b"\n") + 1
+        raise MapError(
+            f"not UTF-8 text (byte {error.start}, line {line}): not a ROS map YAML", path=yaml_path
+        ) from None
+    loader = _bounded_loader()(text)
+    try:
+        return loader.get_single_data()
+    except _YamlRefused as error:
+        raise MapError(f"not accepted as YAML: {error.problem}{_at(error.mark)}", path=yaml_path) from None
+    except yaml.YAMLError as error:
+        raise MapError(f"not valid YAML: {_yaml_problem(error)}", path=yaml_path) from None
+    except (ValueError, OverflowError, RecursionError, MemoryError) as error:
+        # e.g. an integer of more than 4300 digits: Python's int() refuses to convert it.
+        raise MapError(f"not valid YAML for a map: {_cut(str(error), 120)}", path=yaml_path) from None
+    finally:
+        loader.dispose()
+
+
+def _yaml_problem(error) -> str:
+    import yaml
+
+    if not isinstance(error, yaml.MarkedYAMLError):
+        return _cut(" ".join(str(error).split()), 200)
+    problem = error.problem or error.context or "syntax error"
+    if "'\\t'" in problem:
+        problem += " (a tab: YAML indents with spaces)"
+    if error.context and error.problem:
+        problem = f"{problem} ({error.context})"
+    return _cut(" ".join(problem.split()), 200) + _at(error.problem_mark or error.context_mark)
+
+
+def _at(mark) -> str:
+    return "" if mark is None else f" at line {mark.line + 1}, column {mark.column + 1}"
+
+
+def short(value, limit: int = 60) -> str:
+    """``repr`` of ``value`` on one line, cut to ``limit`` characters, for messages.
+
+    Examples
+    --------
+    >>> short("x" * 100, 10)
+    "'xxxxxx..."
+    """
+    return _cut(_repr(value), limit)
+
+
+def _cut(text: str, limit: int) -> str:
+    text = " ".join(text.splitlines())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _repr(value) -> str:
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**50:
+        # repr of a 5000-digit int raises; say what it is instead.
+        return f"an integer of {len(str(abs(value))) if abs(value) < 10**4000 else 'over 4000'} digits"
+    try:
+        return repr(value)
+    except (ValueError, RecursionError):
+        return f"a {type(value).__name__}"
+
+
 def _ros_settings(document: dict, yaml_path: Path) -> dict:
     """Validated map_server keys, with nav2's meaning and the defaults in _ROS_DEFAULTS."""
 
@@ -132,31 +248,33 @@ def _ros_settings(document: dict, yaml_path: Path) -> dict:
 
     image = document["image"]
     if not isinstance(image, str) or not image.strip():
-        raise fail("image", f"must be a non-empty file path, got {image!r}")
+        raise fail("image", f"must be a non-empty file path, got {short(image)}")
+    if "\x00" in image:
+        raise fail("image", f"the file path contains a NUL character: {short(image)}")
 
     resolution = document["resolution"]
-    if not _is_real_number(resolution) or not math.isfinite(resolution) or resolution <= 0:
-        raise fail("resolution", f"must be a positive number (metres per pixel), got {resolution!r}")
+    if not _is_finite_number(resolution) or resolution <= 0:
+        raise fail("resolution", f"must be a positive number (metres per pixel), got {short(resolution)}")
 
     origin = document["origin"]
     if (
         not isinstance(origin, (list, tuple))
         or len(origin) != 3
-        or not all(_is_real_number(value) and math.isfinite(value) for value in origin)
+        or not all(_is_finite_number(value) for value in origin)
     ):
-        raise fail("origin", f"must be a list of 3 finite numbers [x, y, yaw], got {origin!r}")
+        raise fail("origin", f"must be a list of 3 finite numbers [x, y, yaw], got {short(origin)}")
 
     negate = document.get("negate", _ROS_DEFAULTS["negate"])
     if isinstance(negate, bool):
         negate = int(negate)
     if not isinstance(negate, int) or negate not in (0, 1):
-        raise fail("negate", f"must be 0 or 1, got {negate!r}")
+        raise fail("negate", f"must be 0 or 1, got {short(negate)}")
 
     thresholds = {}
     for key in ("occupied_thresh", "free_thresh"):
         value = document.get(key, _ROS_DEFAULTS[key])
         if not _is_real_number(value) or not 0 <= value <= 1:
-            raise fail(key, f"must be a number in [0, 1], got {value!r}")
+            raise fail(key, f"must be a number in [0, 1], got {short(value)}")
         thresholds[key] = float(value)
     if thresholds["free_thresh"] >= thresholds["occupied_thresh"]:
         raise fail(
@@ -166,7 +284,7 @@ def _ros_settings(document: dict, yaml_path: Path) -> dict:
 
     mode = document.get("mode", _ROS_DEFAULTS["mode"])
     if mode not in _ROS_MODES:
-        raise fail("mode", f"must be one of {', '.join(_ROS_MODES)}, got {mode!r}")
+        raise fail("mode", f"must be one of {', '.join(_ROS_MODES)}, got {short(mode)}")
 
     return {
         "image": image,
@@ -238,3 +356,13 @@ def _nav2_occupancy(
 def _is_real_number(value) -> bool:
     # bool is an int subclass; a flag passed by mistake must not read as 0 or 1.
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _is_finite_number(value) -> bool:
+    if not _is_real_number(value):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        # An integer of hundreds of digits: no float holds it.
+        return False
