@@ -10,13 +10,14 @@ from __future__ import annotations
 import dataclasses
 import math
 import operator
+import warnings
 from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 from scipy import ndimage
 
 from ursim_core.correspondences.values import Clique, Correspondences
-from ursim_core.errors import SegmentationError
+from ursim_core.errors import RegionsRecomputedWarning, SegmentationError
 
 __all__ = ["regions_at_points", "assign_regions", "from_pairs"]
 
@@ -139,6 +140,12 @@ def assign_regions(
     SegmentationError
         A label image's shape differs from the size recorded for its map.
 
+    Warns
+    -----
+    RegionsRecomputedWarning
+        Some cliques carried region ids that their points contradict (e.g. labels of
+        another segmentation); the ids of the points replace them.
+
     Examples
     --------
     >>> labels = np.array([[1, 1, 0, 2, 2]], dtype=np.int32)
@@ -158,6 +165,23 @@ def assign_regions(
             )
     sketch_regions = _regions_per_clique(sketch_labels, [c.sketch_points for c in corr.cliques], tolerance)
     metric_regions = _regions_per_clique(metric_labels, [c.metric_points for c in corr.cliques], tolerance)
+    # Cliques that carried region ids (not a fresh .dat file) whose ids the points contradict.
+    changed = [
+        clique.id
+        for clique, sketch, metric in zip(corr.cliques, sketch_regions, metric_regions)
+        if (clique.sketch_regions or clique.metric_regions)
+        and (set(clique.sketch_regions) != set(sketch) or set(clique.metric_regions) != set(metric))
+    ]
+    if changed:
+        listed = ", ".join(str(clique_id) for clique_id in changed[:10]) + (", ..." if len(changed) > 10 else "")
+        noun = "clique" if len(changed) == 1 else "cliques"
+        warnings.warn(
+            RegionsRecomputedWarning(
+                f"the region ids of {len(changed)} {noun} ({noun} {listed}) disagreed with their points "
+                "and were recomputed from the points"
+            ),
+            stacklevel=2,
+        )
     return corr.with_cliques(
         dataclasses.replace(clique, sketch_regions=sketch, metric_regions=metric)
         for clique, sketch, metric in zip(corr.cliques, sketch_regions, metric_regions)

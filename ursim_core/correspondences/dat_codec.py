@@ -5,15 +5,15 @@ Read with :func:`load_dat`, written with :func:`save_dat`.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import re
 import urllib.parse
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
-from ursim_core.correspondences.json_codec import read_file_bytes
+from ursim_core.correspondences.files import read_file_bytes, write_guarded
 from ursim_core.correspondences.values import Clique, Correspondences, MapRef
 from ursim_core.errors import FormatError
-from ursim_core.io.atomic import atomic_write_text
 
 __all__ = ["load_dat", "save_dat"]
 
@@ -21,6 +21,8 @@ __all__ = ["load_dat", "save_dat"]
 _DAT_SET = re.compile(r"^#\s*(\d+)\s*match set$")
 _DAT_SIDE = re.compile(r"^#\s*map([12])$")
 _DAT_POINT = re.compile(r"^(\d+)\s+(\d+)$")
+# A pixel coordinate has a handful of digits; Python refuses int() of more than 4300.
+_MAX_DIGITS = 18
 _DAT_NO_PATH = "-"
 
 
@@ -63,15 +65,16 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
     ('a.png', ((228, 302),), ((166, 308),))
     """
     path = Path(path)
-    lines = _read_dat_lines(path)
+    raw = read_file_bytes(path, what=".dat file")
+    lines = _dat_lines(raw, path)
     if not lines:
         raise FormatError("empty file; expected a '# <map1 path> <map2 path>' header", path=path)
     sketch_ref, metric_ref = _parse_dat_header(lines[0], path)
 
     sets: list[dict] = []
     current: dict | None = None
-    for number, raw in enumerate(lines[1:], start=2):
-        line = raw.strip()
+    for number, text_line in enumerate(lines[1:], start=2):
+        line = text_line.strip()
         if not line:
             continue
         if _DAT_SET.match(line):
@@ -94,11 +97,16 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
         if point:
             if current is None or current["side"] is None:
                 raise FormatError(f"line {number}: point {line!r} before '# map1' or '# map2'", path=path)
+            digits = max(len(point.group(1)), len(point.group(2)))
+            if digits > _MAX_DIGITS:
+                raise FormatError(
+                    f"line {number}: a number of {digits} digits is too large for a pixel coordinate", path=path
+                )
             current["points"][current["side"]].append((int(point.group(1)), int(point.group(2))))
             continue
         raise FormatError(
             f"line {number}: expected 'ROW COL' (two non-negative integers), '# Kmatch set', "
-            f"'# map1' or '# map2', got {raw.strip()!r}",
+            f"'# map1' or '# map2', got {text_line.strip()!r}",
             path=path,
         )
     _finish_dat_set(current, len(lines) + 1, path)
@@ -109,10 +117,12 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
         if drop_empty and not sketch_points and not metric_points:
             continue
         cliques.append(Clique(id=len(cliques) + 1, sketch_points=sketch_points, metric_points=metric_points))
-    return Correspondences(sketch=sketch_ref, metric=metric_ref, cliques=tuple(cliques))
+    return Correspondences(
+        sketch=sketch_ref, metric=metric_ref, cliques=tuple(cliques), loaded_sha256=hashlib.sha256(raw).hexdigest()
+    )
 
 
-def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
+def save_dat(corr: Correspondences, path: str | os.PathLike, *, expected_sha256: str | None = None) -> str:
     """Write ``corr`` in the original annotators' ``.dat`` format, atomically.
 
     Only points are written (the format has nothing else); match sets are
@@ -128,9 +138,23 @@ def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
         What to write.
     path : str or path-like
         Destination ``.dat`` file.
+    expected_sha256 : str, optional
+        The digest the file had when loaded (``corr.loaded_sha256``): refuse to overwrite it
+        if it changed on disk since.
+
+    Returns
+    -------
+    str
+        SHA-256 of the bytes written.
 
     Raises
     ------
+    FileChangedError
+        ``expected_sha256`` was given and the file now holds other bytes.
+    SaveRefusedError
+        ``path`` is one of the maps (or label images) of ``corr``.
+    FormatError
+        A map path cannot be written in the header.
     OSError
         Writing failed; an existing file is left unchanged.
 
@@ -140,7 +164,7 @@ def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "gt.dat"
     >>> corr = Correspondences(MapRef(path="a.png"), MapRef(path="b.png"),
     ...                        cliques=(Clique(id=1, sketch_points=[(1, 2)], metric_points=[(3, 4)]),))
-    >>> save_dat(corr, target)
+    >>> digest = save_dat(corr, target)
     >>> print(target.read_text(), end="")
     # a.png b.png
     # 0match set
@@ -150,7 +174,8 @@ def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
     3 4
     <BLANKLINE>
     """
-    lines = [f"# {_dat_header_token(corr.sketch)} {_dat_header_token(corr.metric)}"]
+    path = Path(path)
+    lines = [f"# {_dat_header_token(corr.sketch, path)} {_dat_header_token(corr.metric, path)}"]
     for index, clique in enumerate(corr.cliques):
         lines.append(f"# {index}match set")
         lines.append("# map1")
@@ -158,11 +183,11 @@ def save_dat(corr: Correspondences, path: str | os.PathLike) -> None:
         lines.append("# map2")
         lines.extend(f"{row} {col}" for row, col in clique.metric_points)
         lines.append("")
-    atomic_write_text(path, "\n".join(lines) + "\n")
+    data = ("\n".join(lines) + "\n").encode("utf-8")
+    return write_guarded(corr, path, data, expected_sha256=expected_sha256, what=".dat file")
 
 
-def _read_dat_lines(path: Path) -> list[str]:
-    raw = read_file_bytes(path, what="a .dat file")
+def _dat_lines(raw: bytes, path: Path) -> list[str]:
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -174,15 +199,22 @@ def _read_dat_lines(path: Path) -> list[str]:
 def _parse_dat_header(line: str, path: Path) -> tuple[MapRef, MapRef]:
     tokens = line.strip().lstrip("#").split() if line.strip().startswith("#") else None
     if tokens is None or len(tokens) != 2:
-        raise FormatError(f"line 1: expected '# <map1 path> <map2 path>', got {line.strip()!r}", path=path)
+        raise FormatError(f"line 1: expected '# <map1 path> <map2 path>', got {_cut(line.strip())!r}", path=path)
     refs = []
     for token in tokens:
         if token == _DAT_NO_PATH:
             refs.append(MapRef())
-        else:
-            text = urllib.parse.unquote(token)
-            refs.append(MapRef(path=Path(text), extra={"dat_path": text}))
+            continue
+        # %XX escapes of bytes that are not UTF-8 come back as the same bytes (surrogateescape).
+        text = urllib.parse.unquote(token, errors="surrogateescape")
+        if "\x00" in text:
+            raise FormatError(f"line 1: a map path contains a NUL character: {_cut(token)!r}", path=path)
+        refs.append(MapRef(path=Path(text), extra={"dat_path": text}))
     return refs[0], refs[1]
+
+
+def _cut(text: str, limit: int = 80) -> str:
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _finish_dat_set(current: dict | None, number: int, path: Path) -> None:
@@ -193,12 +225,40 @@ def _finish_dat_set(current: dict | None, number: int, path: Path) -> None:
         )
 
 
-def _dat_header_token(ref: MapRef) -> str:
+def _dat_header_token(ref: MapRef, target: Path) -> str:
     if ref.path is None:
         return _DAT_NO_PATH
     written = ref.extra.get("dat_path")
-    text = written if isinstance(written, str) and Path(written) == ref.path else ref.path.as_posix()
+    if isinstance(written, str) and _still_names(written, ref.path):
+        text = written
+    else:
+        text = ref.path.as_posix()
     if text == _DAT_NO_PATH:
         return "%2D"  # a file really named "-", not to be read back as "no path"
-    # Escape only what breaks the header, so ordinary paths stay readable.
-    return "".join(urllib.parse.quote(char, safe="") if char.isspace() or char == "%" else char for char in text)
+    # Escape only what breaks the header (white space, %) or is not UTF-8, so ordinary paths
+    # stay readable and every path reads back as the same bytes.
+    return "".join(_escaped(char, target) for char in text)
+
+
+def _escaped(char: str, target: Path) -> str:
+    if char.isspace() or char == "%":
+        return urllib.parse.quote(char, safe="")
+    if "\udc80" <= char <= "\udcff":
+        # A byte of a file name that is not UTF-8, as os.fsdecode keeps it.
+        return f"%{ord(char) - 0xDC00:02X}"
+    if "\ud800" <= char <= "\udfff":
+        raise FormatError(f"a map path holds a lone surrogate {char!r}: it is no file name", path=target)
+    return char
+
+
+def _still_names(written: str, path: Path) -> bool:
+    """Whether the header path ``written`` still names ``path``.
+
+    A .dat header path is relative to a folder nobody recorded (the published files name
+    ``../../../../Test/...``), so after a trip through JSON, which resolves paths, the map is
+    still the same when the resolved path ends with the written one.
+    """
+    if Path(written) == path:
+        return True
+    tail = [part for part in PurePosixPath(written).parts if part not in ("..", ".", "/")]
+    return bool(tail) and list(path.parts[-len(tail) :]) == tail

@@ -9,14 +9,26 @@ the "Correspondence format" section of README.md.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
+import math
 import os
 import re
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path, PurePath
 from typing import Any
 
-from ursim_core.correspondences.schema import CURRENT_VERSION, FORMAT_NAME, json_type, short, validate
+from ursim_core.correspondences.files import read_file_bytes, write_guarded
+from ursim_core.correspondences.schema import (
+    CURRENT_VERSION,
+    FORMAT_NAME,
+    OutOfRange,
+    field_path,
+    json_type,
+    short,
+    validate,
+)
 from ursim_core.correspondences.values import (
     CLIQUE_KEYS,
     MAP_KEYS,
@@ -28,15 +40,14 @@ from ursim_core.correspondences.values import (
     MapRef,
     utc_timestamp,
 )
-from ursim_core.errors import FormatError
-from ursim_core.io.atomic import atomic_write_text
+from ursim_core.errors import FormatError, MapChangedWarning
 
 __all__ = [
     "SUPPORTED_VERSIONS",
     "load_correspondences",
     "save_correspondences",
     "correspondences_to_json",
-    "read_file_bytes",
+    "MAX_DEPTH",
 ]
 
 # version n -> function turning a version-n document (a dict) into a version n+1
@@ -47,15 +58,19 @@ _MIGRATIONS: dict[int, Callable[[dict], dict]] = {}
 SUPPORTED_VERSIONS = tuple(sorted({CURRENT_VERSION, *_MIGRATIONS}))
 
 
-def load_correspondences(path: str | os.PathLike) -> Correspondences:
+def load_correspondences(path: str | os.PathLike, *, sketch_map=None, metric_map=None) -> Correspondences:
     """Read and validate a correspondence JSON file.
 
-    Map and label paths, stored relative to the file's folder, come back absolute.
+    Map and label paths, stored relative to the file's folder, come back absolute. The
+    value's ``loaded_sha256`` is the digest of the bytes read (pass it to the next save).
 
     Parameters
     ----------
     path : str or path-like
         The ``.json`` file.
+    sketch_map, metric_map : Map, optional
+        The maps in use (anything with a ``sha256``): a :class:`MapChangedWarning` is
+        issued when the file recorded another digest for that side.
 
     Returns
     -------
@@ -73,20 +88,42 @@ def load_correspondences(path: str | os.PathLike) -> Correspondences:
     --------
     >>> import tempfile, pathlib
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "pair.json"
-    >>> save_correspondences(Correspondences(cliques=(Clique(id=1, sketch_points=[(1, 2)]),)), target)
+    >>> digest = save_correspondences(Correspondences(cliques=(Clique(id=1, sketch_points=[(1, 2)]),)), target)
     >>> load_correspondences(target).cliques[0].sketch_points
     ((1, 2),)
     """
     path = Path(path)
-    document = _read_json_object(path)
+    raw = read_file_bytes(path, what="correspondence file")
+    document = _parse_json_object(raw, path)
     document = _upgrade(document, path)
+    _check_values(document, path)
     validate(document, path)
     _check_unique_ids(document, path)
     folder = Path(os.path.abspath(path)).parent
-    return _from_document(document, folder)
+    corr = _from_document(document, folder, path)
+    corr = dataclasses.replace(corr, loaded_sha256=hashlib.sha256(raw).hexdigest())
+    for side, ref, loaded in (("sketch", corr.sketch, sketch_map), ("metric", corr.metric, metric_map)):
+        _warn_if_changed(side, ref, loaded, path)
+    return corr
 
 
-def save_correspondences(corr: Correspondences, path: str | os.PathLike, *, now: str | None = None) -> None:
+def _warn_if_changed(side: str, ref: MapRef, loaded, path: Path) -> None:
+    actual = getattr(loaded, "sha256", None)
+    if loaded is None or ref.sha256 is None or actual is None or actual.lower() == ref.sha256.lower():
+        return
+    warnings.warn(
+        MapChangedWarning(
+            f"{path}: the {side} map {getattr(loaded, 'path', None) or ref.path} is not the one these "
+            f"correspondences were made on (SHA-256 {actual[:12]}... instead of {ref.sha256[:12]}...): "
+            "points may no longer fall on the same places"
+        ),
+        stacklevel=3,
+    )
+
+
+def save_correspondences(
+    corr: Correspondences, path: str | os.PathLike, *, now: str | None = None, expected_sha256: str | None = None
+) -> str:
     """Write ``corr`` as a version-1 correspondence JSON file, atomically.
 
     ``modified`` is set to the current time (and ``created`` too if it is
@@ -104,9 +141,21 @@ def save_correspondences(corr: Correspondences, path: str | os.PathLike, *, now:
         Destination ``.json`` file; its folder must exist.
     now : str, optional
         Timestamp to record instead of the current time (reproducible output).
+    expected_sha256 : str, optional
+        The digest the file had when it was loaded (``corr.loaded_sha256``). When given and
+        the file now holds other bytes (another session saved it), nothing is written.
+
+    Returns
+    -------
+    str
+        SHA-256 of the bytes written: the ``expected_sha256`` of the next save.
 
     Raises
     ------
+    FileChangedError
+        ``expected_sha256`` was given and the file changed on disk since.
+    SaveRefusedError
+        ``path`` is one of the maps or label images ``corr`` refers to.
     FormatError
         The content cannot be represented (e.g. a non-JSON value in ``extra``).
     OSError
@@ -116,7 +165,7 @@ def save_correspondences(corr: Correspondences, path: str | os.PathLike, *, now:
     --------
     >>> import tempfile, pathlib
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "pair.json"
-    >>> save_correspondences(Correspondences(annotator="ana"), target, now="2024-05-01T12:00:00Z")
+    >>> digest = save_correspondences(Correspondences(annotator="ana"), target, now="2024-05-01T12:00:00Z")
     >>> load_correspondences(target).modified
     '2024-05-01T12:00:00Z'
     """
@@ -124,7 +173,8 @@ def save_correspondences(corr: Correspondences, path: str | os.PathLike, *, now:
     timestamp = utc_timestamp() if now is None else now
     stamped = dataclasses.replace(corr, created=corr.created or timestamp, modified=timestamp)
     text = correspondences_to_json(stamped, folder=Path(os.path.abspath(path)).parent, path=path)
-    atomic_write_text(path, text)
+    data = text.encode("utf-8")
+    return write_guarded(corr, path, data, expected_sha256=expected_sha256, what="correspondence file")
 
 
 def correspondences_to_json(
@@ -157,40 +207,99 @@ def correspondences_to_json(
         text = json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False)
     except (TypeError, ValueError) as error:
         raise FormatError(f"cannot be written as JSON: {error}", path=path) from None
+    except RecursionError:
+        raise FormatError(f"cannot be written as JSON: nested deeper than {MAX_DEPTH} levels", path=path) from None
+    # Lone surrogates (half of a pair, or a byte of a non-UTF-8 file name as os.fsdecode keeps
+    # it) have no UTF-8 form: written as \\uXXXX escapes they read back as the same string.
+    text = _LONE_SURROGATE.sub(_escape_surrogate, text)
     # Round-trip through the parser so the schema sees exactly what a reader will.
-    validate(json.loads(text), path)
+    reread = _parse_json_object(text.encode("utf-8"), path)
+    _check_values(reread, path)
+    validate(reread, path)
     return _collapse_number_lists(text) + "\n"
 
 
-def read_file_bytes(path: Path, *, what: str) -> bytes:
-    """The file's bytes, or a FormatError naming the file and why it cannot be read."""
-    try:
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise FormatError("file not found", path=path) from None
-    except IsADirectoryError:
-        raise FormatError(f"is a folder, not {what}", path=path) from None
-    except OSError as error:
-        raise FormatError(f"cannot read file: {error.strerror or error}", path=path) from None
+def _escape_surrogate(match: re.Match) -> str:
+    return f"\\u{ord(match.group()):04x}"
 
 
-def _read_json_object(path: Path) -> dict:
-    raw = read_file_bytes(path, what="a correspondence file")
+# Deeper than any file URSIM writes (6 levels) by far, shallow enough for every recursive
+# step after parsing (schema, encoder) to stay far from Python's recursion limit.
+MAX_DEPTH = 64
+# 4300 is Python's own limit for int(str); anything this long is garbage for URSIM anyway.
+_MAX_INT_DIGITS = 4000
+_LONE_SURROGATE = re.compile("[\ud800-\udfff]")
+
+
+def _parse_json_object(raw: bytes, path: Path) -> dict:
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         raise FormatError(f"not UTF-8 text (byte {error.start}): not a JSON file", path=path) from None
+    hooks = {"object_pairs_hook": _reject_duplicate_keys, "parse_constant": _reject_constant}
     try:
-        document = json.loads(text, object_pairs_hook=_reject_duplicate_keys, parse_constant=_reject_constant)
+        try:
+            document = json.loads(text, parse_float=_parse_float, **hooks)
+        except ValueError as error:
+            if isinstance(error, json.JSONDecodeError) or "digits" not in str(error):
+                raise
+            # An integer too long for int(): parse again, keeping it as a value with a place.
+            document = json.loads(text, parse_float=_parse_float, parse_int=_parse_int, **hooks)
     except json.JSONDecodeError as error:
         raise FormatError(
             f"not valid JSON: {error.msg} at line {error.lineno}, column {error.colno}", path=path
         ) from None
     except _InvalidJsonValue as error:
         raise FormatError(f"not valid JSON for URSIM: {error}", path=path) from None
+    except RecursionError:
+        raise FormatError(
+            f"nested deeper than {MAX_DEPTH} levels (arrays or objects inside each other)", path=path
+        ) from None
     if not isinstance(document, dict):
         raise FormatError(f"expected a JSON object at the top level, got {json_type(document)}", path=path)
     return document
+
+
+def _parse_float(text: str):
+    value = float(text)
+    return value if math.isfinite(value) else OutOfRange(text)
+
+
+def _parse_int(text: str):
+    return OutOfRange(text) if len(text) > _MAX_INT_DIGITS else int(text)
+
+
+def _check_values(document: dict, path: Path) -> None:
+    """Refuse what the schema does not look at: too deep, or numbers out of range.
+
+    Walks everything but the known fields of the cliques (the schema checks those), with an
+    explicit stack, so depth costs no recursion.
+    """
+    stack: list[tuple[Any, tuple, int]] = []
+    for key, value in document.items():
+        if key != "cliques" or type(value) is not list:
+            stack.append((value, (key,), 1))
+            continue
+        for index, clique in enumerate(value):
+            if type(clique) is not dict:
+                stack.append((clique, ("cliques", index), 2))
+                continue
+            for name, item in clique.items():
+                if name not in CLIQUE_KEYS or type(item) is OutOfRange:
+                    stack.append((item, ("cliques", index, name), 3))
+    while stack:
+        value, where, depth = stack.pop()
+        if type(value) is OutOfRange:
+            raise FormatError(value.problem(), path=path, field=field_path(where))
+        if isinstance(value, (dict, list)):
+            if depth >= MAX_DEPTH:
+                raise FormatError(
+                    f"nested deeper than {MAX_DEPTH} levels (arrays or objects inside each other)",
+                    path=path,
+                    field=field_path(where),
+                )
+            items = value.items() if isinstance(value, dict) else enumerate(value)
+            stack.extend((item, (*where, key), depth + 1) for key, item in items)
 
 
 class _InvalidJsonValue(ValueError):
@@ -254,11 +363,11 @@ def _check_unique_ids(document: dict, path: Path) -> None:
         first_index[clique_id] = index
 
 
-def _from_document(document: dict, folder: Path) -> Correspondences:
+def _from_document(document: dict, folder: Path, path: Path) -> Correspondences:
     maps = document["maps"]
     return Correspondences(
-        sketch=_map_from_json(maps["sketch"], folder),
-        metric=_map_from_json(maps["metric"], folder),
+        sketch=_map_from_json(maps["sketch"], folder, path, "maps.sketch"),
+        metric=_map_from_json(maps["metric"], folder, path, "maps.metric"),
         cliques=tuple(_clique_from_json(clique) for clique in document["cliques"]),
         annotator=document.get("annotator", ""),
         created=document.get("created", ""),
@@ -268,9 +377,14 @@ def _from_document(document: dict, folder: Path) -> Correspondences:
     )
 
 
-def _map_from_json(item: dict, folder: Path) -> MapRef:
+def _map_from_json(item: dict, folder: Path, path: Path, where: str) -> MapRef:
     segmentation = item.get("segmentation") or {}
     size = item.get("size")
+    for name, text in (("path", item.get("path")), ("segmentation.labels", segmentation.get("labels"))):
+        if text is not None and "\x00" in text:
+            raise FormatError(
+                f"a file path cannot contain a NUL character, got {short(text)}", path=path, field=f"{where}.{name}"
+            )
     return MapRef(
         path=_resolve(item.get("path"), folder),
         sha256=item.get("sha256"),

@@ -207,6 +207,10 @@ class Correspondences:
         Unknown top-level keys, written back unchanged.
     maps_extra : dict
         Unknown keys of the ``maps`` object (beside ``sketch`` and ``metric``).
+    loaded_sha256 : str or None
+        SHA-256 of the file this value was loaded from (set by the loaders, never written).
+        Pass it as ``expected_sha256`` to the next save to detect that another session
+        changed the file meanwhile. Not part of equality.
 
     Examples
     --------
@@ -225,6 +229,7 @@ class Correspondences:
     modified: str = ""
     extra: dict = field(default_factory=dict, hash=False)
     maps_extra: dict = field(default_factory=dict, hash=False)
+    loaded_sha256: str | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
         cliques = tuple(self.cliques)
