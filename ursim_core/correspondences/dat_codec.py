@@ -77,6 +77,18 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
         line = text_line.strip()
         if not line:
             continue
+        point = _DAT_POINT.match(line)
+        if point:
+            if current is None or current["side"] is None:
+                raise FormatError(f"line {number}: point {line!r} before '# map1' or '# map2'", path=path)
+            row, col = point.groups()
+            if len(row) > _MAX_DIGITS or len(col) > _MAX_DIGITS:
+                digits = max(len(row), len(col))
+                raise FormatError(
+                    f"line {number}: a number of {digits} digits is too large for a pixel coordinate", path=path
+                )
+            current["points"][current["side"]].append((int(row), int(col)))
+            continue
         if _DAT_SET.match(line):
             _finish_dat_set(current, number, path)
             current = {"line": number, "side": None, "points": {"1": [], "2": []}}
@@ -93,17 +105,6 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
                 raise FormatError(f"line {number}: expected '# map{expected}', got {line!r}", path=path)
             current["side"] = expected
             continue
-        point = _DAT_POINT.match(line)
-        if point:
-            if current is None or current["side"] is None:
-                raise FormatError(f"line {number}: point {line!r} before '# map1' or '# map2'", path=path)
-            digits = max(len(point.group(1)), len(point.group(2)))
-            if digits > _MAX_DIGITS:
-                raise FormatError(
-                    f"line {number}: a number of {digits} digits is too large for a pixel coordinate", path=path
-                )
-            current["points"][current["side"]].append((int(point.group(1)), int(point.group(2))))
-            continue
         raise FormatError(
             f"line {number}: expected 'ROW COL' (two non-negative integers), '# Kmatch set', "
             f"'# map1' or '# map2', got {text_line.strip()!r}",
@@ -116,7 +117,21 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
         sketch_points, metric_points = match_set["points"]["1"], match_set["points"]["2"]
         if drop_empty and not sketch_points and not metric_points:
             continue
-        cliques.append(Clique(id=len(cliques) + 1, sketch_points=sketch_points, metric_points=metric_points))
+        # The line patterns admit only pairs of non-negative integers: nothing left to check.
+        cliques.append(
+            Clique._trusted(
+                id=len(cliques) + 1,
+                sketch_points=tuple(sketch_points),
+                metric_points=tuple(metric_points),
+                sketch_regions=(),
+                metric_regions=(),
+                source="manual",
+                score=None,
+                note="",
+                status=None,
+                extra={},
+            )
+        )
     return Correspondences(
         sketch=sketch_ref, metric=metric_ref, cliques=tuple(cliques), loaded_sha256=hashlib.sha256(raw).hexdigest()
     )

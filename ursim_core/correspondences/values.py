@@ -176,6 +176,39 @@ class Clique:
             raise ValueError(f"note must be a string, got {self.note!r}")
         _set(self, "extra", _checked_extra(self.extra, CLIQUE_KEYS))
 
+    @classmethod
+    def _from_valid_json(cls, item: dict, extra: dict) -> Clique:
+        """A clique from a JSON object the schema validator accepted, without checking it again.
+
+        The codecs' fast path for big files: the schema guarantees what ``__post_init__``
+        would check (integers, ranges, enums), so only the normalisation is done here.
+        """
+        score = item.get("score")
+        return cls._trusted(
+            id=item["id"],
+            sketch_points=tuple(map(tuple, item["sketch_points"])),
+            metric_points=tuple(map(tuple, item["metric_points"])),
+            sketch_regions=tuple(item.get("sketch_regions", ())),
+            metric_regions=tuple(item.get("metric_regions", ())),
+            source=item.get("source", "manual"),
+            score=None if score is None else float(score),
+            note=item.get("note", ""),
+            status=item.get("status"),
+            extra=extra,
+        )
+
+    @classmethod
+    def _trusted(cls, **fields) -> Clique:
+        """A clique of fields already in their normal form (every field given), unchecked.
+
+        For the codecs, whose parsers enforce the same rules as ``__post_init__``; a frozen
+        dataclass keeps its fields in ``__dict__``, so filling it at once skips ten setattr
+        calls a clique.
+        """
+        clique = object.__new__(cls)
+        clique.__dict__.update(fields)
+        return clique
+
     @property
     def effective_status(self) -> str:
         """The status, with the default filled in: pending for auto, accepted for manual."""
