@@ -250,3 +250,10 @@ def test_symlink_loop_in_yaml_image_says_so(tmp_path):
 def test_dangling_symlink_says_so(tmp_path):
     (tmp_path / "gone.png").symlink_to(tmp_path / "nowhere.png")
     assert "nowhere.png" in _refused(tmp_path / "gone.png")
+
+
+def test_nul_at_the_start_of_a_yaml_file_is_a_map_error(tmp_path):
+    # Found by tests/fuzz: PyYAML's reader refuses it while the loader is being made.
+    path = tmp_path / "map.yaml"
+    path.write_bytes(b"\x00image: room.png\n")
+    _refused(path, "YAML")

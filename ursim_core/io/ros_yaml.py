@@ -179,8 +179,10 @@ def _parse_yaml(yaml_path: Path):
         raise MapError(
             f"not UTF-8 text (byte {error.start}, line {line}): not a ROS map YAML", path=yaml_path
         ) from None
-    loader = _bounded_loader()(text)
+    loader = None
     try:
+        # The reader checks the first characters already when the loader is made.
+        loader = _bounded_loader()(text)
         return loader.get_single_data()
     except _YamlRefused as error:
         raise MapError(f"not accepted as YAML: {error.problem}{_at(error.mark)}", path=yaml_path) from None
@@ -190,7 +192,8 @@ def _parse_yaml(yaml_path: Path):
         # e.g. an integer of more than 4300 digits: Python's int() refuses to convert it.
         raise MapError(f"not valid YAML for a map: {_cut(str(error), 120)}", path=yaml_path) from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def _yaml_problem(error) -> str:
