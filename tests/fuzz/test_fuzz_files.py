@@ -27,6 +27,7 @@ from ursim_core.correspondences import (
     MapRef,
     correspondences_to_json,
     json_codec,
+    json_text,
     load_correspondences,
     load_dat,
     save_correspondences,
@@ -136,8 +137,8 @@ def test_fast_clique_writer_gives_json_dumps_text(corr):
     # collapsing, as every version before the fast writer wrote it.
     folder = Path("/data")
     document = json_codec._to_document(corr, folder)
-    reference = json_codec._collapse_number_lists(json.dumps(document, indent=2, ensure_ascii=False)) + "\n"
-    reference = json_codec._LONE_SURROGATE.sub(json_codec._escape_surrogate, reference)
+    reference = json_text.collapse_number_lists(json.dumps(document, indent=2, ensure_ascii=False)) + "\n"
+    reference = json_text.escape_lone_surrogates(reference)
     assert correspondences_to_json(corr, folder=folder) == reference
 
 

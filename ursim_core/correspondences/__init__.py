@@ -5,7 +5,7 @@ codec with its schema (``schemas/correspondences-1.schema.json``; atomic saves, 
 preserved), the original ``.dat`` codec, and the assignment of clicked points to regions.
 
 Modules: ``values`` (the frozen value types), ``schema`` (JSON Schema, compiled validator,
-readable schema errors), ``json_codec`` (load / save the JSON file), ``dat_codec`` (the
+readable schema errors), ``json_codec`` (load / save the JSON file; ``json_text`` writes its exact text), ``dat_codec`` (the
 original ``.dat`` format), ``files`` (bounded reads; guarded atomic saves), ``assignment`` (points -> region ids). ``codec`` is the deprecated
 old home of all of them, kept for one release.
 
@@ -21,7 +21,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["values", "schema", "files", "json_codec", "dat_codec", "assignment", "codec"],
+    submodules=["values", "schema", "files", "json_text", "json_codec", "dat_codec", "assignment", "codec"],
     submod_attrs={
         "values": ["SOURCES", "STATUSES", "MapRef", "Clique", "Correspondences", "utc_timestamp"],
         "schema": ["FORMAT_NAME", "CURRENT_VERSION", "correspondences_schema"],

@@ -13,13 +13,18 @@ import hashlib
 import json
 import math
 import os
-import re
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path, PurePath
 from typing import Any
 
 from ursim_core.correspondences.files import read_file_bytes, write_guarded
+from ursim_core.correspondences.json_text import (
+    EMPTY_CLIQUES,
+    cliques_text,
+    collapse_number_lists,
+    escape_lone_surrogates,
+)
 from ursim_core.correspondences.schema import (
     CURRENT_VERSION,
     FORMAT_NAME,
@@ -209,8 +214,8 @@ def correspondences_to_json(
     try:
         # Everything but the cliques goes through json.dumps; the cliques, nearly all of a big
         # file, through a writer of the same text that is ~10x faster (_cliques_text).
-        head = _collapse_number_lists(json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False))
-        text = head.replace(_EMPTY_CLIQUES, _cliques_text(corr.cliques), 1)
+        head = collapse_number_lists(json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False))
+        text = head.replace(EMPTY_CLIQUES, cliques_text(corr.cliques), 1)
     except (TypeError, ValueError) as error:
         raise FormatError(f"cannot be written as JSON: {error}", path=path) from None
     except RecursionError:
@@ -220,56 +225,8 @@ def correspondences_to_json(
     try:
         text.encode("utf-8")
     except UnicodeEncodeError:
-        text = _LONE_SURROGATE.sub(_escape_surrogate, text)
+        text = escape_lone_surrogates(text)
     return text + "\n"
-
-
-# json.dumps(indent=2) writes the top-level key at two spaces; strings hold no raw newline,
-# so this text occurs once, where the cliques go.
-_EMPTY_CLIQUES = '\n  "cliques": []'
-_ITEM = ",\n        "
-_encode_string = json.encoder.encode_basestring  # the C encoder json.dumps uses (non-ASCII kept)
-
-
-def _cliques_text(values: Sequence[Clique]) -> str:
-    """The ``"cliques"`` member exactly as ``json.dumps(indent=2)`` + number-list collapsing writes it."""
-    if not values:
-        return _EMPTY_CLIQUES
-    parts = []
-    for clique in values:
-        lines = [f'      "id": {int.__repr__(clique.id)}']
-        for name in ("sketch_points", "metric_points"):
-            points = getattr(clique, name)
-            if points:
-                body = _ITEM.join(f"[{int.__repr__(row)}, {int.__repr__(col)}]" for row, col in points)
-                lines.append(f'      "{name}": [\n        {body}\n      ]')
-            else:
-                lines.append(f'      "{name}": []')
-        for name in ("sketch_regions", "metric_regions"):
-            regions = getattr(clique, name)
-            lines.append(f'      "{name}": [{", ".join(map(int.__repr__, regions))}]')
-        lines.append(f'      "source": {_encode_string(clique.source)}')
-        if clique.score is not None:
-            lines.append(f'      "score": {_number_text(clique.score)}')
-        if clique.note:
-            lines.append(f'      "note": {_encode_string(clique.note)}')
-        if clique.status is not None:
-            lines.append(f'      "status": {_encode_string(clique.status)}')
-        for key, value in clique.extra.items():
-            dumped = json.dumps(value, indent=2, ensure_ascii=False, allow_nan=False)
-            lines.append(f"      {_encode_string(key)}: " + _collapse_number_lists(dumped.replace("\n", "\n      ")))
-        parts.append("    {\n" + ",\n".join(lines) + "\n    }")
-    return '\n  "cliques": [\n' + ",\n".join(parts) + "\n  ]"
-
-
-def _number_text(value: float) -> str:
-    if not math.isfinite(value):
-        raise ValueError(f"Out of range float values are not JSON compliant: {value!r}")
-    return float.__repr__(value)
-
-
-def _escape_surrogate(match: re.Match) -> str:
-    return f"\\u{ord(match.group()):04x}"
 
 
 # Deeper than any file URSIM writes (6 levels) by far, shallow enough for every recursive
@@ -277,7 +234,6 @@ def _escape_surrogate(match: re.Match) -> str:
 MAX_DEPTH = 64
 # 4300 is Python's own limit for int(str); anything this long is garbage for URSIM anyway.
 _MAX_INT_DIGITS = 4000
-_LONE_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _parse_json_object(raw: bytes, path: Path) -> dict:
@@ -535,15 +491,3 @@ def _clique_to_json(clique: Clique) -> dict:
         item["status"] = clique.status
     item.update(clique.extra)
     return item
-
-
-# A JSON array holding only numbers, as json.dumps(indent=...) spreads it over
-# several lines. Raw newlines never occur inside JSON strings (they are escaped),
-# so requiring them keeps this from touching string content.
-_NUMBER = r"-?[0-9]+(?:\.[0-9]+)?(?:[eE][-+]?[0-9]+)?"
-_NUMBER_LIST = re.compile(r"\[\n\s*(" + _NUMBER + r"(?:,\n\s*" + _NUMBER + r")*)\n\s*\]")
-
-
-def _collapse_number_lists(text: str) -> str:
-    # [row, col] points and region lists on one line each: a file a person can read.
-    return _NUMBER_LIST.sub(lambda match: "[" + ", ".join(re.split(r",\n\s*", match.group(1))) + "]", text)
