@@ -56,7 +56,7 @@ class UrsimError(Exception):
         if self.field:
             where += f"field '{self.field}': "
         # One line, whatever the problem text holds: the CLI prints it as the whole message.
-        return " ".join(f"{where}{self.problem}".split("\n"))
+        return " ".join(f"{where}{self.problem}".splitlines())
 
 
 class MapError(UrsimError):
