@@ -11,7 +11,7 @@ import re
 import urllib.parse
 from pathlib import Path, PurePosixPath
 
-from ursim_core.correspondences.files import read_file_bytes, write_guarded
+from ursim_core.correspondences.files import paused_garbage_collection, read_file_bytes, write_guarded
 from ursim_core.correspondences.values import Clique, Correspondences, MapRef
 from ursim_core.errors import FormatError
 
@@ -66,6 +66,11 @@ def load_dat(path: str | os.PathLike, *, drop_empty: bool = False) -> Correspond
     """
     path = Path(path)
     raw = read_file_bytes(path, what=".dat file")
+    with paused_garbage_collection():
+        return _parse_dat(raw, path, drop_empty=drop_empty)
+
+
+def _parse_dat(raw: bytes, path: Path, *, drop_empty: bool) -> Correspondences:
     lines = _dat_lines(raw, path)
     if not lines:
         raise FormatError("empty file; expected a '# <map1 path> <map2 path>' header", path=path)

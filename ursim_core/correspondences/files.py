@@ -11,8 +11,11 @@
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import hashlib
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 from ursim_core.correspondences.values import Correspondences
@@ -20,7 +23,7 @@ from ursim_core.errors import FileChangedError, FormatError, SaveRefusedError
 from ursim_core.io.atomic import atomic_write_bytes
 from ursim_core.io.reading import read_regular_file
 
-__all__ = ["MAX_FILE_BYTES", "read_file_bytes", "write_guarded", "sha256_of_file"]
+__all__ = ["MAX_FILE_BYTES", "read_file_bytes", "write_guarded", "sha256_of_file", "paused_garbage_collection"]
 
 # 100k cliques take about 20 MB of JSON; this bounds memory, not any real file.
 MAX_FILE_BYTES = 1024**3
@@ -29,6 +32,23 @@ MAX_FILE_BYTES = 1024**3
 def read_file_bytes(path: Path, *, what: str) -> bytes:
     """The file's bytes, or a FormatError naming the file and why it cannot be read."""
     return read_regular_file(path, max_bytes=MAX_FILE_BYTES, error=FormatError, what=what)
+
+
+@contextlib.contextmanager
+def paused_garbage_collection() -> Iterator[None]:
+    """No cyclic garbage collection inside the block (restored after, also on error).
+
+    Parsing a big file makes hundreds of thousands of lists, dicts and tuples, none of which
+    form cycles; each allocation burst triggers a full collection that walks all of them
+    again, which made loading 100k cliques 2.5x slower (3.3 s of CPU instead of 1.3 s).
+    """
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def sha256_of_file(path: Path) -> str | None:

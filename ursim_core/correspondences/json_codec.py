@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path, PurePath
 from typing import Any
 
-from ursim_core.correspondences.files import read_file_bytes, write_guarded
+from ursim_core.correspondences.files import paused_garbage_collection, read_file_bytes, write_guarded
 from ursim_core.correspondences.json_text import (
     EMPTY_CLIQUES,
     cliques_text,
@@ -99,13 +99,14 @@ def load_correspondences(path: str | os.PathLike, *, sketch_map=None, metric_map
     """
     path = Path(path)
     raw = read_file_bytes(path, what="correspondence file")
-    document = _parse_json_object(raw, path)
-    document = _upgrade(document, path)
-    _check_values(document, path)
-    validate(document, path)
-    _check_unique_ids(document, path)
-    folder = Path(os.path.abspath(path)).parent
-    corr = _from_document(document, folder, path, loaded_sha256=hashlib.sha256(raw).hexdigest())
+    with paused_garbage_collection():
+        document = _parse_json_object(raw, path)
+        document = _upgrade(document, path)
+        _check_values(document, path)
+        validate(document, path)
+        _check_unique_ids(document, path)
+        folder = Path(os.path.abspath(path)).parent
+        corr = _from_document(document, folder, path, loaded_sha256=hashlib.sha256(raw).hexdigest())
     for side, ref, loaded in (("sketch", corr.sketch, sketch_map), ("metric", corr.metric, metric_map)):
         _warn_if_changed(side, ref, loaded, path)
     return corr
@@ -176,7 +177,8 @@ def save_correspondences(
     path = Path(path)
     timestamp = utc_timestamp() if now is None else now
     stamped = dataclasses.replace(corr, created=corr.created or timestamp, modified=timestamp)
-    text = correspondences_to_json(stamped, folder=Path(os.path.abspath(path)).parent, path=path)
+    with paused_garbage_collection():
+        text = correspondences_to_json(stamped, folder=Path(os.path.abspath(path)).parent, path=path)
     data = text.encode("utf-8")
     return write_guarded(corr, path, data, expected_sha256=expected_sha256, what="correspondence file")
 
