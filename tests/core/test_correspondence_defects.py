@@ -335,3 +335,11 @@ def test_region_ids_that_disagree_with_the_points_are_reported(tmp_path):
         assign_regions(
             done.with_cliques(Clique(id=c.id, sketch_points=c.sketch_points) for c in done.cliques), labels, labels
         )
+
+
+@pytest.mark.parametrize("name", ["pair\x00.json", "pair\ud800.json"])
+@pytest.mark.parametrize("save", [save_correspondences, save_dat])
+def test_unusable_target_names_are_a_typed_error_not_unicode_or_value_error(tmp_path, name, save):
+    with pytest.raises(SaveRefusedError, match="file name"):
+        save(Correspondences(), tmp_path / name)
+    assert list(tmp_path.iterdir()) == []

@@ -69,6 +69,20 @@ def _real(path: Path | str) -> str:
     return os.path.normcase(os.path.realpath(path))
 
 
+def _check_name(target: Path) -> None:
+    # The system would refuse these names with ValueError / UnicodeEncodeError, which a caller
+    # catching OSError (an autosave) would not expect.
+    text = str(target)
+    if "\x00" in text:
+        raise SaveRefusedError("the file name contains a NUL character", path=target)
+    try:
+        os.fsencode(text)
+    except UnicodeEncodeError:
+        raise SaveRefusedError(
+            "the file name holds characters no file system name can (lone surrogates)", path=target
+        ) from None
+
+
 def _check_not_a_map(corr: Correspondences, target: Path) -> None:
     real_target = _real(target)
     for side, ref in (("sketch", corr.sketch), ("metric", corr.metric)):
@@ -108,6 +122,7 @@ def write_guarded(corr: Correspondences, target: Path, data: bytes, *, expected_
     OSError
         Writing failed; the old file is untouched.
     """
+    _check_name(target)
     _check_not_a_map(corr, target)
     if expected_sha256 is not None:
         actual = sha256_of_file(target)

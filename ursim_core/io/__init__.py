@@ -6,7 +6,8 @@ save of the project goes through.
 
 Modules: ``maps`` (the Map value, load_map, map_from_array, pixel <-> world), ``images``
 (file bytes -> decoded pixels -> grey), ``ros_yaml`` (ROS map_server YAML, as nav2 reads it),
-``atomic`` (atomic writes).
+``reading`` (bounded reads of regular files only: no pipe, device or multi-GB file),
+``atomic`` (atomic writes; stale temporary files cleaned).
 
 May import: :mod:`ursim_core.errors` only. Everything else builds on it.
 
@@ -20,7 +21,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["atomic", "images", "maps", "ros_yaml"],
+    submodules=["atomic", "images", "maps", "reading", "ros_yaml"],
     submod_attrs={
         "atomic": ["atomic_write_bytes", "atomic_write_text"],
         "maps": [
