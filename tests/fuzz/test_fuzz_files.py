@@ -12,7 +12,6 @@ import io
 import json
 import math
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -41,9 +40,10 @@ NOW = "2024-05-01T12:00:00Z"
 FUZZ = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
-def _folder() -> Path:
-    # hypothesis runs many examples per test; a function-scoped tmp_path would be shared.
-    return Path(tempfile.mkdtemp(prefix="ursim-fuzz-"))
+def _folder(factory) -> Path:
+    # hypothesis runs many examples per test: one fresh folder each, under pytest's own
+    # temporary root (session-scoped, cleaned by pytest), as tmp_path would be shared.
+    return factory.mktemp("fuzz")
 
 
 def _assert_one_clear_error(error: UrsimError, path: Path) -> None:
@@ -116,8 +116,8 @@ def documents(draw) -> Correspondences:
 
 @FUZZ
 @given(corr=documents())
-def test_json_whatever_is_saved_loads_equal_and_saves_the_same_text(corr):
-    folder = _folder()
+def test_json_whatever_is_saved_loads_equal_and_saves_the_same_text(corr, tmp_path_factory):
+    folder = _folder(tmp_path_factory)
     target = folder / "pair.json"
     save_correspondences(corr, target, now=NOW)
     first = target.read_bytes()
@@ -226,8 +226,8 @@ def mutations(draw, valid: bytes) -> bytes:
 
 @FUZZ
 @given(data=mutations(VALID_JSON))
-def test_json_every_failure_is_one_format_error_and_every_success_saves(data):
-    folder = _folder()
+def test_json_every_failure_is_one_format_error_and_every_success_saves(data, tmp_path_factory):
+    folder = _folder(tmp_path_factory)
     path = folder / "pair.json"
     path.write_bytes(data)
     try:
@@ -260,8 +260,8 @@ VALID_DAT = b"""# /home/a/sketches/00.png ../../model_simple.png
 
 @FUZZ
 @given(data=mutations(VALID_DAT))
-def test_dat_every_failure_is_one_format_error_and_every_success_round_trips(data):
-    folder = _folder()
+def test_dat_every_failure_is_one_format_error_and_every_success_round_trips(data, tmp_path_factory):
+    folder = _folder(tmp_path_factory)
     path = folder / "gt.dat"
     path.write_bytes(data)
     try:
@@ -287,9 +287,9 @@ IMAGES = {fmt: _image_bytes(fmt) for fmt in ("PNG", "BMP", "TIFF", "JPEG", "PPM"
 
 @FUZZ
 @given(fmt=st.sampled_from(sorted(IMAGES)), data=st.data())
-def test_map_every_failure_is_one_map_error(fmt, data):
+def test_map_every_failure_is_one_map_error(fmt, data, tmp_path_factory):
     damaged = data.draw(mutations(IMAGES[fmt]))
-    folder = _folder()
+    folder = _folder(tmp_path_factory)
     path = folder / f"map.{fmt.lower()}"
     path.write_bytes(damaged)
     try:
@@ -328,8 +328,8 @@ yaml_fragments = st.sampled_from(
 
 @FUZZ
 @given(parts=st.lists(yaml_fragments, min_size=1, max_size=6), noise=st.binary(max_size=4))
-def test_yaml_every_failure_is_one_map_error(parts, noise):
-    folder = _folder()
+def test_yaml_every_failure_is_one_map_error(parts, noise, tmp_path_factory):
+    folder = _folder(tmp_path_factory)
     grey = np.zeros((6, 6), np.uint8)
     grey[1:5, 1:5] = 255
     Image.fromarray(grey).save(folder / "room.png")
@@ -344,9 +344,9 @@ def test_yaml_every_failure_is_one_map_error(parts, noise):
 
 
 @pytest.mark.parametrize("size", [0, 1, 7, 8, 30, 4096])
-def test_random_bytes_after_real_signatures_are_one_map_error(size):
+def test_random_bytes_after_real_signatures_are_one_map_error(size, tmp_path_factory):
     generator = np.random.default_rng(size)
-    folder = _folder()
+    folder = _folder(tmp_path_factory)
     for signature in (b"\x89PNG\r\n\x1a\n", b"II*\x00", b"MM\x00*", b"\xff\xd8\xff", b"BM", b"P5\n", b"GIF89a", b""):
         path = folder / "map.png"
         path.write_bytes(signature + generator.integers(0, 256, size, dtype=np.uint8).tobytes())
