@@ -121,3 +121,25 @@ def test_symlink_is_kept_and_its_target_replaced(tmp_path):
     assert link.is_symlink()
     assert real.read_text() == "new"
     assert _names(tmp_path) == ["link.txt", "real.txt"]
+
+
+# --------------------------------------------------------------------------- issue 12 item 15
+
+
+def test_stale_temporary_files_of_our_pattern_are_removed_on_the_next_save(tmp_path):
+    import time
+
+    from ursim_core.io.atomic import STALE_TEMP_SECONDS
+
+    target = tmp_path / "pair.json"
+    old = time.time() - STALE_TEMP_SECONDS - 60
+    stale = tmp_path / ".pair.json.0badc0de.tmp"
+    fresh = tmp_path / ".pair.json.12345678.tmp"  # a writer that may still be running
+    other = tmp_path / ".other.json.0badc0de.tmp"  # another file's: not ours to judge here
+    unlike = tmp_path / ".pair.json.notours.tmp"  # not our pattern
+    for path in (stale, fresh, other, unlike):
+        path.write_bytes(b"partial")
+    for path in (stale, other, unlike):
+        os.utime(path, (old, old))
+    atomic_write_bytes(target, b"new")
+    assert _names(tmp_path) == sorted([fresh.name, other.name, unlike.name, target.name])

@@ -12,14 +12,15 @@ import jsonschema
 import numpy as np
 import pytest
 
-from ursim_core.correspondences import codec as corr_module
-from ursim_core.correspondences.codec import (
+from ursim_core.correspondences import (
     Clique,
     Correspondences,
     MapRef,
     assign_regions,
+    assignment,
     correspondences_schema,
     from_pairs,
+    json_codec,
     load_correspondences,
     regions_at_points,
     save_correspondences,
@@ -391,7 +392,7 @@ def test_failed_encoding_keeps_the_old_file(tmp_path, monkeypatch):
     def failing_dumps(*args, **kwargs):
         raise ValueError("encoder exploded")
 
-    monkeypatch.setattr(corr_module.json, "dumps", failing_dumps)
+    monkeypatch.setattr(json_codec.json, "dumps", failing_dumps)
     with pytest.raises(FormatError, match="encoder exploded"):
         save_correspondences(Correspondences(), target, now=NOW)
     assert target.read_text() == "previous"
@@ -575,7 +576,7 @@ def test_older_versions_go_through_the_migration_table(tmp_path, monkeypatch):
         upgraded["cliques"] = [dict(clique, id=clique.pop("number")) for clique in document["cliques"]]
         return upgraded
 
-    monkeypatch.setitem(corr_module._MIGRATIONS, 0, from_version_0)
+    monkeypatch.setitem(json_codec._MIGRATIONS, 0, from_version_0)
     document = _valid_document()
     document["version"] = 0
     for clique in document["cliques"]:
@@ -640,13 +641,13 @@ def test_regions_at_points_edge_inputs():
 
 def test_many_points_give_a_nearest_region_like_brute_force(monkeypatch):
     transforms = []
-    real_transform = corr_module.ndimage.distance_transform_edt
+    real_transform = assignment.ndimage.distance_transform_edt
 
     def counting_transform(*args, **kwargs):
         transforms.append(1)
         return real_transform(*args, **kwargs)
 
-    monkeypatch.setattr(corr_module.ndimage, "distance_transform_edt", counting_transform)
+    monkeypatch.setattr(assignment.ndimage, "distance_transform_edt", counting_transform)
     generator = np.random.default_rng(7)
     labels = np.zeros((60, 80), dtype=np.int32)
     for region in range(1, 9):

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from ursim_core.correspondences.codec import Clique, Correspondences, MapRef, load_dat, save_dat
+from ursim_core.correspondences import Clique, Correspondences, MapRef, load_dat, save_dat
 from ursim_core.errors import FormatError
 from ursim_core.evaluation import datasets
 

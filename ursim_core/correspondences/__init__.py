@@ -4,6 +4,11 @@ Owns: the value types (:class:`Clique`, :class:`MapRef`, :class:`Correspondences
 codec with its schema (``schemas/correspondences-1.schema.json``; atomic saves, unknown keys
 preserved), the original ``.dat`` codec, and the assignment of clicked points to regions.
 
+Modules: ``values`` (the frozen value types), ``schema`` (JSON Schema, compiled validator,
+readable schema errors), ``json_codec`` (load / save the JSON file; ``json_text`` writes its exact text), ``dat_codec`` (the
+original ``.dat`` format), ``files`` (bounded reads; guarded atomic saves), ``assignment`` (points -> region ids). ``codec`` is the deprecated
+old home of all of them, kept for one release.
+
 May import: :mod:`ursim_core.io` and :mod:`ursim_core.errors` (label images are plain arrays
 here, so it does not need :mod:`ursim_core.segmentation`).
 
@@ -16,27 +21,12 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["codec"],
+    submodules=["values", "schema", "files", "json_text", "json_codec", "dat_codec", "assignment", "codec"],
     submod_attrs={
-        "codec": [
-            "FORMAT_NAME",
-            "CURRENT_VERSION",
-            "SUPPORTED_VERSIONS",
-            "SOURCES",
-            "STATUSES",
-            "MapRef",
-            "Clique",
-            "Correspondences",
-            "load_correspondences",
-            "save_correspondences",
-            "correspondences_to_json",
-            "correspondences_schema",
-            "load_dat",
-            "save_dat",
-            "regions_at_points",
-            "assign_regions",
-            "from_pairs",
-            "utc_timestamp",
-        ],
+        "values": ["SOURCES", "STATUSES", "MapRef", "Clique", "Correspondences", "utc_timestamp"],
+        "schema": ["FORMAT_NAME", "CURRENT_VERSION", "correspondences_schema"],
+        "json_codec": ["SUPPORTED_VERSIONS", "load_correspondences", "save_correspondences", "correspondences_to_json"],
+        "dat_codec": ["load_dat", "save_dat"],
+        "assignment": ["regions_at_points", "assign_regions", "from_pairs"],
     },
 )

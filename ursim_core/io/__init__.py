@@ -4,6 +4,11 @@ Owns: :class:`Map` and its loaders (:func:`load_map`, :func:`map_from_array`), t
 world conversions, and :func:`atomic_write_bytes` / :func:`atomic_write_text`, which every
 save of the project goes through.
 
+Modules: ``maps`` (the Map value, load_map, map_from_array, pixel <-> world), ``images``
+(file bytes -> decoded pixels -> grey), ``ros_yaml`` (ROS map_server YAML, as nav2 reads it),
+``reading`` (bounded reads of regular files only: no pipe, device or multi-GB file),
+``atomic`` (atomic writes; stale temporary files cleaned).
+
 May import: :mod:`ursim_core.errors` only. Everything else builds on it.
 
 >>> from ursim_core.io import map_from_array
@@ -16,7 +21,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["atomic", "maps"],
+    submodules=["atomic", "images", "maps", "reading", "ros_yaml"],
     submod_attrs={
         "atomic": ["atomic_write_bytes", "atomic_write_text"],
         "maps": [

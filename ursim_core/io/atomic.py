@@ -7,19 +7,28 @@ middle of a save leaves the previous version intact.
 The new content is written to a temporary file in the *same* directory (so the
 final rename never crosses a file system), flushed and fsync'ed, then moved over
 the target with :func:`os.replace`, which is atomic on POSIX and Windows.
+
+A writer killed between the two leaves its hidden ``.NAME.xxxxxxxx.tmp`` behind.
+The next save of ``NAME`` removes such files of our own pattern once they are
+older than :data:`STALE_TEMP_SECONDS` (no live save takes minutes), so repeated
+crashes cannot fill a disk.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
 import secrets
 import stat
+import time
 from pathlib import Path
 
-__all__ = ["atomic_write_bytes", "atomic_write_text"]
+__all__ = ["atomic_write_bytes", "atomic_write_text", "STALE_TEMP_SECONDS"]
 
 _TEMP_ATTEMPTS = 100
+# A temporary file this old belongs to a writer that died: a save takes seconds at most.
+STALE_TEMP_SECONDS = 300
 
 
 def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memoryview) -> None:
@@ -59,6 +68,7 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
         # Replacing the link itself would silently detach it from its file.
         target = Path(os.path.realpath(target))
     directory = target.parent
+    _remove_stale_temp_files(directory, target.name)
     descriptor, temp_path = _create_temp_file(directory, target.name)
     try:
         try:
@@ -125,6 +135,22 @@ def _create_temp_file(directory: Path, name: str) -> tuple[int, Path]:
         except FileExistsError:
             continue
     raise FileExistsError(f"could not create a temporary file in {directory}")
+
+
+def _remove_stale_temp_files(directory: Path, name: str) -> None:
+    """Delete ``.NAME.<8 hex>.tmp`` files older than STALE_TEMP_SECONDS: killed writers' leftovers."""
+    pattern = re.compile(re.escape(f".{name}.") + r"[0-9a-f]{8}\.tmp\Z")
+    deadline = time.time() - STALE_TEMP_SECONDS
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return  # cleaning is a courtesy; the save itself reports real problems
+    for entry in entries:
+        if not pattern.match(entry.name):
+            continue
+        with contextlib.suppress(OSError):
+            if entry.is_file(follow_symlinks=False) and entry.stat(follow_symlinks=False).st_mtime < deadline:
+                os.unlink(entry.path)
 
 
 def _copy_permission_bits(source: Path, destination: Path) -> None:

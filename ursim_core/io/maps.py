@@ -36,22 +36,31 @@ ROS map_server YAML files (``.yaml`` / ``.yml``) are read as the navigation2 map
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
-import io
 import math
 import numbers
-import re
-import struct
-import threading
-import warnings
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ursim_core.errors import MapError, ParameterError
+from ursim_core.io.images import (
+    Pixels,
+    decode_image,
+    display_grey,
+    imread_grey,
+    pixels_from_array,
+    read_file_bytes,
+    transparent_mask,
+)
+from ursim_core.io.ros_yaml import (
+    OCCUPANCY_FREE,
+    OCCUPANCY_OCCUPIED,
+    OCCUPANCY_UNKNOWN,
+    ROS_SUFFIXES,
+    read_ros_yaml,
+)
 
 __all__ = [
     "Map",
@@ -68,10 +77,6 @@ __all__ = [
 
 DEFAULT_FREE_THRESHOLD = 250
 DEFAULT_MAX_PIXELS = 64_000_000
-# Values of Map.occupancy (ROS nav_msgs/OccupancyGrid); scale-mode maps also hold 1..99.
-OCCUPANCY_FREE = 0
-OCCUPANCY_OCCUPIED = 100
-OCCUPANCY_UNKNOWN = -1
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,41 +117,6 @@ class Map:
     def name(self) -> str:
         """File name without extension ('map' when there is no file)."""
         return self.path.stem if self.path is not None else "map"
-
-
-# ---------------------------------------------------------------------------------------------
-# Constants of the conversions (see the module docstring for where each comes from).
-
-_ROS_SUFFIXES = (".yaml", ".yml")
-_ROS_MODES = ("trinary", "scale", "raw")
-_ROS_DEFAULTS = {"negate": 0, "occupied_thresh": 0.65, "free_thresh": 0.25, "mode": "trinary"}
-
-# cv2.cvtColor(COLOR_RGB2GRAY) on uint8: fixed point with 15 fractional bits, rounded.
-_CV_LUMA = (9798, 19235, 3735)
-_CV_LUMA_SHIFT = 15
-# libpng png_set_rgb_to_gray(png, 1, 0.299, 0.587) as called by cv::imread(IMREAD_GRAYSCALE):
-# coefficients truncated to 15 bits, blue takes the remainder, result truncated.
-_LIBPNG_LUMA = (9797, 19234, 32768 - 9797 - 19234)
-_LIBPNG_LUMA_SHIFT = 15
-
-# Bounded work arrays: conversions run over blocks of about this many pixels so a map at the
-# pixel limit does not need several full-size uint32 temporaries.
-_BLOCK_PIXELS = 1 << 20
-
-_SUPPORTED_MODES_TEXT = "grey, grey+alpha, RGB, RGBA or palette, 8 or 16 bit"
-_PILLOW_LIMIT_LOCK = threading.Lock()
-
-
-@dataclass(frozen=True)
-class _Pixels:
-    """Decoded pixels before any thresholding.
-
-    ``colour`` is (rows, cols) grey or (rows, cols, 3) RGB, uint8 or uint16 (16-bit only for
-    grey). ``alpha`` is (rows, cols) uint8 or uint16 opacity (max = opaque) or None.
-    """
-
-    colour: np.ndarray
-    alpha: np.ndarray | None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -224,10 +194,19 @@ def load_map(
     _check_threshold(threshold)
     _check_max_pixels(max_pixels)
     path = Path(path)
-    if path.suffix.lower() in _ROS_SUFFIXES:
-        return _load_ros_yaml(path, max_pixels=max_pixels)
-    data = _read_file_bytes(path, empty_problem="empty file (0 bytes): zero-size image")
-    pixels = _decode_image(data, path, max_pixels=max_pixels, apply_exif_orientation=True)
+    if path.suffix.lower() in ROS_SUFFIXES:
+        ros = read_ros_yaml(path, max_pixels=max_pixels)
+        return Map(
+            free=ros.occupancy == OCCUPANCY_FREE,
+            path=path,
+            sha256=ros.sha256,
+            resolution=ros.resolution,
+            origin=ros.origin,
+            occupancy=ros.occupancy,
+            image=ros.image,
+        )
+    data = read_file_bytes(path, empty_problem="empty file (0 bytes): zero-size image", max_pixels=max_pixels)
+    pixels = decode_image(data, path, max_pixels=max_pixels, apply_exif_orientation=True)
     return _binary_map(
         pixels,
         threshold=threshold,
@@ -295,7 +274,7 @@ def map_from_array(
         if not free.any():
             raise MapError("no free pixel: the boolean map is all False", path=path)
         return Map(free=free, path=path, image=np.where(free, 255, 0).astype(np.uint8))
-    pixels = _pixels_from_array(values, path)
+    pixels = pixels_from_array(values, path)
     return _binary_map(pixels, threshold=threshold, nonzero_free=nonzero_free, path=path, sha256=None)
 
 
@@ -404,467 +383,39 @@ def _check_max_pixels(max_pixels) -> None:
 
 
 # ---------------------------------------------------------------------------------------------
-# Reading and decoding files
+# From pixels to a free mask
 
 
-def _read_file_bytes(path: Path, *, empty_problem: str) -> bytes:
-    # Reading everything once means the digest describes exactly the bytes that get decoded.
-    if path.is_dir():
-        raise MapError("is a directory, not a map file", path=path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise MapError("file not found", path=path) from None
-    except OSError as error:
-        raise MapError(f"cannot read the file: {error.strerror or error}", path=path) from error
-    if not data:
-        raise MapError(empty_problem, path=path)
-    return data
-
-
-@contextlib.contextmanager
-def _pillow_pixel_limit(max_pixels: int) -> Iterator[None]:
-    """Let our ``max_pixels`` decide instead of Pillow's decompression-bomb limit.
-
-    Pillow checks ``Image.MAX_IMAGE_PIXELS`` inside ``Image.open`` (a warning above it, an
-    error above twice it). When our limit is the smaller one, Pillow can only complain about
-    images we refuse anyway, so its warning is silenced and its error translated by the
-    caller. Only when the caller allows more than Pillow does is Pillow's global raised, for
-    the duration of the open and under a lock, then restored.
-    """
-    from PIL import Image
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", Image.DecompressionBombWarning)
-        pillow_limit = Image.MAX_IMAGE_PIXELS
-        if pillow_limit is None or max_pixels <= pillow_limit:
-            yield
-            return
-        with _PILLOW_LIMIT_LOCK:
-            saved_limit = Image.MAX_IMAGE_PIXELS
-            Image.MAX_IMAGE_PIXELS = max_pixels
-            try:
-                yield
-            finally:
-                Image.MAX_IMAGE_PIXELS = saved_limit
-
-
-_NETPBM_SIZE = re.compile(rb"\AP[1-7](?:\s|#[^\n]*\n)+(\d+)(?:\s|#[^\n]*\n)+(\d+)")
-_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-
-
-def _declared_size(data: bytes) -> tuple[int, int] | None:
-    """(width, height) from a PNG or Netpbm header that Pillow refused, else None.
-
-    Pillow reports a zero-sized file only as "cannot identify image file"; reading the size
-    ourselves lets the error say what is actually wrong.
-    """
-    if data.startswith(_PNG_SIGNATURE) and data[12:16] == b"IHDR" and len(data) >= 24:
-        width, height = struct.unpack(">II", data[16:24])
-        return width, height
-    match = _NETPBM_SIZE.match(data)
-    if match:
-        return int(match.group(1)), int(match.group(2))
-    return None
-
-
-def _decode_image(data: bytes, path: Path, *, max_pixels: int, apply_exif_orientation: bool) -> _Pixels:
-    from PIL import Image, UnidentifiedImageError
-
-    with _pillow_pixel_limit(max_pixels):
-        try:
-            image = Image.open(io.BytesIO(data))
-        except Image.DecompressionBombError as error:
-            raise MapError(
-                f"image larger than the limit max_pixels={max_pixels} (checked from the header before decoding: {error})",
-                path=path,
-            ) from None
-        except UnidentifiedImageError:
-            declared = _declared_size(data)
-            if declared is not None and 0 in declared:
-                raise MapError(f"zero-size image ({declared[0]} x {declared[1]} pixels)", path=path) from None
-            raise MapError("not an image (or a format Pillow cannot read)", path=path) from None
-        except MemoryError:
-            raise
-        except Exception as error:
-            raise MapError(f"corrupt image header: {error}", path=path) from error
-
-    width, height = image.size
-    if width == 0 or height == 0:
-        raise MapError(f"zero-size image ({width} x {height} pixels)", path=path)
-    if width * height > max_pixels:
-        raise MapError(
-            f"image has {width * height} pixels ({width} x {height}), more than the limit "
-            f"max_pixels={max_pixels} (checked from the header before decoding)",
-            path=path,
-        )
-    try:
-        if image.format == "PNG":
-            # Pillow stops decoding once it has all rows, so a PNG cut inside its last
-            # chunk loads silently; verify() walks every chunk and checks its CRC.
-            with _pillow_pixel_limit(max_pixels):
-                Image.open(io.BytesIO(data)).verify()
-        image.load()
-    except MemoryError:
-        raise
-    except Exception as error:
-        raise MapError(f"truncated or corrupt image data: {error}", path=path) from error
-    if apply_exif_orientation:
-        image = _exif_oriented(image)
-    return _pixels_from_pillow(image, path)
-
-
-def _exif_oriented(image):
-    from PIL import ImageOps
-
-    try:
-        orientation = image.getexif().get(0x0112, 1)
-    except Exception:
-        return image
-    if orientation in (2, 3, 4, 5, 6, 7, 8):
-        return ImageOps.exif_transpose(image)
-    return image
-
-
-def _pixels_from_pillow(image, path: Path | None) -> _Pixels:
-    mode = image.mode
-    transparency = image.info.get("transparency")
-    if mode == "1":
-        image, mode = image.convert("L"), "L"
-    elif mode in ("P", "PA"):
-        palette_has_alpha = image.palette is not None and "A" in image.palette.mode
-        has_alpha = mode == "PA" or transparency is not None or palette_has_alpha
-        image = image.convert("RGBA" if has_alpha else "RGB")
-        mode, transparency = image.mode, None
-    elif mode in ("La", "RGBa"):
-        # Premultiplied alpha: un-premultiply so the colour of half-covered pixels is right.
-        image = image.convert(mode.upper())
-        mode = image.mode
-
-    if mode == "L":
-        grey = np.asarray(image).copy()
-        return _Pixels(grey, _alpha_from_key(grey, transparency, channel_axis=False))
-    if mode == "LA":
-        values = np.asarray(image)
-        return _Pixels(values[..., 0].copy(), values[..., 1].copy())
-    if mode in ("RGB", "RGBX"):
-        rgb = np.asarray(image)[..., :3].copy()
-        return _Pixels(rgb, _alpha_from_key(rgb, transparency, channel_axis=True))
-    if mode == "RGBA":
-        values = np.asarray(image)
-        return _Pixels(values[..., :3].copy(), values[..., 3].copy())
-    if mode in ("I;16", "I;16L", "I;16B", "I;16N", "I"):
-        values = np.asarray(image)
-        if mode == "I" and values.size and (values.min() < 0 or values.max() > 65535):
-            raise MapError(
-                f"unsupported image mode 'I': 32-bit integer values outside 0..65535 "
-                f"(supported: {_SUPPORTED_MODES_TEXT})",
-                path=path,
-            )
-        grey = values.astype(np.uint16)
-        return _Pixels(grey, _alpha_from_key(grey, transparency, channel_axis=False))
-    raise MapError(f"unsupported image mode '{mode}' (supported: {_SUPPORTED_MODES_TEXT})", path=path)
-
-
-def _alpha_from_key(colour: np.ndarray, key, *, channel_axis: bool) -> np.ndarray | None:
-    """Opacity from a PNG tRNS colour key: the one colour that is fully transparent."""
-    if key is None:
-        return None
-    try:
-        key_values = np.asarray(key, dtype=np.int64).reshape(-1)
-    except (TypeError, ValueError):
-        return None
-    expected = 3 if channel_axis else 1
-    if key_values.size != expected:
-        # A key of the wrong shape cannot match any pixel; Pillow keeps such keys verbatim.
-        return None
-    matches = np.all(colour == key_values, axis=-1) if channel_axis else colour == key_values[0]
-    return np.where(matches, 0, 255).astype(np.uint8)
-
-
-def _pixels_from_array(values: np.ndarray, path: Path | None) -> _Pixels:
-    if values.ndim == 3 and values.shape[2] not in (1, 2, 3, 4):
-        raise MapError(f"an image array needs 1, 2, 3 or 4 channels, got shape {values.shape}", path=path)
-    if values.ndim > 3:
-        raise MapError(
-            f"an image array must be (rows, cols) or (rows, cols, channels), got shape {values.shape}", path=path
-        )
-    if values.dtype not in (np.uint8, np.uint16):
-        if not np.issubdtype(values.dtype, np.integer):
-            raise MapError(
-                f"unsupported array dtype {values.dtype}: use bool (free mask), uint8 or uint16",
-                path=path,
-            )
-        if values.min() < 0 or values.max() > 255:
-            raise MapError(
-                f"integer array of dtype {values.dtype} has values outside 0..255; pass uint16 for 16-bit images",
-                path=path,
-            )
-        values = values.astype(np.uint8)
-    if values.ndim == 2:
-        return _Pixels(values.copy(), None)
-    channels = values.shape[2]
-    if channels in (1, 2):
-        alpha = values[..., 1].copy() if channels == 2 else None
-        return _Pixels(values[..., 0].copy(), alpha)
-    rgb = _to_uint8(values[..., :3])
-    alpha = values[..., 3].copy() if channels == 4 else None
-    return _Pixels(rgb, alpha)
-
-
-# ---------------------------------------------------------------------------------------------
-# Pixel conversions
-
-
-def _row_blocks(n_rows: int, n_cols: int) -> Iterator[slice]:
-    step = max(1, _BLOCK_PIXELS // max(n_cols, 1))
-    for start in range(0, n_rows, step):
-        yield slice(start, min(start + step, n_rows))
-
-
-def _to_uint8(values: np.ndarray) -> np.ndarray:
-    """16-bit to 8-bit by rounding v / 257; 8-bit data is returned as a copy."""
-    if values.dtype == np.uint8:
-        return values.copy()
-    return ((values.astype(np.uint32) + 128) // 257).astype(np.uint8)
-
-
-def _luma(rgb: np.ndarray, *, weights: tuple[int, int, int], shift: int, rounded: bool, grey_exact: bool) -> np.ndarray:
-    grey = np.empty(rgb.shape[:2], dtype=np.uint8)
-    offset = (1 << (shift - 1)) if rounded else 0
-    for block in _row_blocks(*rgb.shape[:2]):
-        part = rgb[block].astype(np.uint32)
-        red, green, blue = part[..., 0], part[..., 1], part[..., 2]
-        value = (red * weights[0] + green * weights[1] + blue * weights[2] + offset) >> shift
-        if grey_exact:
-            # libpng copies grey pixels (R == G == B) unchanged; truncation would darken them.
-            value = np.where((red == green) & (green == blue), red, value)
-        grey[block] = value
-    return grey
-
-
-def _display_grey(pixels: _Pixels) -> np.ndarray:
-    """uint8 grey by the default rules (rounded 16-bit scaling, OpenCV luma)."""
-    if pixels.colour.ndim == 2:
-        return _to_uint8(pixels.colour)
-    return _luma(pixels.colour, weights=_CV_LUMA, shift=_CV_LUMA_SHIFT, rounded=True, grey_exact=False)
-
-
-def _imread_grey(pixels: _Pixels) -> np.ndarray:
-    """uint8 grey as cv::imread(IMREAD_GRAYSCALE) gives it for a PNG (libpng transforms)."""
-    if pixels.colour.ndim == 2:
-        if pixels.colour.dtype == np.uint16:
-            return (pixels.colour >> 8).astype(np.uint8)
-        return pixels.colour.copy()
-    return _luma(pixels.colour, weights=_LIBPNG_LUMA, shift=_LIBPNG_LUMA_SHIFT, rounded=False, grey_exact=True)
-
-
-def _transparent(alpha: np.ndarray | None) -> np.ndarray | None:
-    if alpha is None:
-        return None
-    half = (int(np.iinfo(alpha.dtype).max) + 1) // 2
-    return alpha < half
-
-
-def _binary_map(pixels: _Pixels, *, threshold: float, nonzero_free: bool, path: Path | None, sha256: str | None) -> Map:
+def _binary_map(pixels: Pixels, *, threshold: float, nonzero_free: bool, path: Path | None, sha256: str | None) -> Map:
     if nonzero_free:
-        grey = _imread_grey(pixels)
+        grey = imread_grey(pixels)
         free = grey > 0
         if not free.any():
             raise MapError("no free pixel: every pixel is black (0)", path=path)
         return Map(free=free, path=path, sha256=sha256, image=grey)
 
-    grey = _display_grey(pixels)
-    transparent = _transparent(pixels.alpha)
+    grey = display_grey(pixels)
+    transparent = transparent_mask(pixels.alpha)
+    hidden = 0
     if transparent is not None:
+        # Free-looking pixels that are transparent: the usual surprise of a palette PNG whose
+        # white entry carries tRNS transparency.
+        hidden = int(np.count_nonzero(transparent & (grey > threshold)))
         grey[transparent] = 0
     free = grey > threshold
     if not free.any():
         if transparent is not None and transparent.all():
             reason = "every pixel is transparent"
+        elif hidden:
+            reason = (
+                f"the {hidden} pixels brighter than threshold {threshold} are all transparent "
+                "(alpha < 50 %, e.g. a palette whose white entry is marked transparent), "
+                "and transparent pixels are outside the map"
+            )
         else:
             reason = f"no grey value above threshold {threshold} (the brightest is {int(grey.max())})"
         raise MapError(f"no free pixel: {reason}", path=path)
     return Map(free=free, path=path, sha256=sha256, image=grey)
-
-
-# ---------------------------------------------------------------------------------------------
-# ROS map_server YAML
-
-
-def _load_ros_yaml(yaml_path: Path, *, max_pixels: int) -> Map:
-    import yaml
-
-    text = _read_file_bytes(yaml_path, empty_problem="empty file (0 bytes): not a ROS map YAML")
-    try:
-        document = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        raise MapError(f"not valid YAML: {error}", path=yaml_path) from None
-    if not isinstance(document, dict):
-        raise MapError(
-            "not a ROS map_server YAML file: expected a mapping with keys image, resolution, "
-            f"origin, got {type(document).__name__}",
-            path=yaml_path,
-        )
-    settings = _ros_settings(document, yaml_path)
-
-    image_path = Path(settings["image"])
-    if not image_path.is_absolute():
-        image_path = yaml_path.parent / image_path
-    if not image_path.exists():
-        raise MapError(f"image file not found: {image_path}", path=yaml_path, field="image")
-    try:
-        data = _read_file_bytes(image_path, empty_problem="empty file (0 bytes): zero-size image")
-        # nav2 loads through GraphicsMagick without auto-orientation, so EXIF is ignored here.
-        pixels = _decode_image(data, image_path, max_pixels=max_pixels, apply_exif_orientation=False)
-    except MapError as error:
-        raise MapError(f"cannot load the image {image_path}: {error.problem}", path=yaml_path, field="image") from error
-
-    occupancy = _nav2_occupancy(
-        pixels,
-        mode=settings["mode"],
-        negate=settings["negate"],
-        free_thresh=settings["free_thresh"],
-        occupied_thresh=settings["occupied_thresh"],
-    )
-    free = occupancy == OCCUPANCY_FREE
-    if not free.any():
-        n_occupied = int(np.count_nonzero(occupancy == OCCUPANCY_OCCUPIED))
-        n_unknown = int(np.count_nonzero(occupancy == OCCUPANCY_UNKNOWN))
-        raise MapError(
-            f"no free cell in {image_path.name} (mode {settings['mode']}, negate {settings['negate']}, "
-            f"free_thresh {settings['free_thresh']}): {n_occupied} occupied, {n_unknown} unknown, "
-            f"{occupancy.size - n_occupied - n_unknown} intermediate",
-            path=yaml_path,
-        )
-    image = _display_grey(pixels)
-    transparent = _transparent(pixels.alpha)
-    if transparent is not None:
-        image[transparent] = 0
-    return Map(
-        free=free,
-        path=yaml_path,
-        sha256=hashlib.sha256(data).hexdigest(),
-        resolution=settings["resolution"],
-        origin=settings["origin"],
-        occupancy=occupancy,
-        image=image,
-    )
-
-
-def _ros_settings(document: dict, yaml_path: Path) -> dict:
-    """Validated map_server keys, with nav2's meaning and the defaults in _ROS_DEFAULTS."""
-
-    def fail(key: str, problem: str) -> MapError:
-        return MapError(problem, path=yaml_path, field=key)
-
-    for key in ("image", "resolution", "origin"):
-        if key not in document or document[key] is None:
-            raise fail(key, f"missing required key '{key}'")
-
-    image = document["image"]
-    if not isinstance(image, str) or not image.strip():
-        raise fail("image", f"must be a non-empty file path, got {image!r}")
-
-    resolution = document["resolution"]
-    if not _is_real_number(resolution) or not math.isfinite(resolution) or resolution <= 0:
-        raise fail("resolution", f"must be a positive number (metres per pixel), got {resolution!r}")
-
-    origin = document["origin"]
-    if (
-        not isinstance(origin, (list, tuple))
-        or len(origin) != 3
-        or not all(_is_real_number(value) and math.isfinite(value) for value in origin)
-    ):
-        raise fail("origin", f"must be a list of 3 finite numbers [x, y, yaw], got {origin!r}")
-
-    negate = document.get("negate", _ROS_DEFAULTS["negate"])
-    if isinstance(negate, bool):
-        negate = int(negate)
-    if not isinstance(negate, int) or negate not in (0, 1):
-        raise fail("negate", f"must be 0 or 1, got {negate!r}")
-
-    thresholds = {}
-    for key in ("occupied_thresh", "free_thresh"):
-        value = document.get(key, _ROS_DEFAULTS[key])
-        if not _is_real_number(value) or not 0 <= value <= 1:
-            raise fail(key, f"must be a number in [0, 1], got {value!r}")
-        thresholds[key] = float(value)
-    if thresholds["free_thresh"] >= thresholds["occupied_thresh"]:
-        raise fail(
-            "free_thresh",
-            f"must be below occupied_thresh ({thresholds['free_thresh']} >= {thresholds['occupied_thresh']})",
-        )
-
-    mode = document.get("mode", _ROS_DEFAULTS["mode"])
-    if mode not in _ROS_MODES:
-        raise fail("mode", f"must be one of {', '.join(_ROS_MODES)}, got {mode!r}")
-
-    return {
-        "image": image,
-        "resolution": float(resolution),
-        "origin": tuple(float(value) for value in origin),
-        "negate": negate,
-        "mode": mode,
-        **thresholds,
-    }
-
-
-def _nav2_lookup_table(
-    n_channels: int, *, mode: str, negate: int, free_thresh: float, occupied_thresh: float
-) -> np.ndarray:
-    """Occupancy for every possible sum of ``n_channels`` 16-bit channel values.
-
-    The per-pixel arithmetic copies nav2's ``loadMapFromFile`` on a Q16 GraphicsMagick:
-    ``shade = (sum / n_channels) / 65535``. A table over the integer sums gives the same
-    doubles as nav2 without a float array the size of the map.
-    """
-    sums = np.arange(n_channels * 65535 + 1, dtype=np.float64)
-    shade = (sums / n_channels) / 65535.0
-    if mode == "raw":
-        # std::round rounds halves away from zero; shade is never negative.
-        value = np.floor(shade * 255.0 + 0.5)
-        in_range = (value >= OCCUPANCY_FREE) & (value <= OCCUPANCY_OCCUPIED)
-        return np.where(in_range, value, OCCUPANCY_UNKNOWN).astype(np.int8)
-    occ = shade if negate else 1.0 - shade
-    table = np.full(sums.shape, OCCUPANCY_UNKNOWN, dtype=np.int8)
-    occupied = occupied_thresh < occ
-    free = ~occupied & (occ < free_thresh)
-    table[occupied] = OCCUPANCY_OCCUPIED
-    table[free] = OCCUPANCY_FREE
-    if mode == "scale":
-        between = ~occupied & ~free
-        scaled = np.rint((occ[between] - free_thresh) / (occupied_thresh - free_thresh) * 100.0)
-        table[between] = np.clip(scaled, 1, 99).astype(np.int8)
-    return table
-
-
-def _nav2_occupancy(
-    pixels: _Pixels, *, mode: str, negate: int, free_thresh: float, occupied_thresh: float
-) -> np.ndarray:
-    colour, alpha = pixels.colour, pixels.alpha
-    colour_to_q16 = 257 if colour.dtype == np.uint8 else 1
-    alpha_to_q16 = 0 if alpha is None else (257 if alpha.dtype == np.uint8 else 1)
-    alpha_in_shade = mode == "trinary" and alpha is not None
-    table = _nav2_lookup_table(
-        4 if alpha_in_shade else 3,
-        mode=mode,
-        negate=negate,
-        free_thresh=free_thresh,
-        occupied_thresh=occupied_thresh,
-    )
-    occupancy = np.empty(colour.shape[:2], dtype=np.int8)
-    for block in _row_blocks(*colour.shape[:2]):
-        part = colour[block].astype(np.uint32) * colour_to_q16
-        # A grey pixel is R = G = B for GraphicsMagick, so it counts three times.
-        sums = part.sum(axis=-1, dtype=np.uint32) if part.ndim == 3 else part * 3
-        if alpha_in_shade:
-            sums += alpha[block].astype(np.uint32) * alpha_to_q16
-        cells = table[sums]
-        if mode == "scale" and alpha is not None:
-            cells[alpha[block] != np.iinfo(alpha.dtype).max] = OCCUPANCY_UNKNOWN
-        occupancy[block] = cells
-    return occupancy
 
 
 # ---------------------------------------------------------------------------------------------
