@@ -56,7 +56,7 @@ class SketchNavigator:
         self.sketch_seg = segment(self.sketch_map, preset=self.sketch_preset)
         self.correspondences = None
         if correspondences:
-            from ursim_core.correspondences.codec import load_correspondences
+            from ursim_core.correspondences import load_correspondences
 
             self.correspondences = load_correspondences(Path(correspondences))
         self.metric_map = None
@@ -77,7 +77,7 @@ class SketchNavigator:
         metric_map = map_from_occupancy_grid(grid.data, grid.width, grid.height, grid.resolution, grid.origin)
         metric_seg = segment(metric_map, preset=self.metric_preset)
         if self.correspondences is not None:
-            from ursim_core.correspondences.codec import assign_regions
+            from ursim_core.correspondences import assign_regions
 
             assigned = assign_regions(self.correspondences, self.sketch_seg.labels, metric_seg.labels)
             table = match_table(assigned)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ursim_core.cli import main
-from ursim_core.correspondences.codec import load_correspondences, load_dat
+from ursim_core.correspondences import load_correspondences, load_dat
 
 
 def building(scale: float = 1.0) -> np.ndarray:

@@ -91,7 +91,7 @@ def test_parse_augment():
 
 
 def test_transform_map_and_correspondences_move_together():
-    from ursim_core.correspondences.codec import Clique, Correspondences, MapRef
+    from ursim_core.correspondences import Clique, Correspondences, MapRef
     from ursim_core.io.maps import Map
 
     free = np.zeros((20, 30), bool)

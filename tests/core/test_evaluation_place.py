@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ursim_core.correspondences.codec import Clique
+from ursim_core.correspondences import Clique
 from ursim_core.evaluation.scoring import place_accuracy, place_problem, score_matches, score_places
 from ursim_core.segmentation.graph import region_graph
 

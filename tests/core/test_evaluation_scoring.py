@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from ursim_core.correspondences.codec import Clique, Correspondences
+from ursim_core.correspondences import Clique, Correspondences
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation.scoring import MatchScore, score_cliques, score_matches
 

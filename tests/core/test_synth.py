@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 from scipy import ndimage
 
-from ursim_core.correspondences.codec import assign_regions, load_correspondences
+from ursim_core.correspondences import assign_regions, load_correspondences
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match

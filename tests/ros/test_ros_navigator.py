@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 import ursim_ros
-from ursim_core.correspondences.codec import Clique, Correspondences, save_correspondences
+from ursim_core.correspondences import Clique, Correspondences, save_correspondences
 from ursim_core.errors import ParameterError
 from ursim_core.io.maps import map_from_array, world_to_pixel
 from ursim_core.io.occupancy_grid import OccupancyGrid, occupancy_grid_from_map

@@ -68,7 +68,7 @@ def convert_correspondences(
     ...
     ursim_core.errors.ParameterError: a.txt: unknown correspondence file type (expected .dat or .json)
     """
-    from ursim_core.correspondences.codec import (
+    from ursim_core.correspondences import (
         MapRef,
         assign_regions,
         load_correspondences,

@@ -131,7 +131,7 @@ def prepare_navigation(args: argparse.Namespace) -> Navigation:
 
     sketch_map, metric_map = load(args.sketch), load(args.metric)
     if args.correspondences:
-        from ursim_core.correspondences.codec import assign_regions, load_correspondences
+        from ursim_core.correspondences import assign_regions, load_correspondences
 
         corr = load_correspondences(Path(args.correspondences))
         sketch_seg = _labels_or_segment(corr.sketch, sketch_map, args.sketch_preset)

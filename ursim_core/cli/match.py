@@ -138,7 +138,7 @@ def matcher_record(config, result) -> dict[str, Any]:
 
 def load_reference(path: str | Path):
     """A ground-truth file of either format, by its suffix."""
-    from ursim_core.correspondences.codec import load_correspondences, load_dat
+    from ursim_core.correspondences import load_correspondences, load_dat
 
     path = Path(path)
     suffix = path.suffix.lower()
@@ -151,7 +151,7 @@ def load_reference(path: str | Path):
 
 def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, metric_preset: str, params: dict):
     """Pair score and place score of ``pairs`` against a ground truth with points."""
-    from ursim_core.correspondences.codec import assign_regions
+    from ursim_core.correspondences import assign_regions
     from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, place_accuracy, score_matches
 
     assigned = assign_regions(reference, sketch_seg.labels, metric_seg.labels, tolerance=10)
@@ -199,7 +199,7 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
     from types import SimpleNamespace
 
     from ursim_core.cli.segment import segment_checked
-    from ursim_core.correspondences.codec import Correspondences, MapRef, from_pairs, save_correspondences
+    from ursim_core.correspondences import Correspondences, MapRef, from_pairs, save_correspondences
     from ursim_core.matching import match
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image

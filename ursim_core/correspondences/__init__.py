@@ -21,12 +21,35 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["values", "schema", "files", "json_text", "json_codec", "dat_codec", "assignment", "codec"],
+    submodules=[
+        "values",
+        "schema",
+        "files",
+        "json_text",
+        "json_codec",
+        "dat_codec",
+        "assignment",
+        "exporters",
+        "codec",
+    ],
     submod_attrs={
         "values": ["SOURCES", "STATUSES", "MapRef", "Clique", "Correspondences", "utc_timestamp"],
         "schema": ["FORMAT_NAME", "CURRENT_VERSION", "correspondences_schema"],
         "json_codec": ["SUPPORTED_VERSIONS", "load_correspondences", "save_correspondences", "correspondences_to_json"],
         "dat_codec": ["load_dat", "save_dat"],
         "assignment": ["regions_at_points", "assign_regions", "from_pairs"],
+        "exporters": [
+            "EXPORT_FORMATS",
+            "LABEL_KEY",
+            "clique_label",
+            "with_clique_label",
+            "region_polygons",
+            "correspondences_to_geojson",
+            "correspondences_to_labelme",
+            "correspondences_to_qgis_points",
+            "export_correspondences",
+            "export_format_of",
+            "export_file",
+        ],
     },
 )

@@ -55,7 +55,7 @@ def clique_label(clique) -> str | None:
 
     Kept through the codec's unknown keys until the codec has a ``label`` field of its own.
 
-    >>> from ursim_core.correspondences.codec import Clique
+    >>> from ursim_core.correspondences import Clique
     >>> clique_label(Clique(id=1, extra={"label": "kitchen"}))
     'kitchen'
     """
@@ -68,7 +68,7 @@ def with_clique_label(clique, label: str | None):
 
     What the GUI's label editor calls; the label is kept in the JSON under ``"label"``.
 
-    >>> from ursim_core.correspondences.codec import Clique
+    >>> from ursim_core.correspondences import Clique
     >>> clique_label(with_clique_label(Clique(id=1), "  corridor "))
     'corridor'
     >>> with_clique_label(Clique(id=1, extra={"label": "x"}), "").extra
@@ -172,7 +172,7 @@ def correspondences_to_geojson(corr, *, side: str = "metric", labels=None, the_m
 
     Examples
     --------
-    >>> from ursim_core.correspondences.codec import Clique, Correspondences
+    >>> from ursim_core.correspondences import Clique, Correspondences
     >>> corr = Correspondences(cliques=(Clique(id=1, metric_points=[(2, 3)], extra={"label": "hall"}),))
     >>> feature = correspondences_to_geojson(corr)["features"][0]
     >>> feature["geometry"], feature["properties"]["label"]
@@ -242,7 +242,7 @@ def correspondences_to_labelme(
 
     Examples
     --------
-    >>> from ursim_core.correspondences.codec import Clique, Correspondences
+    >>> from ursim_core.correspondences import Clique, Correspondences
     >>> corr = Correspondences(cliques=(Clique(id=2, sketch_points=[(10, 4)]),))
     >>> shape = correspondences_to_labelme(corr, image_size=(20, 30))["shapes"][0]
     >>> shape["label"], shape["points"], shape["group_id"], shape["shape_type"]
@@ -302,7 +302,7 @@ def correspondences_to_qgis_points(corr, *, metric_map=None, crs_wkt: str = "") 
 
     Examples
     --------
-    >>> from ursim_core.correspondences.codec import Clique, Correspondences
+    >>> from ursim_core.correspondences import Clique, Correspondences
     >>> corr = Correspondences(cliques=(Clique(id=1, sketch_points=[(10, 20)], metric_points=[(5, 7)]),))
     >>> print(correspondences_to_qgis_points(corr), end="")
     #CRS:
@@ -396,7 +396,7 @@ def export_file(
         Unknown format or side. FormatError / MapError / SegmentationError for unreadable
         inputs, naming the file.
     """
-    from ursim_core.correspondences.codec import load_correspondences, load_dat
+    from ursim_core.correspondences import load_correspondences, load_dat
 
     _check_side(side)
     kind = export_format_of(target, format)

@@ -12,7 +12,7 @@ Protocol (``original_code.md`` §1.1, §1.13; correct scoring of ``ursim_core.ev
   both maps; the *released* pipeline uses every non-zero pixel as free and the ``"ursim-released"``
   preset (t = 0.50) for both, as the released driver did.
 - Ground-truth points map to regions of the segmentation being matched by
-  :func:`ursim_core.correspondences.codec.regions_at_points` (10 px tolerance).
+  :func:`ursim_core.correspondences.regions_at_points` (10 px tolerance).
 - F1 is computed per sketch and annotator with ``score_matches`` (correct mode by default:
   pairs counted once, cliques with an empty side ignored; ``legacy="fnfix"`` reproduces the
   released scorer with the flag initialised).
@@ -55,16 +55,16 @@ def reference_cliques(labels: np.ndarray, metric_labels: np.ndarray, cliques, *,
     labels, metric_labels : ndarray
         Label images of the sketch and the metric map.
     cliques : iterable of Clique
-        From :func:`ursim_core.correspondences.codec.load_dat` (``sketch_points``, ``metric_points``).
+        From :func:`ursim_core.correspondences.load_dat` (``sketch_points``, ``metric_points``).
 
     Examples
     --------
-    >>> from ursim_core.correspondences.codec import Clique
+    >>> from ursim_core.correspondences import Clique
     >>> sketch = np.array([[1, 1, 2]]); metric = np.array([[5, 6, 6]])
     >>> reference_cliques(sketch, metric, [Clique(id=1, sketch_points=[(0, 2)], metric_points=[(0, 0)])])
     [({2}, {5})]
     """
-    from ursim_core.correspondences.codec import Correspondences, assign_regions
+    from ursim_core.correspondences import Correspondences, assign_regions
 
     assigned = assign_regions(Correspondences(cliques=tuple(cliques)), labels, metric_labels, tolerance=tolerance)
     return [(set(c.sketch_regions), set(c.metric_regions)) for c in assigned.cliques]
@@ -127,7 +127,7 @@ def kth_pairs(root, *, pipeline: str = "recommended", sketches: Sequence[str] | 
     """
     import time
 
-    from ursim_core.correspondences.codec import load_dat
+    from ursim_core.correspondences import load_dat
 
     root = Path(root)
     folder = root / "ursim_kth_sketches"

@@ -8,7 +8,7 @@ Pipeline (:func:`run_evaluation`):
    in a caller-owned dict (``segmentation_cache``) and on disk (``cache_dir``); keys include the
    file's SHA-256, so an edited map is segmented again.
 3. The ground-truth points of each annotator are mapped to the regions of the segmentations being
-   evaluated (:func:`ursim_core.correspondences.codec.assign_regions`, 10 px tolerance as the released
+   evaluated (:func:`ursim_core.correspondences.assign_regions`, 10 px tolerance as the released
    code). The points were clicked on MAORIS with its default parameters; they are mapped onto
    whatever segmentation is evaluated, so a point may land in a merged or split region.
 4. For each (experiment, matcher, variant) the m-independent work is done once, then every m of

@@ -115,8 +115,8 @@ def score_matches(pairs: Iterable[tuple[int, int]], reference: Iterable, *, lega
     reference : iterable
         Reference cliques, each a ``(sketch_regions, metric_regions)`` pair of
         collections of region ids, or an object with ``sketch_regions`` and
-        ``metric_regions`` attributes (a :class:`~ursim_core.correspondences.codec.Clique`).
-        A :class:`~ursim_core.correspondences.codec.Correspondences` is taken as its cliques.
+        ``metric_regions`` attributes (a :class:`~ursim_core.correspondences.Clique`).
+        A :class:`~ursim_core.correspondences.Correspondences` is taken as its cliques.
     legacy : {False, True, "as-built", "fnfix"}, keyword-only
         Scoring rules; see the module docstring. False is the correct scoring.
 
@@ -359,7 +359,7 @@ def place_problem(
     tolerance : float, keyword-only
         Largest distance of a point to its region (the released code's 10 px rule).
     """
-    from ursim_core.correspondences.codec import regions_at_points
+    from ursim_core.correspondences import regions_at_points
 
     indices, sketch_regions, places = [], [], []
     for index, (sketch_points, metric_points) in enumerate(_point_cliques(reference)):

@@ -4,7 +4,7 @@ An :class:`Instance` is one experiment in one orientation of its sketch (upright
 evaluation is augmented); the ground-truth sketch points of a turned sketch are turned with it.
 
 1. The ground-truth points of each annotator are mapped to the regions of the segmentations being
-   evaluated (:func:`ursim_core.correspondences.codec.assign_regions`, 10 px tolerance as the released
+   evaluated (:func:`ursim_core.correspondences.assign_regions`, 10 px tolerance as the released
    code). The points were clicked on MAORIS with its default parameters; they are mapped onto
    whatever segmentation is evaluated, so a point may land in a merged or split region.
 2. For each (experiment, matcher, variant) the m-independent work is done once
@@ -90,7 +90,7 @@ class Reference:
 
 def references_of(instances: list[Instance], segmentations) -> tuple[list[dict[str, Reference]], list[str]]:
     """Per instance (same order): annotator -> :class:`Reference`; and notes on dropped points."""
-    from ursim_core.correspondences.codec import assign_regions, load_dat, regions_at_points
+    from ursim_core.correspondences import assign_regions, load_dat, regions_at_points
     from ursim_core.evaluation.augment import transform_correspondences
 
     loaded: dict[Path, Any] = {}

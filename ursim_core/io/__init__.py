@@ -21,7 +21,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["atomic", "images", "maps", "reading", "ros_yaml"],
+    submodules=["atomic", "images", "maps", "occupancy_grid", "reading", "ros_yaml"],
     submod_attrs={
         "atomic": ["atomic_write_bytes", "atomic_write_text"],
         "maps": [
@@ -35,6 +35,17 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "OCCUPANCY_FREE",
             "OCCUPANCY_OCCUPIED",
             "OCCUPANCY_UNKNOWN",
+        ],
+        "occupancy_grid": [
+            "OccupancyGrid",
+            "map_from_occupancy_grid",
+            "occupancy_grid_from_map",
+            "occupancy_from_free",
+            "save_map_yaml",
+            "yaw_from_quaternion",
+            "quaternion_from_yaw",
+            "SAVE_MODES",
+            "SAVE_DEFAULTS",
         ],
     },
 )

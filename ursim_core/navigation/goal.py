@@ -2,7 +2,7 @@
 
 The rule is the one of place accuracy (issue 11), so that the score and the robot agree: the
 tapped sketch point belongs to the region under it (or the nearest region within 10 px, the
-annotators' rule, :func:`~ursim_core.correspondences.codec.regions_at_points`); the goal is the
+annotators' rule, :func:`~ursim_core.correspondences.regions_at_points`); the goal is the
 interior point (the pixel farthest from the region's border) of the *largest* metric region
 matched to that sketch region. ``target="mirror"`` instead places the goal where the tap sits
 relative to its sketch region, carried over by the similarity that best aligns the matched
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ursim_core.correspondences.codec import regions_at_points
+from ursim_core.correspondences import regions_at_points
 from ursim_core.correspondences.exporters import LABEL_KEY, clique_label
 from ursim_core.errors import ParameterError
 

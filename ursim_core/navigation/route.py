@@ -20,7 +20,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from ursim_core.correspondences.codec import regions_at_points
+from ursim_core.correspondences import regions_at_points
 from ursim_core.errors import ParameterError
 from ursim_core.navigation.goal import MatchTable, match_table
 

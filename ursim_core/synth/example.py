@@ -63,7 +63,7 @@ def save_example(plan: FloorPlan, sketch: Sketch, folder: str | Path, *, now: st
     """Write ``metric.png``, ``sketch.png`` (8-bit grey, 255 free, 0 wall) and ``ground_truth.json``.
 
     The JSON file is in the project's correspondence format
-    (:func:`ursim_core.correspondences.codec.save_correspondences`), with the maps' sizes and
+    (:func:`ursim_core.correspondences.save_correspondences`), with the maps' sizes and
     SHA-256 and one clique per place present in both maps.
 
     Parameters
@@ -86,7 +86,7 @@ def save_example(plan: FloorPlan, sketch: Sketch, folder: str | Path, *, now: st
     """
     import dataclasses
 
-    from ursim_core.correspondences.codec import MapRef, save_correspondences
+    from ursim_core.correspondences import MapRef, save_correspondences
     from ursim_core.io.atomic import atomic_write_bytes
 
     folder = Path(folder)

@@ -37,11 +37,11 @@ def ground_truth_pairs(plan: FloorPlan, sketch: Sketch) -> list[tuple[list[tuple
 def ground_truth_correspondences(
     plan: FloorPlan, sketch: Sketch, *, sketch_path: str | Path | None = None, metric_path: str | Path | None = None
 ):
-    """The ground truth as a :class:`~ursim_core.correspondences.codec.Correspondences` value.
+    """The ground truth as a :class:`~ursim_core.correspondences.Correspondences` value.
 
     One clique per place in both maps, numbered from 1 in place order, noted
     ``"place <id> <kind>"``; region lists are left empty (they depend on a segmentation,
-    see :func:`ursim_core.correspondences.codec.assign_regions`).
+    see :func:`ursim_core.correspondences.assign_regions`).
 
     Examples
     --------
@@ -53,7 +53,7 @@ def ground_truth_correspondences(
     >>> corr.metric.size == plan.free.shape
     True
     """
-    from ursim_core.correspondences.codec import Clique, Correspondences, MapRef
+    from ursim_core.correspondences import Clique, Correspondences, MapRef
 
     kinds = plan.kinds
     cliques = tuple(

@@ -7,13 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from ursim_core.correspondences.codec import (
-    Clique,
-    Correspondences,
-    MapRef,
-    load_correspondences,
-    save_correspondences,
-)
+from ursim_core.correspondences import Clique, Correspondences, MapRef, load_correspondences, save_correspondences
 from ursim_core.correspondences.exporters import (
     clique_label,
     correspondences_to_geojson,

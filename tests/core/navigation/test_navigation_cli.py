@@ -13,7 +13,7 @@ from PIL import Image
 
 from ursim_core.cli import goal as goal_cli
 from ursim_core.cli import route as route_cli
-from ursim_core.correspondences.codec import Clique, Correspondences, MapRef, save_correspondences
+from ursim_core.correspondences import Clique, Correspondences, MapRef, save_correspondences
 from ursim_core.errors import FormatError, UrsimError
 from ursim_core.io.maps import load_map, world_to_pixel
 from ursim_core.io.occupancy_grid import save_map_yaml

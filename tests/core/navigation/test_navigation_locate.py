@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ursim_core.correspondences.codec import Clique, Correspondences
+from ursim_core.correspondences import Clique, Correspondences
 from ursim_core.errors import ParameterError
 from ursim_core.io.maps import Map, world_to_pixel
 from ursim_core.navigation import MatchTable, locate, match_table

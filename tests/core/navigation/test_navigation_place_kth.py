@@ -20,7 +20,7 @@ import pytest
 from PIL import Image
 
 from ursim_core.cli import goal as goal_cli
-from ursim_core.correspondences.codec import load_dat, regions_at_points
+from ursim_core.correspondences import load_dat, regions_at_points
 from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 from ursim_core.io.maps import load_map
 from ursim_core.matching.pipeline import match

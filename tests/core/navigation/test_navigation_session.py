@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from ursim_core.correspondences.codec import Clique, Correspondences
+from ursim_core.correspondences import Clique, Correspondences
 from ursim_core.errors import ParameterError
 from ursim_core.io.maps import Map
 from ursim_core.navigation import NAVIGATION_FORMAT, NavigationSession, load_waypoints_yaml
