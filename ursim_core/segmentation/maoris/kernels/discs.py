@@ -32,7 +32,7 @@ the number of pixel runs of the result plus the number of pixels (about
 
 Half-widths ``isqrt(R^2 - d^2)`` come from integer arithmetic only, so the
 result is bit for bit that of painting every disc
-(:func:`ursim_core.segmentation.maoris.inscribed_circle_radii`).
+(:func:`ursim_core.segmentation.maoris.inscribed_circle.inscribed_circle_radii`).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ursim_core.segmentation._loop_helpers import loop_helper
+from ursim_core.segmentation.maoris.kernels.helpers import loop_helper
 
 # Columns of the shape table returned by :func:`centre_rectangles`.
 TOP, BOTTOM, LEFT, RIGHT, RADIUS, DIAGONALS = range(6)
