@@ -24,8 +24,8 @@ _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
     "discs": ("centre_rectangles", "paint_discs"),
     "flat_zones": ("label_flat_zones", "zone_values_and_sizes", "first_pixels", "resolve_parents", "relabel"),
-    "adjacency": ("build_adjacency", "adjacency_entries", "adjacency_from_entries", "remove_small_zones"),
-    "contacts": ("count_contacts", "join_counts", "contact_table", "_compact_labels"),
+    "adjacency": ("build_adjacency", "adjacency_entries", "_link_entries", "remove_small_zones"),
+    "contacts": ("_compact_labels", "count_contacts", "join_counts", "contact_table"),
     "fusion": ("merge_ripples", "remove_doors"),
 }
 

@@ -21,7 +21,7 @@ from ursim_core.segmentation.maoris.steps import (
     remove_small_zones,
     watershed_merge,
 )
-from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, flat_zones
+from ursim_core.segmentation.maoris.zone_graph import ZoneGraph, flat_zones
 
 __all__ = ["maoris_labels", "compile_kernels"]
 
@@ -78,12 +78,21 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     return labels
 
 
-def compile_kernels() -> float:
-    """Compile (or load from numba's cache) the compiled steps; return the seconds it took.
+def compile_kernels(*, processes: int | None = None) -> float:
+    """Compile (or load from numba's cache) the MAORIS kernels; return the seconds it took.
 
-    The first segmentation in a new environment otherwise pays this (about
-    43 s; under a second once cached). Benchmarks call it
-    so that their timings exclude it.
+    The first segmentation in a new environment otherwise pays this; benchmarks call it
+    so that their timings exclude it. Prints nothing (callers say what is happening:
+    :func:`~ursim_core.segmentation.maoris.kernel_cache.kernels_cached` tells whether it
+    will take long).
+
+    Parameters
+    ----------
+    processes : int, optional
+        When the kernels are not all cached, compile their groups
+        (:data:`~ursim_core.segmentation.maoris.kernels.signatures.GROUPS`) in this many
+        processes at once into numba's cache, then load them here. Default: one per
+        usable CPU, at most the number of groups; 1 compiles in this process only.
 
     Examples
     --------
@@ -92,12 +101,27 @@ def compile_kernels() -> float:
     """
     import time
 
+    from ursim_core.segmentation.maoris.kernel_cache import kernels_cached
+    from ursim_core.segmentation.maoris.kernels import signatures
+
     start = time.perf_counter()
-    free = np.zeros((40, 60), bool)
-    free[3:37, 3:28] = free[3:37, 31:57] = free[15:22, 28:31] = True  # two rooms and a door
-    labels = maoris_labels(free, PRESETS["default"])
-    # Large images count contacts in bands of rows, which this small one does not.
-    padded = np.pad(labels, _PAD)
-    alive = np.arange(int(labels.max()) + 1) > 0
-    _contacts.start_tracking(padded.ravel(), padded.shape[1], alive, bands=2)
+    if processes is None:
+        processes = min(_contacts._usable_cpus(), len(signatures.GROUPS))
+    if processes > 1 and not kernels_cached():
+        _compile_in_processes(len(signatures.GROUPS), processes)
+    signatures.compile_group()
     return time.perf_counter() - start
+
+
+def _compile_in_processes(groups: int, processes: int) -> None:
+    import subprocess
+    import sys
+
+    code = "from ursim_core.segmentation.maoris.kernels.signatures import compile_group; compile_group({})"
+    pending = list(range(groups))
+    running: list[subprocess.Popen] = []
+    while pending or running:
+        while pending and len(running) < processes:
+            running.append(subprocess.Popen([sys.executable, "-c", code.format(pending.pop(0))]))
+        running.pop(0).wait()
+    # A failed group is compiled again in this process (compile_group), with its error.

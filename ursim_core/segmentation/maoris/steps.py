@@ -44,7 +44,7 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     parent = np.where(graph._alive, np.arange(len(graph._value), dtype=np.int32), 0).astype(np.int32)
     _adjacency.remove_small_zones(int(min_size), graph._size, graph._alive, parent, compact)
     _flat_zones.resolve_parents(parent, graph._alive)
-    _flat_zones.relabel(graph._labels, parent)
+    _flat_zones.relabel(graph._labels.ravel(), parent)
     return graph
 
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ursim_core.segmentation.maoris.kernels.helpers import loop_helper
+from ursim_core.segmentation.maoris.kernels.helpers import inner_kernel, loop_helper
 
 NO_MINIMUM = -1
 
@@ -47,7 +47,7 @@ HEAD, TAIL, DEGREE, VALUE = 0, 1, 2, 3
 NEIGHBOUR, NEXT, PREVIOUS, ATTRIBUTE = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@inner_kernel
 def _contacts_in_order(zones, last_partner, records, nodes, count_only):
     """Scan the 4-contacts of a zone image in raster order (each pixel against
     its left, then its upper neighbour) and link the new edges; or, with
@@ -55,7 +55,7 @@ def _contacts_in_order(zones, last_partner, records, nodes, count_only):
     number of edges). Returns the number of nodes used otherwise."""
     rows, cols = zones.shape
     n_candidates = 0
-    n_nodes = 0
+    n_nodes = np.int64(0)  # typed, not a literal: a literal argument compiles a callee twice
     for row in range(rows):
         last_left_a, last_left_b = -1, -1
         for col in range(cols):
@@ -93,7 +93,7 @@ def _contacts_in_order(zones, last_partner, records, nodes, count_only):
     return n_candidates if count_only else n_nodes
 
 
-@njit(cache=True)
+@inner_kernel
 def _isolated_zones(value):
     """Zone records without neighbours, zone z of value ``value[z]``."""
     records = np.empty((len(value), 4), np.int32)
@@ -136,25 +136,30 @@ def _link_pair(records, nodes, node, a, b, minimum, unbreakable):
     nodes[node + 1, ATTRIBUTE] = unbreakable
 
 
-@njit(cache=True)
 def adjacency_from_entries(zone, other, minimum, unbreakable, value):
     """Zone graph from (zone, neighbour, minimum, unbreakable) entries, each
     zone's in list order: the inverse of :func:`adjacency_entries`. Every edge
     must appear in both directions, with the same attributes."""
-    count = len(value)
-    records = _isolated_zones(value)
     # Entry i of an edge (low -> high) owns the node pair 2i, 2i + 1; the
-    # reversed entry finds it by key.
+    # reversed entry finds it by key. The keys are distinct, so any sort gives the
+    # same owners; numpy's sort here spares compiling numba's (about 5 s).
+    count = len(value)
     keys = zone.astype(np.int64) * count + other
     order = np.argsort(keys)
-    sorted_keys = keys[order]
+    low, high = np.minimum(zone, other).astype(np.int64), np.maximum(zone, other)
+    owner = order[np.searchsorted(keys[order], low * count + high)]
+    return _link_entries(zone, other, owner, minimum, unbreakable, value)
+
+
+@njit(cache=True)
+def _link_entries(zone, other, owner, minimum, unbreakable, value):
+    """:func:`adjacency_from_entries` given each entry's owner entry."""
+    records = _isolated_zones(value)
     nodes = np.empty((max(2 * len(zone), 2), 4), np.int32)
     for i in range(len(zone)):
-        low, high = min(zone[i], other[i]), max(zone[i], other[i])
-        owner = order[np.searchsorted(sorted_keys, np.int64(low) * count + high)]
-        node = 2 * owner if zone[i] == low else 2 * owner + 1
+        node = 2 * owner[i] if zone[i] < other[i] else 2 * owner[i] + 1
         _append(records, nodes, zone[i], node, other[i])
-        if zone[i] == low:
+        if zone[i] < other[i]:
             nodes[node, ATTRIBUTE] = minimum[i]
             nodes[node + 1, ATTRIBUTE] = unbreakable[i]
     return records, nodes

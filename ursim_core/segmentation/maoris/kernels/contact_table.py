@@ -8,9 +8,8 @@ many partners spill into a shared hash table.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from ursim_core.segmentation.maoris.kernels.helpers import _filled, loop_helper
+from ursim_core.segmentation.maoris.kernels.helpers import _filled, inner_kernel, loop_helper
 
 # A hash table of int64 keys ``a * base + b`` -> count, open addressing with
 # linear probing (much faster than a typed dict for millions of updates).
@@ -21,7 +20,7 @@ _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MEMO = 64  # recently used keys -> slots: neighbouring pixels repeat the same few keys
 
 
-@njit(cache=True)
+@inner_kernel
 def _new_table(bits):
     """Empty table with 2**bits slots: keys, counts and ``meta`` = [entries, bits,
     memo keys (_MEMO), memo slots (_MEMO)]."""
@@ -69,7 +68,7 @@ def _table_add(keys, counts, meta, key, delta):
         meta[0] += 1
 
 
-@njit(cache=True)
+@inner_kernel
 def _table_reserve(keys, counts, meta, more):
     """The table itself, or a larger copy if ``more`` new keys could overfill it."""
     if 2 * (meta[0] + more) <= len(keys):

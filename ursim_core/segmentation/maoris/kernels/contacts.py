@@ -24,7 +24,7 @@ from ursim_core.segmentation.maoris.kernels.contact_table import (
     _table_reserve,
 )
 from ursim_core.segmentation.maoris.kernels.flat_zones import relabel
-from ursim_core.segmentation.maoris.kernels.helpers import _filled, _grown, _zone_of, loop_helper
+from ursim_core.segmentation.maoris.kernels.helpers import _filled, _grown, _zone_of, inner_kernel, loop_helper
 
 # Size of the cache of pending counts when counting from scratch (count_contacts).
 _PENDING_BITS = 14
@@ -97,7 +97,7 @@ def _count(around, partners, total):
     if not _is_contour(around):
         return 0
     total[around[4]] += 1
-    return _distinct_others(around, partners, 0)
+    return _distinct_others(around, partners, np.int64(0))
 
 
 @loop_helper
@@ -122,7 +122,7 @@ def _recount(around, here, into, partners, signs, total):
             return own, 0
         own = into
         total[own] += 1
-        n = _distinct_others(around, partners, 0)
+        n = _distinct_others(around, partners, np.int64(0))
         for i in range(n):
             signs[i] = 1
     elif own == into:
@@ -140,7 +140,7 @@ def _recount(around, here, into, partners, signs, total):
         if not _is_contour(around):
             # No longer a contour pixel: it leaves every count of `into`.
             total[own] -= 1
-            n = _distinct_others(around, partners, 1)
+            n = _distinct_others(around, partners, np.int64(1))
             for i in range(1, n):
                 signs[i] = -1
     elif was_contour:
@@ -204,7 +204,7 @@ def _compact_labels(labels, alive):
     return original, compact_of, n
 
 
-@njit(cache=True)
+@inner_kernel
 def _restore_labels(labels, parent, original):
     """Undo :func:`_compact_labels`, each label replaced by its current zone."""
     lookup = np.zeros(len(parent), np.int32)
@@ -230,7 +230,7 @@ def count_contacts(labels, width, n, start, stop):
     following = np.empty(1024, np.int32)
     head = _filled(n, -1, np.int32)
     tail = _filled(n, -1, np.int32)
-    keys, counts, meta = _new_table(16)
+    keys, counts, meta = _new_table(np.int64(16))
     slots = _filled(n * _SLOTS, -1, np.int64)
     for zone in range(n):
         slots[zone * _SLOTS] = 0
@@ -269,7 +269,7 @@ def count_contacts(labels, width, n, start, stop):
                 continue
             if pending_keys[index] != _EMPTY:
                 if 2 * (meta[0] + 1) > len(keys):
-                    keys, counts = _table_reserve(keys, counts, meta, 1)
+                    keys, counts = _table_reserve(keys, counts, meta, np.int64(1))
                 evicted = pending_keys[index]
                 _contact_add(slots, keys, counts, meta, base, evicted // base, evicted % base, pending_counts[index])
             pending_keys[index] = key
@@ -364,7 +364,9 @@ def contact_table(labels, width, alive):
     count)`` rows in original ids (other = 0: the zone's contour size)."""
     work = labels.copy()
     original, compact_of, n = _compact_labels(work, alive)
-    pixels, following, head, tail, used, keys, counts, meta, slots, total = count_contacts(work, width, n, 0, work.size)
+    pixels, following, head, tail, used, keys, counts, meta, slots, total = count_contacts(
+        work, width, n, np.int64(0), work.size
+    )
     rows = 0
     for zone in range(1, n):
         if total[zone] > 0:

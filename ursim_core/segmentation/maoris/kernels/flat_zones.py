@@ -51,7 +51,7 @@ def label_flat_zones(values):
             final[label] = zones
         else:
             final[label] = final[root]
-    relabel(labels, final)
+    relabel(labels.ravel(), final)
     return labels
 
 

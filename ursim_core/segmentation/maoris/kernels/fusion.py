@@ -25,7 +25,7 @@ from ursim_core.segmentation.maoris.kernels.contacts import (
     _recount,
     _restore_labels,
 )
-from ursim_core.segmentation.maoris.kernels.helpers import _bits, _filled, _grown, _prefetch, loop_helper
+from ursim_core.segmentation.maoris.kernels.helpers import _bits, _filled, _grown, _prefetch, inner_kernel, loop_helper
 
 
 @loop_helper
@@ -55,7 +55,7 @@ def _mark(pixel, labels, seen, bits, affected, used, n_affected):
 _AHEAD = 6
 
 
-@njit(cache=True)
+@inner_kernel
 def _contacts_fuse(here, into, labels, width, state, scratch):
     """Fuse compact zone ``here`` into ``into`` in the contact state; returns
     the state (its table may have grown) and the scratch arrays, grown if needed.
@@ -134,7 +134,7 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
         change_counts = np.zeros(size, np.int64)
         changed = np.empty(size // 2, np.int64)
     change_bits = _bits(len(change_keys))
-    n_changed = 0
+    n_changed = np.int64(0)
     for k in range(n_affected):
         _neighbourhood(labels, parent, affected[k], width, around)
         own, n = _recount(around, here, into, partners, signs, total)
@@ -167,16 +167,16 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
     return state, (walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed)
 
 
-@njit(cache=True)
+@inner_kernel
 def _new_scratch():
     """Empty scratch arrays of :func:`_contacts_fuse`."""
     return (
         np.empty(1024, np.int32),
         np.empty(1024, np.int32),
-        _filled(4096, _EMPTY, np.int64),
+        _filled(np.int64(4096), _EMPTY, np.int64),
         np.empty(1024, np.int32),
         np.empty(1024, np.int64),
-        _filled(4096, _EMPTY, np.int64),
+        _filled(np.int64(4096), _EMPTY, np.int64),
         np.zeros(4096, np.int64),
         np.empty(2048, np.int64),
     )

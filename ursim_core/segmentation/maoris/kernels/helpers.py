@@ -15,8 +15,15 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-loop_helper = njit(cache=True, _nrt=False, forceinline=True)
+# Neither decorator caches nor builds the wrappers that let Python call a function
+# (``no_cpython_wrapper``): a helper is compiled into the kernels that call it, and
+# those are cached whole. Each cached or wrapped function costs a few tenths of a
+# second when the kernels compile on an empty cache, and there are about fifty.
+loop_helper = njit(_nrt=False, forceinline=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 """Decorator of the helpers called in the compiled loops: no NRT, always inlined."""
+
+inner_kernel = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True)
+"""Decorator of the compiled functions that only other compiled functions call."""
 
 
 @intrinsic
@@ -41,7 +48,7 @@ def _prefetch(typingctx, array, index):
     return signature, codegen
 
 
-@njit(cache=True)
+@inner_kernel
 def _filled(size, fill, dtype):
     # np.full and slice assignments cost seconds of compilation each; loops do not.
     array = np.empty(size, dtype)
@@ -50,7 +57,7 @@ def _filled(size, fill, dtype):
     return array
 
 
-@njit(cache=True)
+@inner_kernel
 def _grown(array, capacity, fill):
     grown = np.empty(capacity, array.dtype)
     for i in range(capacity):
