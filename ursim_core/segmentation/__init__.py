@@ -27,6 +27,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "interface": [
             "Segmentation",
             "SEGMENTERS",
+            "DEFAULT_SEGMENTERS",
             "segment",
             "resolve_params",
             "read_label_array",

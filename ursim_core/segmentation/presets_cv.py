@@ -90,15 +90,16 @@ def _grid(method: str, **axes: list) -> list[Candidate]:
 def default_selections(maps: str = "sketches") -> dict[str, list[Candidate]]:
     """The selection rules of the presets chosen on data, by preset name.
 
-    Sketches: ``sketch`` as it was chosen (threshold x doors, the module docstring of
-    :mod:`ursim_core.segmentation.maoris.params`) and ``sketch-cv``, a wider MAORIS grid
-    (threshold, doors, quantum, ripples, small_after). Robot maps: ``watershed`` (door
-    ratio x minimum size) and the MAORIS threshold x doors grid.
+    Sketches: ``sketch``, the MAORIS grid it is chosen from (threshold, doors, quantum,
+    ripples, small_after; :mod:`ursim_core.segmentation.maoris.params`), and
+    ``sketch-t-doors``, the threshold x doors grid of the earlier ``sketch``. Robot maps:
+    ``watershed`` (door ratio x minimum size, its defaults'
+    :data:`~ursim_core.segmentation.watershed.WATERSHED_DEFAULTS`) and the MAORIS
+    threshold x doors grid.
     """
     if maps == "sketches":
         return {
-            "sketch": _grid("maoris", threshold=[0.25, 0.30, 0.35, 0.40, 0.50], doors=[40, 50, 60]),
-            "sketch-cv": _grid(
+            "sketch": _grid(
                 "maoris",
                 threshold=[0.15, 0.20, 0.25],
                 doors=[50, 100],
@@ -106,10 +107,11 @@ def default_selections(maps: str = "sketches") -> dict[str, list[Candidate]]:
                 ripples=[40, 45],
                 small_after=[0, 100],
             ),
+            "sketch-t-doors": _grid("maoris", threshold=[0.25, 0.30, 0.35, 0.40, 0.50], doors=[40, 50, 60]),
         }
     return {
-        "watershed": _grid("watershed", door_ratio=[0.4, 0.5, 0.6, 0.7, 0.8], min_size=[100, 200, 400, 800]),
-        "maoris-grid": _grid("maoris", threshold=[0.25, 0.30, 0.40, 0.50], doors=[40, 60]),
+        "watershed": _grid("watershed", door_ratio=[0.7, 0.75, 0.8, 0.85, 0.9], min_size=[50, 100, 200]),
+        "maoris-t-doors": _grid("maoris", threshold=[0.25, 0.30, 0.40, 0.50], doors=[40, 60]),
     }
 
 

@@ -77,11 +77,15 @@ def test_kernel_cache_lists_the_declared_kernels():
 
 def test_kernels_cached_is_true_after_compiling_and_false_on_an_empty_cache(tmp_path):
     from ursim_core.segmentation.maoris import compile_kernels, kernels_cached
+    from ursim_core.segmentation.maoris.kernel_cache import compile_notice
 
     compile_kernels(processes=1)
-    assert kernels_cached()
-    code = "from ursim_core.segmentation.maoris import kernels_cached; print(kernels_cached())"
-    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path)) == "False"
+    assert kernels_cached() and compile_notice() is None
+    code = (
+        "from ursim_core.segmentation.maoris.kernel_cache import compile_notice, kernels_cached\n"
+        "print(kernels_cached(), compile_notice())"
+    )
+    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path)).startswith("False Compiling the segmentation kernels (first run")
 
 
 def test_region_graph_boxes_are_those_of_scipy_find_objects():

@@ -87,3 +87,13 @@ def test_cross_validation_chooses_each_maps_candidate_on_the_other_maps(monkeypa
     summary = {row["preset"]: row for row in cv.summary()}
     assert summary["p"]["cv_worst"] < summary["p"]["cv_mean"] <= 1.0
     assert summary["annotators' agreement"]["cv_mean"] == 1.0  # a and b agree everywhere
+
+
+def test_raster_renumbering_is_that_of_the_scoring_module():
+    from ursim_core.segmentation.scoring import relabel_in_raster_order
+    from ursim_core.segmentation.watershed import _in_raster_order
+
+    rng = np.random.default_rng(1)
+    for shape in ((1, 1), (6, 1), (1, 7), (30, 41)):
+        labels = rng.choice(np.array([0, 3, 4, 9], np.int32), size=shape)
+        assert np.array_equal(_in_raster_order(labels), relabel_in_raster_order(labels))

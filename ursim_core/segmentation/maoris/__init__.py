@@ -34,8 +34,10 @@ one by one in an order that decides ties, so the graph steps cannot be
 vectorised; steps 3, 4 and 6 run as compiled code (numba, :mod:`.kernels`)
 on an array form of the zone graph, and step 1 paints its discs with compiled
 code too (:mod:`.kernels.discs`). The contacts of large maps are counted in bands
-of rows on one thread per CPU. The kernels compile on first use, about 43 s,
-once: numba caches them beside the module (or in ``NUMBA_CACHE_DIR``).
+of rows on one thread per CPU. The kernels compile once, about 27 s of CPU
+(:func:`compile_kernels` spreads it over two processes; ``ursim bench compile``
+measures it), and numba caches them beside the module (or in ``NUMBA_CACHE_DIR``);
+:func:`kernels_cached` tells, without importing numba, whether that is done.
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
 

@@ -15,7 +15,7 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["kernels_cached", "ENTRY_KERNELS"]
+__all__ = ["kernels_cached", "compile_notice", "ENTRY_KERNELS", "COMPILE_CPU_SECONDS"]
 
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 
@@ -28,6 +28,28 @@ ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
     "contacts": ("_compact_labels", "count_contacts", "join_counts", "contact_table"),
     "fusion": ("merge_ripples", "remove_doors"),
 }
+
+
+#: CPU seconds that compiling every kernel on an empty cache took here (``ursim bench
+#: compile``, 2-CPU machine); :func:`compile_notice` turns it into the user's wait.
+COMPILE_CPU_SECONDS = 27
+
+
+def compile_notice() -> str | None:
+    """The line to show before a segmentation that will first compile the kernels, else None.
+
+    Examples
+    --------
+    >>> compile_notice() is None or compile_notice().startswith("Compiling")
+    True
+    """
+    if kernels_cached():
+        return None
+    processes = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 2)
+    return (
+        "Compiling the segmentation kernels (first run only, about "
+        f"{round(COMPILE_CPU_SECONDS / processes * 1.2 / 5) * 5} s)..."
+    )
 
 
 def _cache_dirs(source: Path) -> list[Path]:

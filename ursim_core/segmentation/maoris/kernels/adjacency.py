@@ -24,8 +24,8 @@ work is bound by memory latency, not arithmetic):
 :class:`ursim_core.segmentation.maoris.zone_graph.ZoneGraph` owns the arrays; the
 functions here only mutate them. Semantics are those documented on
 ``flat_zones``, ``remove_small_zones``, ``merge_ripples``, ``remove_doors``
-and ``ZoneGraph.fuse``. Compilation takes about 43 s the first time,
-and numba caches it. The small helpers of the loops are ``loop_helper``
+and ``ZoneGraph.fuse``. The kernels called from Python are compiled once
+for the signatures of :mod:`.signatures` and cached by numba. The small helpers of the loops are ``loop_helper``
 functions: compiled without reference counting, inlined by LLVM.
 """
 
