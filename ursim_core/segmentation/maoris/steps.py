@@ -35,6 +35,7 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
 
     Examples
     --------
+    >>> from ursim_core.segmentation.maoris import flat_zones
     >>> values = np.array([[10, 10, 10, 30]], np.uint8)
     >>> graph = remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=2)
     >>> graph.labels.tolist()
@@ -59,6 +60,7 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
 
     Examples
     --------
+    >>> from ursim_core.segmentation.maoris import flat_zones
     >>> values = np.full((7, 7), 100, np.uint8); values[2:5, 2:5] = 200
     >>> graph = merge_ripples(ZoneGraph(flat_zones(values), values))
     >>> len(graph)   # the ring touches the core on >= 40 % of its contour
@@ -129,6 +131,7 @@ def watershed_merge(graph: ZoneGraph, *, threshold: float, margin: float = 0.10)
 
     Examples
     --------
+    >>> from ursim_core.segmentation.maoris import flat_zones
     >>> values = np.array([[200, 200, 180, 180, 60, 60]], np.uint8)
     >>> graph = watershed_merge(ZoneGraph(flat_zones(values), values), threshold=0.25)
     >>> graph.labels.tolist()
@@ -188,6 +191,7 @@ def remove_doors(graph: ZoneGraph, *, doors: float = 40) -> ZoneGraph:
 
     Examples
     --------
+    >>> from ursim_core.segmentation.maoris import flat_zones
     >>> values = np.zeros((12, 24), np.uint8)
     >>> values[1:11, 1:11] = values[1:11, 13:23] = 200   # two rooms
     >>> values[4:8, 11:13] = 50                           # a door
@@ -208,6 +212,7 @@ def remove_isolated_zones(graph: ZoneGraph) -> ZoneGraph:
 
     Examples
     --------
+    >>> from ursim_core.segmentation.maoris import flat_zones
     >>> values = np.array([[10, 0, 20, 30]], np.uint8)
     >>> remove_isolated_zones(ZoneGraph(flat_zones(values), values)).vertices()
     [2, 3]
