@@ -19,7 +19,7 @@ _CHILD = """
 import json, resource, time
 start = time.perf_counter()
 from ursim_core.segmentation.maoris import compile_kernels, kernels_cached
-seconds = compile_kernels(processes={processes})
+seconds = compile_kernels({processes})
 own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
 print(json.dumps({{"compile_s": seconds, "process_s": time.perf_counter() - start,
     "cpu_s": own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime, "cached": kernels_cached()}}))
@@ -32,8 +32,7 @@ def bench_compile(*, processes: int | None = None, repeats: int = 1) -> list[dic
     Parameters
     ----------
     processes : int, optional
-        Passed to ``compile_kernels`` (default: one process per usable CPU, at most the
-        number of kernel groups; 1 = sequential).
+        Passed to ``compile_kernels`` (default: its default, one process).
     repeats : int
         Runs, each on a new empty cache.
 
@@ -48,13 +47,13 @@ def bench_compile(*, processes: int | None = None, repeats: int = 1) -> list[dic
     for _ in range(repeats):
         with tempfile.TemporaryDirectory(prefix="ursim-numba-cache-") as cache:
             env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-            code = _CHILD.format(processes=repr(processes))
+            code = _CHILD.format(processes="" if processes is None else f"processes={int(processes)}")
             result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
             row = json.loads(result.stdout.strip().splitlines()[-1])
         rows.append(row)
         print(
             f"kernel compilation on an empty cache: {row['compile_s']:.1f} s "
             f"(process {row['process_s']:.1f} s, CPU {row['cpu_s']:.1f} s, "
-            f"processes={'auto' if processes is None else processes}, cached after: {row['cached']})"
+            f"processes={1 if processes is None else processes}, cached after: {row['cached']})"
         )
     return rows

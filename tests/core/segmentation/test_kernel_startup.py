@@ -101,3 +101,12 @@ def test_region_graph_boxes_are_those_of_scipy_find_objects():
         for index, box in enumerate(ndimage.find_objects(labels), start=1):
             if box is not None:
                 assert tuple(boxes[index]) == (box[0].start, box[1].start, box[0].stop, box[1].stop)
+
+
+def test_kernel_groups_compile_in_processes_and_cover_every_kernel():
+    from ursim_core.segmentation.maoris.kernels import signatures
+    from ursim_core.segmentation.maoris.pipeline import _compile_in_processes, compile_kernels
+
+    assert sorted(key for group in signatures.GROUPS for key in group) == sorted(signatures.SIGNATURES)
+    compile_kernels()
+    _compile_in_processes(len(signatures.GROUPS), 2)  # cached: each process loads its group

@@ -30,9 +30,9 @@ ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
 }
 
 
-#: CPU seconds that compiling every kernel on an empty cache took here (``ursim bench
-#: compile``, 2-CPU machine); :func:`compile_notice` turns it into the user's wait.
-COMPILE_CPU_SECONDS = 27
+#: Seconds of CPU that compiling every kernel on an empty cache took on the 2-CPU machine
+#: of the project (``ursim bench compile``: 27-34 s); the wait :func:`compile_notice` gives.
+COMPILE_CPU_SECONDS = 30
 
 
 def compile_notice() -> str | None:
@@ -45,11 +45,7 @@ def compile_notice() -> str | None:
     """
     if kernels_cached():
         return None
-    processes = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 2)
-    return (
-        "Compiling the segmentation kernels (first run only, about "
-        f"{round(COMPILE_CPU_SECONDS / processes * 1.2 / 5) * 5} s)..."
-    )
+    return f"Compiling the segmentation kernels (first run only, about {COMPILE_CPU_SECONDS} s)..."
 
 
 def _cache_dirs(source: Path) -> list[Path]:

@@ -11,7 +11,6 @@ import numpy as np
 
 from ursim_core.errors import ParameterError
 from ursim_core.segmentation.maoris.inscribed_circle import _as_free_mask, _free_bbox, inscribed_circle_image, quantize
-from ursim_core.segmentation.maoris.kernels import contacts as _contacts
 from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
 from ursim_core.segmentation.maoris.steps import (
     mark_unbreakable_edges,
@@ -78,7 +77,7 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     return labels
 
 
-def compile_kernels(*, processes: int | None = None) -> float:
+def compile_kernels(*, processes: int = 1) -> float:
     """Compile (or load from numba's cache) the MAORIS kernels; return the seconds it took.
 
     The first segmentation in a new environment otherwise pays this; benchmarks call it
@@ -88,11 +87,13 @@ def compile_kernels(*, processes: int | None = None) -> float:
 
     Parameters
     ----------
-    processes : int, optional
-        When the kernels are not all cached, compile their groups
+    processes : int, keyword-only
+        When more than 1 and the kernels are not all cached, compile their groups
         (:data:`~ursim_core.segmentation.maoris.kernels.signatures.GROUPS`) in this many
-        processes at once into numba's cache, then load them here. Default: one per
-        usable CPU, at most the number of groups; 1 compiles in this process only.
+        processes at once into numba's cache, then load them here. Default 1: on the
+        shared 2-CPU machine it was measured on (load 7-8), two processes took longer
+        (66 s wall, 42 s CPU) than one (53 s, 34 s); on idle CPUs they may be faster
+        (not measured).
 
     Examples
     --------
@@ -105,8 +106,6 @@ def compile_kernels(*, processes: int | None = None) -> float:
     from ursim_core.segmentation.maoris.kernels import signatures
 
     start = time.perf_counter()
-    if processes is None:
-        processes = min(_contacts._usable_cpus(), len(signatures.GROUPS))
     if processes > 1 and not kernels_cached():
         _compile_in_processes(len(signatures.GROUPS), processes)
     signatures.compile_group()
