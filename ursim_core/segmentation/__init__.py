@@ -2,7 +2,9 @@
 
 Owns: :class:`Segmentation` (label image + region adjacency graph), :func:`segment` and the
 ``SEGMENTERS`` registry, label-image files, the region graph (:func:`region_graph`), MAORIS
-(:mod:`ursim_core.segmentation.maoris`) and the scoring of a segmentation against ground truth
+(:mod:`ursim_core.segmentation.maoris`), the clearance watershed
+(:mod:`ursim_core.segmentation.watershed`), leave-one-map-out figures of the presets
+(:mod:`ursim_core.segmentation.presets_cv`) and the scoring of a segmentation against ground truth
 (:mod:`ursim_core.segmentation.scoring`).
 
 May import: :mod:`ursim_core.io` and :mod:`ursim_core.errors`; never matching, evaluation or
@@ -20,11 +22,12 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["interface", "graph", "scoring", "maoris"],
+    submodules=["interface", "graph", "scoring", "maoris", "watershed", "presets_cv"],
     submod_attrs={
         "interface": [
             "Segmentation",
             "SEGMENTERS",
+            "DEFAULT_SEGMENTERS",
             "segment",
             "resolve_params",
             "read_label_array",
@@ -32,5 +35,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "save_label_image",
         ],
         "graph": ["region_graph", "adjacent_pairs", "contour_pca_shape"],
+        "watershed": ["watershed_labels"],
+        "presets_cv": ["cross_validate"],
     },
 )

@@ -5,7 +5,6 @@ from __future__ import annotations
 import cv2
 import networkx as nx
 import numpy as np
-from scipy import ndimage
 
 __all__ = ["region_graph", "adjacent_pairs", "contour_pca_shape"]
 
@@ -75,6 +74,32 @@ def contour_pca_shape(mask: np.ndarray) -> float:
     return float(np.clip(1.0 - max(float(eigenvalues[0]), 0.0) / largest, 0.0, 1.0))
 
 
+def _bounding_boxes(labels: np.ndarray, count: int) -> np.ndarray:
+    """``(row_start, col_start, row_stop, col_stop)`` of each label 0..count - 1 (stops
+    exclusive; as ``scipy.ndimage.find_objects``, without importing scipy.ndimage).
+
+    Computed on the runs of equal labels along rows, far fewer than the pixels.
+    """
+    rows, cols = labels.shape
+    starts = np.ones(labels.shape, bool)
+    starts[:, 1:] = labels[:, 1:] != labels[:, :-1]
+    run_rows, run_cols = np.nonzero(starts)
+    run_labels = labels[run_rows, run_cols]
+    # A run stops where the next one starts on the same row, else at the row's end.
+    stops = np.full(len(run_cols), cols, np.intp)
+    same_row = run_rows[1:] == run_rows[:-1]
+    stops[:-1][same_row] = run_cols[1:][same_row]
+    keep = run_labels > 0
+    run_labels, run_rows, run_cols, stops = run_labels[keep], run_rows[keep], run_cols[keep], stops[keep]
+    boxes = np.empty((count, 4), np.intp)
+    boxes[:, 0], boxes[:, 1], boxes[:, 2], boxes[:, 3] = rows, cols, 0, 0
+    np.minimum.at(boxes[:, 0], run_labels, run_rows)
+    np.minimum.at(boxes[:, 1], run_labels, run_cols)
+    np.maximum.at(boxes[:, 2], run_labels, run_rows + 1)
+    np.maximum.at(boxes[:, 3], run_labels, stops)
+    return boxes
+
+
 def region_graph(labels: np.ndarray) -> nx.Graph:
     """Build the region adjacency graph of a label image.
 
@@ -113,9 +138,11 @@ def region_graph(labels: np.ndarray) -> nx.Graph:
     rows, cols = np.indices(labels.shape)
     row_sums = np.bincount(flat, weights=rows.ravel(), minlength=n_max + 1)
     col_sums = np.bincount(flat, weights=cols.ravel(), minlength=n_max + 1)
-    for index, box in enumerate(ndimage.find_objects(labels), start=1):
-        if box is None or sizes[index] == 0:
+    boxes = _bounding_boxes(labels, n_max + 1)
+    for index in range(1, n_max + 1):
+        if sizes[index] == 0:
             continue
+        box = (slice(int(boxes[index, 0]), int(boxes[index, 2])), slice(int(boxes[index, 1]), int(boxes[index, 3])))
         mask = labels[box] == index
         # Distance to the region's own border (zero padding makes image edges borders too).
         inside = cv2.distanceTransform(np.pad(mask.astype(np.uint8), 1), cv2.DIST_L2, 5)[1:-1, 1:-1]

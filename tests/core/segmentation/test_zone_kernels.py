@@ -2,7 +2,7 @@
 
 The replays run on the dict form of :class:`ZoneGraph` through its public
 mutations (``fuse``, ``remove``), with contact percentages counted here from
-masks, so they share no code with ``_zone_kernels``. They are slow, hence
+masks, so they share no code with the kernels (:mod:`ursim_core.segmentation.maoris.kernels`). They are slow, hence
 small maps.
 """
 
@@ -230,7 +230,7 @@ def _tracked_contacts(tracking) -> tuple[dict[tuple[int, int], int], list[list[i
 
 @pytest.mark.parametrize("bands", [2, 3, 7])
 def test_contacts_counted_in_bands_of_rows_equal_one_pass(bands):
-    from ursim_core.segmentation import _zone_kernels
+    from ursim_core.segmentation.maoris.kernels import contacts as _contacts
     from ursim_core.synth.generator import make_large_building
 
     values = quantize(inscribed_circle_image(make_large_building(400, seed=bands).free), quantum=5)
@@ -241,19 +241,19 @@ def test_contacts_counted_in_bands_of_rows_equal_one_pass(bands):
     for count in (1, bands):
         labels = graph._labels.ravel().copy()
         results.append(
-            _tracked_contacts(_zone_kernels.start_tracking(labels, graph._labels.shape[1], graph._alive, bands=count))
+            _tracked_contacts(_contacts.start_tracking(labels, graph._labels.shape[1], graph._alive, bands=count))
         )
     assert len(results[0][0]) > 1000
     assert results[0] == results[1]
 
 
 def test_segmentation_is_the_same_with_contacts_counted_in_bands(monkeypatch):
-    from ursim_core.segmentation import _zone_kernels
     from ursim_core.segmentation.maoris import maoris_labels
+    from ursim_core.segmentation.maoris.kernels import contacts as _contacts
     from ursim_core.synth.generator import make_large_building
 
     free = make_large_building(600, seed=2).free
     expected = maoris_labels(free, PRESETS["robot"])
-    monkeypatch.setattr(_zone_kernels, "_BAND_PIXELS", 0)
-    monkeypatch.setattr(_zone_kernels, "_usable_cpus", lambda: 3)
+    monkeypatch.setattr(_contacts, "_BAND_PIXELS", 0)
+    monkeypatch.setattr(_contacts, "_usable_cpus", lambda: 3)
     np.testing.assert_array_equal(maoris_labels(free, PRESETS["robot"]), expected)

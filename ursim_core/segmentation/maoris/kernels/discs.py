@@ -32,7 +32,7 @@ the number of pixel runs of the result plus the number of pixels (about
 
 Half-widths ``isqrt(R^2 - d^2)`` come from integer arithmetic only, so the
 result is bit for bit that of painting every disc
-(:func:`ursim_core.segmentation.maoris.inscribed_circle_radii`).
+(:func:`ursim_core.segmentation.maoris.inscribed_circle.inscribed_circle_radii`).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ursim_core.segmentation._loop_helpers import loop_helper
+from ursim_core.segmentation.maoris.kernels.helpers import inner_kernel, loop_helper
 
 # Columns of the shape table returned by :func:`centre_rectangles`.
 TOP, BOTTOM, LEFT, RIGHT, RADIUS, DIAGONALS = range(6)
@@ -149,7 +149,7 @@ def _load_radii(dist, row, max_radius, into):
         into[col + 1] = max_radius if value >= max_radius else np.int32(value)
 
 
-@njit(cache=True)
+@inner_kernel
 def _grown(shapes, capacity):
     grown = np.empty((capacity, shapes.shape[1]), shapes.dtype)
     for i in range(shapes.shape[0]):
@@ -179,7 +179,7 @@ def paint_discs(dist, shapes, out):
     # every image row it meets from end to end, as the capped one does.
     reach_cap = rows + cols
     trimmed_reach_limit = min(_TRIMMED_REACH_LIMIT, reach_cap)
-    largest_trimmed = -1
+    largest_trimmed = np.int64(-1)  # typed, not a literal: a literal argument compiles a callee twice
     for i in range(len(shapes)):
         if shapes[i, DIAGONALS] != 0 and shapes[i, RADIUS] - 1 < trimmed_reach_limit:
             largest_trimmed = max(largest_trimmed, shapes[i, RADIUS] - 1)
@@ -236,7 +236,7 @@ def _raise_span(out, row, first_col, last_col, radius):
         out[row, col] = max(out[row, col], radius)
 
 
-@njit(cache=True)
+@inner_kernel
 def _uncovered_pieces(largest_reach):
     """What the diagonal neighbours (radius r + 1) of a one-pixel shape leave of its disc.
 

@@ -1,0 +1,182 @@
+"""MAORIS steps 1-2: the value image.
+
+Step 1 (:func:`inscribed_circle_radii`, :func:`inscribed_circle_image`): every free pixel gets the
+radius of the largest inscribed disc containing it (``FuzzyOpening.cpp``), min-max normalised to
+0..255. Step 2 (:func:`quantize`): normalise again and round up to multiples of 5
+(``ZoneReducer.hpp``). The discs are painted by compiled code (:mod:`.kernels.discs`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import cv2
+import numpy as np
+
+from ursim_core.errors import ParameterError, SegmentationError
+from ursim_core.segmentation.maoris.kernels import discs as _disc_kernels
+
+__all__ = ["inscribed_circle_radii", "inscribed_circle_image", "quantize"]
+
+
+def _as_free_mask(free: Any) -> np.ndarray:
+    array = np.asarray(free)
+    if array.ndim != 2 or array.shape[0] == 0 or array.shape[1] == 0:
+        raise SegmentationError(f"free-space mask must be a non-empty 2-D array, got shape {array.shape}")
+    return array.astype(bool, copy=False) if array.dtype != bool else array
+
+
+def inscribed_circle_radii(free: np.ndarray, *, max_radius: int = 500) -> np.ndarray:
+    """Radius of the largest (shifted) inscribed disc containing each free pixel.
+
+    Exactly the C++ ``fuzzyOpening(src, out, max_radius)`` before normalisation:
+    ``out(p) = max r(q)`` over free pixels q with ``|p - (q - (1, 1))| <= r(q) - 1``,
+    where ``r(q) = min(int(dist(q)), max_radius)`` and dist is the exact
+    Euclidean distance to the nearest obstacle pixel. Obstacle pixels get 0, and
+    so do the free pixels no disc reaches (the row/column just above/left of a
+    wall, an effect of the C++'s one-pixel shift).
+
+    Instead of painting a disc per pixel, only the *non-dominated* centres are
+    painted: q is dominated when a neighbour q2's disc contains q's disc
+    (``r(q2) - r(q) >= |q2 - q|``), which removes ~95 % of them. The rest are
+    painted row span by row span in compiled code (:mod:`.kernels.discs`), each
+    pixel keeping the largest radius: equal-radius rectangles of centres
+    (ridges) as one shape, and lone centres only where no disc of a larger
+    radius beside them covers theirs.
+
+    Parameters
+    ----------
+    free : ndarray of bool, shape (rows, cols)
+        True for free space.
+    max_radius : int, keyword-only
+        Cap on the disc radius (the C++ hard-codes 500).
+
+    Returns
+    -------
+    ndarray of int32, shape (rows, cols)
+
+    Examples
+    --------
+    >>> free = np.zeros((9, 9), bool); free[1:8, 1:8] = True
+    >>> inscribed_circle_radii(free)[4]
+    array([0, 4, 4, 4, 4, 4, 3, 0, 0], dtype=int32)
+    """
+    free = _as_free_mask(free)
+    if int(max_radius) < 1:
+        raise ParameterError(f"must be >= 1, got {max_radius!r}", field="max_radius")
+    out = np.zeros(free.shape, np.int32)
+    window = _free_bbox(free, margin=1)
+    if window is None:
+        return out
+    out[window] = _inscribed_radii_in_window(free[window], int(max_radius))
+    return out
+
+
+def _free_bbox(free: np.ndarray, *, margin: int) -> tuple[slice, slice] | None:
+    """Bounding box of the free pixels grown by ``margin`` (clipped), or None."""
+    rows = np.flatnonzero(free.any(axis=1))
+    if len(rows) == 0:
+        return None
+    cols = np.flatnonzero(free.any(axis=0))
+    return (
+        slice(max(rows[0] - margin, 0), min(rows[-1] + 1 + margin, free.shape[0])),
+        slice(max(cols[0] - margin, 0), min(cols[-1] + 1 + margin, free.shape[1])),
+    )
+
+
+def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:
+    # Cropping to the free pixels' bounding box plus a 1-pixel obstacle margin
+    # leaves the distance transform unchanged (the margin is obstacle, and the
+    # image border is kept where the box touches it).
+    dist = cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    # Radii are int32 (as the output); a larger cap only matters without any obstacle.
+    shapes = _disc_kernels.centre_rectangles(dist, min(max_radius, np.iinfo(np.int32).max))
+    out = np.zeros(free.shape, np.int32)
+    _disc_kernels.paint_discs(dist, shapes, out)
+    return out
+
+
+def _normalise_to_uint8(values: np.ndarray) -> np.ndarray:
+    return _by_lookup(values, _normalise_exactly)
+
+
+def _normalise_exactly(values: np.ndarray) -> np.ndarray:
+    # cv::normalize(NORM_MINMAX, CV_8U) on a float image, as the C++ does.
+    return cv2.normalize(np.asarray(values, np.float32), None, 0, 255, cv2.NORM_MINMAX, cv2.CV_8U)
+
+
+def _by_lookup(values: np.ndarray, function) -> np.ndarray:
+    """``function(values)`` for a ``function`` that maps each element by the
+    element and the array's minimum and maximum only (a min-max normalisation).
+
+    An integer image is mapped through a table: ``function`` of the range
+    lo..hi of its values, which has the same minimum and maximum. At 4000 px
+    that is one pass over the image instead of several float passes.
+    """
+    values = np.asarray(values)
+    if values.dtype.kind not in "iu" or values.ndim != 2 or values.size == 0:
+        return function(values)
+    lo, hi = int(values.min()), int(values.max())
+    if hi - lo > 1 << 16:
+        return function(values)
+    table = function(np.arange(lo, hi + 1, dtype=values.dtype)[None, :])[0]
+    offsets = values - lo if lo else values
+    if hi - lo <= 255:  # cv2.LUT takes 8-bit indices, and is several times faster than numpy
+        return cv2.LUT(offsets.astype(np.uint8, copy=False), np.pad(table, (0, 255 - (hi - lo))))
+    return table[offsets]
+
+
+def inscribed_circle_image(free: np.ndarray, *, max_radius: int = 500) -> np.ndarray:
+    """Largest-inscribed-circle image, min-max normalised to 0..255 (uint8).
+
+    Parameters
+    ----------
+    free : ndarray of bool, shape (rows, cols)
+    max_radius : int, keyword-only
+
+    Returns
+    -------
+    ndarray of uint8
+        0 on obstacles; the largest radius maps to 255.
+
+    Examples
+    --------
+    >>> free = np.zeros((9, 9), bool); free[1:8, 1:8] = True
+    >>> int(inscribed_circle_image(free).max())
+    255
+    """
+    return _normalise_to_uint8(inscribed_circle_radii(free, max_radius=max_radius))
+
+
+# ---------------------------------------------------------------------------
+# Step 2: quantisation
+
+
+def quantize(values: np.ndarray, *, quantum: int = 5) -> np.ndarray:
+    """Min-max normalise to 0..255, then round up to multiples of ``quantum``.
+
+    0 stays 0 (walls); results above 255 are clipped to 255.
+
+    Parameters
+    ----------
+    values : ndarray
+    quantum : int, keyword-only
+
+    Returns
+    -------
+    ndarray of uint8
+
+    Examples
+    --------
+    >>> quantize(np.array([[0, 1, 5, 6, 254, 255]], np.uint8)).tolist()
+    [[0, 5, 5, 10, 255, 255]]
+    """
+    quantum = int(quantum)
+    if not 1 <= quantum <= 255:
+        raise ParameterError(f"must be in 1..255, got {quantum!r}", field="quantum")
+
+    def exactly(values: np.ndarray) -> np.ndarray:
+        normalised = _normalise_exactly(values).astype(np.int32)
+        return np.minimum(-(-normalised // quantum) * quantum, 255).astype(np.uint8)
+
+    return _by_lookup(values, exactly)

@@ -1,0 +1,74 @@
+"""The one signature of every MAORIS kernel called from Python, and compiling them.
+
+Each kernel is compiled for exactly these argument types (a test checks that a
+segmentation calls nothing else), so compiling them ahead needs no example input, and
+the kernels can be compiled in groups, one process per group, into numba's cache:
+:func:`compile_group` is what each process runs (see
+:func:`ursim_core.segmentation.maoris.pipeline.compile_kernels`).
+"""
+
+from __future__ import annotations
+
+from numba import types
+
+from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, flat_zones, fusion
+
+__all__ = ["SIGNATURES", "GROUPS", "compile_group"]
+
+_I32, _I64, _BOOL = types.int32[::1], types.int64[::1], types.bool_[::1]
+_I32_2D, _I64_2D = types.int32[:, ::1], types.int64[:, ::1]
+_F32_2D, _U8_2D = types.float32[:, ::1], types.uint8[:, ::1]
+_INT, _FLOAT = types.int64, types.float64
+# The compact zone graph (records, nodes); the contact counts of count_contacts; the
+# tracking state of start_tracking (original, compact_of, (parent, pixels, ...)).
+_GRAPH = types.UniTuple(_I32_2D, 2)
+_COUNTS = types.Tuple((_I32, _I32, _I32, _I32, _INT, _I64, _I64, _I64, _I64, _I64))
+_STATE = types.Tuple((_I32, _I32, _I32, _I32, _I32, _I64, _I64, _I64, _I64, _I64))
+_TRACKING = types.Tuple((_I32, _I32, _STATE))
+
+#: ``(module, kernel name) -> argument types``.
+SIGNATURES: dict[tuple[str, str], tuple] = {
+    ("discs", "centre_rectangles"): (_F32_2D, _INT),
+    ("discs", "paint_discs"): (_F32_2D, _I64_2D, _I32_2D),
+    ("flat_zones", "label_flat_zones"): (_U8_2D,),
+    ("flat_zones", "zone_values_and_sizes"): (_I32_2D, _U8_2D, _INT),
+    ("flat_zones", "first_pixels"): (_I32_2D, _INT),
+    ("flat_zones", "resolve_parents"): (_I32, _BOOL),
+    ("flat_zones", "relabel"): (_I32, _I32),
+    ("adjacency", "build_adjacency"): (_I32_2D, _I32),
+    ("adjacency", "adjacency_entries"): (_BOOL, _GRAPH),
+    ("adjacency", "_link_entries"): (_I32, _I32, _I64, _I32, _BOOL, _I32),
+    ("adjacency", "remove_small_zones"): (_INT, _I64, _BOOL, _I32, _GRAPH),
+    ("contacts", "_compact_labels"): (_I32, _BOOL),
+    ("contacts", "count_contacts"): (_I32, _INT, _INT, _INT, _INT),
+    ("contacts", "join_counts"): (_COUNTS, _COUNTS),
+    ("contacts", "contact_table"): (_I32, _INT, _BOOL),
+    ("fusion", "merge_ripples"): (_I32, _FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
+    ("fusion", "remove_doors"): (_FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
+}
+
+_MODULES = {
+    "discs": discs,
+    "flat_zones": flat_zones,
+    "adjacency": adjacency,
+    "contacts": contacts,
+    "fusion": fusion,
+}
+
+#: Kernel groups of about equal compilation time (measured), one process each.
+GROUPS: tuple[tuple[tuple[str, str], ...], ...] = (
+    tuple(key for key in SIGNATURES if key[0] in ("fusion", "contacts")),
+    tuple(key for key in SIGNATURES if key[0] not in ("fusion", "contacts")),
+)
+
+
+def kernel(key: tuple[str, str]):
+    """The numba dispatcher of ``(module, name)``."""
+    return getattr(_MODULES[key[0]], key[1])
+
+
+def compile_group(index: int | None = None) -> None:
+    """Compile (or load from numba's cache) the kernels of ``GROUPS[index]``, or all."""
+    keys = SIGNATURES if index is None else GROUPS[index]
+    for key in keys:
+        kernel(key).compile(SIGNATURES[key])

@@ -1,0 +1,126 @@
+"""The whole MAORIS pipeline, and the compiled kernels' first run.
+
+:func:`maoris_labels` runs the seven steps; :func:`compile_kernels` compiles (or loads) the
+kernels; :func:`kernels_cached` says, without importing numba, whether this install has them
+compiled on disk.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ursim_core.errors import ParameterError
+from ursim_core.segmentation.maoris.inscribed_circle import _as_free_mask, _free_bbox, inscribed_circle_image, quantize
+from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
+from ursim_core.segmentation.maoris.steps import (
+    mark_unbreakable_edges,
+    merge_ripples,
+    remove_doors,
+    remove_isolated_zones,
+    remove_small_zones,
+    watershed_merge,
+)
+from ursim_core.segmentation.maoris.zone_graph import ZoneGraph, flat_zones
+
+__all__ = ["maoris_labels", "compile_kernels"]
+
+
+def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -> np.ndarray:
+    """Segment a free-space mask into rooms with MAORIS.
+
+    Parameters
+    ----------
+    free : ndarray of bool, shape (rows, cols)
+        True = free space.
+    params : MaorisParams
+        See :data:`PRESETS`.
+
+    Returns
+    -------
+    ndarray of int32
+        0 = no region; regions 1..N in the raster order of their first pixel.
+
+    Notes
+    -----
+    As in the C++, some free pixels get no region: the row and column just
+    above and left of walls (the one-pixel shift of the inscribed discs),
+    regions deleted for having no neighbour when there are several, and
+    everything when the map has no obstacle pixel at all (the inscribed-circle
+    image is then constant and normalises to 0). A map without free pixels
+    gives all zeros.
+
+    Examples
+    --------
+    >>> free = np.zeros((30, 30), bool); free[3:27, 3:27] = True
+    >>> int(maoris_labels(free, PRESETS["robot"]).max())
+    1
+    """
+    if not isinstance(params, MaorisParams):
+        raise ParameterError(f"expected MaorisParams, got {type(params).__name__}", field="params")
+    free = _as_free_mask(free)
+    labels = np.zeros(free.shape, np.int32)
+    # Everything outside the free pixels' bounding box is obstacle: work on the box.
+    window = _free_bbox(free, margin=1)
+    if window is None:
+        return labels
+    free = free[window]
+    values = quantize(inscribed_circle_image(free, max_radius=params.max_radius), quantum=params.quantum)
+    graph = ZoneGraph(flat_zones(values), values)
+    remove_small_zones(graph, min_size=params.small_before)
+    merge_ripples(graph, ripples=params.ripples)
+    mark_unbreakable_edges(graph, threshold=params.threshold)
+    watershed_merge(graph, threshold=params.threshold, margin=params.margin)
+    remove_doors(graph, doors=params.doors)
+    remove_small_zones(graph, min_size=params.small_after)
+    remove_isolated_zones(graph)
+    labels[window] = graph.label_image()
+    return labels
+
+
+def compile_kernels(*, processes: int = 1) -> float:
+    """Compile (or load from numba's cache) the MAORIS kernels; return the seconds it took.
+
+    The first segmentation in a new environment otherwise pays this; benchmarks call it
+    so that their timings exclude it. Prints nothing (callers say what is happening:
+    :func:`~ursim_core.segmentation.maoris.kernel_cache.kernels_cached` tells whether it
+    will take long).
+
+    Parameters
+    ----------
+    processes : int, keyword-only
+        When more than 1 and the kernels are not all cached, compile their groups
+        (:data:`~ursim_core.segmentation.maoris.kernels.signatures.GROUPS`) in this many
+        processes at once into numba's cache, then load them here. Default 1: on the
+        shared 2-CPU machine it was measured on (load 7-8), two processes took longer
+        (66 s wall, 42 s CPU) than one (53 s, 34 s); on idle CPUs they may be faster
+        (not measured).
+
+    Examples
+    --------
+    >>> compile_kernels() >= 0
+    True
+    """
+    import time
+
+    from ursim_core.segmentation.maoris.kernel_cache import kernels_cached
+    from ursim_core.segmentation.maoris.kernels import signatures
+
+    start = time.perf_counter()
+    if processes > 1 and not kernels_cached():
+        _compile_in_processes(len(signatures.GROUPS), processes)
+    signatures.compile_group()
+    return time.perf_counter() - start
+
+
+def _compile_in_processes(groups: int, processes: int) -> None:
+    import subprocess
+    import sys
+
+    code = "from ursim_core.segmentation.maoris.kernels.signatures import compile_group; compile_group({})"
+    pending = list(range(groups))
+    running: list[subprocess.Popen] = []
+    while pending or running:
+        while pending and len(running) < processes:
+            running.append(subprocess.Popen([sys.executable, "-c", code.format(pending.pop(0))]))
+        running.pop(0).wait()
+    # A failed group is compiled again in this process (compile_group), with its error.

@@ -1,0 +1,322 @@
+"""MAORIS step 3: flat zones and the zone graph (``ZoneExtractor.cpp``, ``GraphZone``).
+
+:func:`flat_zones` labels the 4-connected components of equal value; :class:`ZoneGraph` holds
+them with their 4-adjacency, the edge attributes (:class:`ZoneEdge`) and the contact counts that
+the later steps (:mod:`.steps`) read and change.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ursim_core.errors import SegmentationError
+from ursim_core.segmentation.maoris.kernels import adjacency as _adjacency
+from ursim_core.segmentation.maoris.kernels import contacts as _contacts
+from ursim_core.segmentation.maoris.kernels import flat_zones as _flat_zones
+
+__all__ = ["flat_zones", "ZoneGraph", "ZoneEdge"]
+
+
+def flat_zones(values: np.ndarray) -> np.ndarray:
+    """4-connected components of equal non-zero value.
+
+    Zones are numbered 1..N in the raster order of their first pixel; 0 stays 0.
+
+    Examples
+    --------
+    >>> flat_zones(np.array([[5, 5, 0], [0, 5, 7], [5, 0, 7]])).tolist()
+    [[1, 1, 0], [0, 1, 2], [3, 0, 2]]
+    """
+    values = np.asarray(values)
+    if values.ndim != 2:
+        raise SegmentationError(f"value image must be 2-D, got shape {values.shape}")
+    return _flat_zones.label_flat_zones(values)
+
+
+class ZoneEdge:
+    """Edge attributes: the lowest value met along fused paths, and breakability."""
+
+    __slots__ = ("minimum", "unbreakable")
+
+    def __init__(self, minimum: int | None = None, unbreakable: bool = False):
+        self.minimum = minimum
+        self.unbreakable = unbreakable
+
+    def __repr__(self) -> str:
+        return f"ZoneEdge(minimum={self.minimum}, unbreakable={self.unbreakable})"
+
+
+_MISSING = object()
+_PAD = 2  # label image padding: pixels next to a zone gather their own 3x3 neighbourhood
+
+
+class ZoneGraph:
+    """Zones (flat zones, later regions) and their adjacency, as the C++ GraphZone.
+
+    Vertices are zone ids kept in insertion order (ascending id = raster order
+    of the first pixel); each vertex's neighbours are kept in edge-insertion
+    order. A fusion moves the absorbed zone's pixels and transfers its edges.
+
+    The adjacency has two forms. A new graph keeps it in compact arrays (see
+    :mod:`.kernels`): a large map starts with millions of flat zones, and
+    the first steps (:func:`remove_small_zones`, :func:`merge_ripples`) run
+    on them as compiled code. The first access to :attr:`adj` turns it into
+    dicts, which the later steps, on a few hundred zones, read and change;
+    a compiled step converts them back.
+
+    Contacts (contour pixels of a zone having another zone in their 3x3
+    neighbourhood) are counted for the whole image by compiled code when first
+    queried, and dropped by the next fusion; the compiled steps that need them
+    while fusing track them incrementally themselves. Fusions in dict form
+    are only recorded; the label image is rewritten once, when next needed.
+
+    Parameters
+    ----------
+    zones : ndarray of int, shape (rows, cols)
+        Zone labels 1..N (0 = no zone), e.g. from :func:`flat_zones`.
+    values : ndarray, shape (rows, cols)
+        The value of every pixel; each zone must be flat.
+
+    Examples
+    --------
+    >>> values = np.array([[10, 10, 20], [10, 10, 20]], np.uint8)
+    >>> graph = ZoneGraph(flat_zones(values), values)
+    >>> graph.vertices(), graph.neighbours(1), graph.contact_percent(2, 1)
+    ([1, 2], [2], 100)
+    """
+
+    def __init__(self, zones: np.ndarray, values: np.ndarray):
+        zones = np.asarray(zones)
+        values = np.asarray(values)
+        if zones.shape != values.shape or zones.ndim != 2:
+            raise SegmentationError(f"zones {zones.shape} and values {values.shape} must be 2-D of equal shape")
+        self.shape = zones.shape
+        zones = zones.astype(np.int32, copy=False)
+        self._labels = np.pad(zones, _PAD)
+        count = int(zones.max(initial=0))
+        value, self._size = _flat_zones.zone_values_and_sizes(zones, values, count + 1)
+        self._value_array = value
+        self._value: list[int] = value.tolist()
+        # The adjacency lives either in compact arrays (the compiled steps'
+        # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
+        self._alive = self._size > 0
+        self._alive[0] = False
+        self._compact: tuple | None = _adjacency.build_adjacency(zones, value)
+        self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
+        # Contact counts, computed for the whole image when first queried and
+        # dropped by the next fusion (the compiled steps track their own).
+        self._contacts: dict[int, int] | None = None
+        # Fusions not yet written into the label image: zone -> receiver (0 = deleted).
+        self._pending: dict[int, int] = {}
+        self._identity = np.arange(count + 1, dtype=np.int32)
+
+    @property
+    def adj(self) -> dict[int, dict[int, ZoneEdge | None]]:
+        """``adj[a][b]``: the edge between a and b, or None for a plain edge (no
+        minimum, breakable) never touched; :meth:`edge` always gives a
+        :class:`ZoneEdge`. Read-only for callers: mutate through :meth:`fuse`
+        and :meth:`remove`."""
+        if self._adj is None:
+            self._adj = self._adjacency_dicts()
+            self._compact = None
+        return self._adj
+
+    def _adjacency_dicts(self) -> dict[int, dict[int, ZoneEdge | None]]:
+        adj: dict[int, dict[int, ZoneEdge | None]] = {zone: {} for zone in np.flatnonzero(self._alive).tolist()}
+        edges: dict[int, ZoneEdge | None] = {}  # node -> the edge object both directions share
+        for zone, other, node, twin, low, unbreakable in _adjacency.adjacency_entries(
+            self._alive, self._compact
+        ).tolist():
+            edge = edges.pop(twin, _MISSING)
+            if edge is _MISSING:
+                edge = None if low < 0 and not unbreakable else ZoneEdge(None if low < 0 else low, bool(unbreakable))
+                edges[node] = edge
+            adj[zone][other] = edge
+        return adj
+
+    def _compact_adjacency(self) -> tuple:
+        """The adjacency as compact arrays (converted from `_adj` if needed)."""
+        if self._compact is None:
+            entries = [
+                (a, b, _adjacency.NO_MINIMUM if edge is None or edge.minimum is None else edge.minimum,
+                 edge is not None and edge.unbreakable)
+                for a, neighbours in self._adj.items()
+                for b, edge in neighbours.items()
+            ]  # fmt: skip
+            columns = list(zip(*entries)) or [()] * 4
+            zone, other, minimum = (np.array(column, np.int32) for column in columns[:3])
+            unbreakable = np.array(columns[3], bool)
+            self._compact = _adjacency.adjacency_from_entries(zone, other, minimum, unbreakable, self._value_array)
+            self._alive = np.zeros(len(self._value), bool)
+            self._alive[list(self._adj)] = True
+            self._adj = None
+        return self._compact
+
+    def _run_compiled(self) -> tuple:
+        """Prepare for a compiled step: labels flushed, contacts dropped."""
+        self._flush()
+        self._contacts = None
+        return self._compact_adjacency()
+
+    # -- queries ----------------------------------------------------------
+
+    def vertices(self) -> list[int]:
+        """Zone ids in insertion order."""
+        if self._adj is None:
+            return np.flatnonzero(self._alive).tolist()
+        return list(self._adj)
+
+    def __len__(self) -> int:
+        return int(self._alive.sum()) if self._adj is None else len(self._adj)
+
+    def __contains__(self, zone: object) -> bool:
+        if self._adj is not None:
+            return zone in self._adj
+        return isinstance(zone, (int, np.integer)) and 0 < zone < len(self._alive) and bool(self._alive[zone])
+
+    def neighbours(self, zone: int) -> list[int]:
+        """Neighbours of ``zone`` in edge-insertion order."""
+        return list(self.adj[zone])
+
+    def edge(self, a: int, b: int) -> ZoneEdge:
+        """Attributes of the edge between ``a`` and ``b`` (``adj[a][b]`` may hold None
+        for a plain edge; this materialises it)."""
+        edge = self.adj[a][b]
+        if edge is None:
+            edge = self.adj[a][b] = self.adj[b][a] = ZoneEdge()
+        return edge
+
+    def value(self, zone: int) -> int:
+        """Quantised value of a zone (it keeps it when other zones are fused into it)."""
+        return self._value[zone]
+
+    def size(self, zone: int) -> int:
+        """Number of pixels of a zone."""
+        return int(self._size[zone])
+
+    @property
+    def labels(self) -> np.ndarray:
+        """Current zone label image, shape ``self.shape`` (a view; do not modify)."""
+        self._flush()
+        return self._labels[_PAD:-_PAD, _PAD:-_PAD]
+
+    def contact_percent(self, zone: int, other: int) -> int:
+        """Integer percentage of ``zone``'s contour pixels having ``other`` in their 3x3 neighbourhood."""
+        return self.contact_percents(zone)(other)
+
+    def contact_percents(self, zone: int) -> Callable[[int], int]:
+        """A function ``other -> contact_percent(zone, other)`` valid until the next fusion.
+
+        Faster than repeated :meth:`contact_percent` calls for one zone.
+        """
+        contacts = self._ensure_contacts()
+        key = zone * len(self._value)
+        total = contacts.get(key, 0)
+        if total == 0:
+            return lambda other: 0
+        get = contacts.get
+        return lambda other: get(key + other, 0) * 100 // total
+
+    def contact_sum(self, zone: int) -> int:
+        """Sum of :meth:`contact_percent` over the graph neighbours of ``zone``."""
+        percents = self.contact_percents(zone)
+        return sum(percents(other) for other in self.adj[zone])
+
+    def label_image(self) -> np.ndarray:
+        """Labels renumbered 1..N in the raster order of each region's first pixel."""
+        self._flush()
+        zones = np.array(self.vertices(), np.int64)
+        # The padding adds no labels, so raster order in it is raster order in the map.
+        first = _flat_zones.first_pixels(self._labels, len(self._value))[zones]
+        lookup = np.zeros(len(self._value), np.int32)
+        lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
+        return lookup[self.labels]
+
+    # -- contacts and relabelling -------------------------------------------
+
+    def _flush(self) -> None:
+        """Write the pending fusions into the label image, in one vectorised pass."""
+        if not self._pending:
+            return
+        pending = self._pending
+        zones = np.fromiter(pending.keys(), np.int64, len(pending))
+        # A persistent identity lookup, patched for this flush: allocating one per
+        # flush would cost O(zones) each time.
+        parent = self._identity
+        parent[zones] = np.fromiter(pending.values(), np.int64, len(pending))
+        # Follow chains z -> b -> c so every pending zone maps to its final
+        # receiver: pointer doubling, log(chain length) vectorised passes.
+        while True:
+            jumped = parent[parent[zones]]
+            if np.array_equal(jumped, parent[zones]):
+                break
+            parent[zones] = jumped
+        self._labels = parent[self._labels]
+        parent[zones] = zones
+        self._pending = {}
+
+    def _ensure_contacts(self) -> dict[int, int]:
+        # Counts keyed by ``a * base + b``: contour pixels of a with b in their
+        # 3x3 neighbourhood (b >= 1), and the contour size of a (b = 0).
+        if self._contacts is None:
+            self._flush()
+            alive = np.zeros(len(self._value), bool)
+            alive[self.vertices()] = True
+            table = _contacts.contact_table(self._labels.ravel(), self._labels.shape[1], alive)
+            codes = table[:, 0] * len(self._value) + table[:, 1]
+            self._contacts = dict(zip(codes.tolist(), table[:, 2].tolist()))
+        return self._contacts
+
+    # -- mutations -------------------------------------------------------
+
+    def fuse(self, zone: int, into: int) -> None:
+        """Fuse ``zone`` into its neighbour ``into``: pixels, size and edges move.
+
+        ``into`` keeps its value. An edge (zone, n) whose n is not yet a
+        neighbour of ``into`` becomes a new edge (into, n) recording the lowest
+        value met, ``min(value(zone), minimum of (zone, n))``; an existing
+        (into, n) keeps its minimum. Unbreakable edges stay unbreakable. No
+        self-loops or duplicate edges.
+
+        Examples
+        --------
+        >>> values = np.array([[90, 40, 90]], np.uint8)
+        >>> graph = ZoneGraph(flat_zones(values), values)
+        >>> graph.fuse(2, 1)
+        >>> graph.neighbours(1), graph.edge(1, 3).minimum, graph.size(1)
+        ([3], 40, 2)
+        """
+        if zone == into:
+            raise SegmentationError(f"cannot fuse zone {zone} into itself")
+        self._pending[zone] = into
+        self._contacts = None
+        self._size[into] += self._size[zone]
+        zone_value = self._value[zone]
+        adj = self.adj
+        target = adj[into]
+        for neighbour, old in adj.pop(zone).items():
+            neighbour_adj = adj[neighbour]
+            del neighbour_adj[zone]
+            if neighbour == into:
+                continue
+            if neighbour not in target:
+                if old is None or old.minimum is None or zone_value < old.minimum:
+                    minimum = zone_value
+                else:
+                    minimum = old.minimum
+                edge = ZoneEdge(minimum, old is not None and old.unbreakable)
+                target[neighbour] = edge
+                neighbour_adj[into] = edge
+            elif old is not None and old.unbreakable:
+                # A direct contact already exists: no valley between the two,
+                # keep its minimum; unbreakability is kept.
+                self.edge(into, neighbour).unbreakable = True
+
+    def remove(self, zone: int) -> None:
+        """Delete a zone: its pixels become 0 and its edges disappear."""
+        self._pending[zone] = 0
+        self._contacts = None
+        for neighbour in self.adj.pop(zone):
+            del self.adj[neighbour][zone]
