@@ -2,7 +2,7 @@
 
     .venv/bin/python tools/make_example.py
 
-The plan and the sketch come from one seed (``ursim_core.synth.generator.make_pair``); the JSON
+The plan and the sketch come from one seed (``ursim_core.synth.make_pair``); the JSON
 records a fixed timestamp so that running this again changes no file.
 """
 

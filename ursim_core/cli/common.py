@@ -115,14 +115,11 @@ def announce_kernel_compilation() -> None:
     if _announced:
         return
     _announced = True
-    from ursim_core.segmentation import maoris
+    from ursim_core.segmentation.maoris import compile_notice
 
-    kernels_cached = getattr(maoris, "kernels_cached", None)
-    if kernels_cached is None or kernels_cached():
-        return
-    seconds = getattr(maoris, "COMPILE_SECONDS", None)
-    about = f"about {seconds:.0f} s" if isinstance(seconds, (int, float)) else "up to a minute"
-    print(f"Compiling the segmentation kernels (first run only, {about})...", file=sys.stderr, flush=True)
+    notice = compile_notice()
+    if notice:
+        print(notice, file=sys.stderr, flush=True)
 
 
 def check_output_folder(path: str | Path, option: str = "-o") -> Path:

@@ -34,7 +34,16 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("maps", nargs="*", metavar="MAP", help="map images or ROS map YAML files")
     parser.add_argument("-o", "--output", metavar="OUT", help="output folder")
     parser.add_argument(
-        "--preset", default="sketch", help="parameter preset: sketch, robot, default, icra, ursim-released"
+        "--method",
+        choices=["maoris", "watershed"],
+        default="maoris",
+        help="segmenter: maoris (default; sketches and robot maps) or watershed (clearance watershed with "
+        "saddle-ratio doors, for robot occupancy maps: presets default, robot)",
+    )
+    parser.add_argument(
+        "--preset",
+        default="sketch",
+        help="parameter preset: maoris: sketch, robot, default, icra, ursim-released; watershed: default, robot",
     )
     parser.add_argument("--param", action="append", metavar="NAME=VALUE", help="override one parameter (repeatable)")
     parser.add_argument(
@@ -103,7 +112,7 @@ def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, p
     atomic_write_text(out / f"{name}.regions.json", json.dumps(document, indent=2) + "\n")
 
 
-def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: bool = False):
+def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: bool = False, method: str = "maoris"):
     """Segment a map; a segmentation with no region is an error that names the map.
 
     ``canonical``: in the map's canonical pose (:mod:`ursim_core.segmentation.canonical`), for a
@@ -114,7 +123,7 @@ def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: 
 
     announce_kernel_compilation()
     segmenter = segment_canonical if canonical else segment
-    segmentation = segmenter(the_map, preset=preset, params=params)
+    segmentation = segmenter(the_map, method=method, preset=preset, params=params)
     if segmentation.n_regions == 0:
         free = int(the_map.free.sum())
         why = (
@@ -130,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     from ursim_core.segmentation import resolve_params
 
     params = segmentation_params(args)
-    resolve_params("maoris", args.preset, params)  # fail on a bad option before any work
+    resolve_params(args.method, args.preset, params)  # fail on a bad option before any work
     if args.evaluate:
         return _evaluate(args, params)
     if not args.maps:
@@ -147,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
     for index, (path, name) in enumerate(zip(args.maps, names), start=1):
         try:
             the_map = load(path, args)
-            segmentation = segment_checked(the_map, preset=args.preset, params=params)
+            segmentation = segment_checked(the_map, method=args.method, preset=args.preset, params=params)
             with staged_folder(out) as staging:
                 write_segmentation_outputs(the_map, segmentation, staging, name=name, preset=args.preset)
             print(f"{path}: {segmentation.n_regions} regions, {segmentation.graph.number_of_edges()} edges")
@@ -172,7 +181,7 @@ def _evaluate(args: argparse.Namespace, params: dict[str, Any]) -> int:
     rows = []
     for index, (map_path, gt_path) in enumerate(pairs, start=1):
         the_map = load(map_path, args)
-        segmentation = segment_checked(the_map, preset=args.preset, params=params)
+        segmentation = segment_checked(the_map, method=args.method, preset=args.preset, params=params)
         score = score_segmentation(segmentation.labels, gt_labels_from_separator_image(gt_path))
         rows.append((map_path.stem, segmentation.n_regions, score.precision, score.recall, score.f1))
         progress(index, text=map_path.name)

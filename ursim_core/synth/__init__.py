@@ -13,7 +13,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["drawing", "example", "floor_plans", "generator", "ground_truth"],
+    submodules=["drawing", "example", "floor_plans", "ground_truth"],
     submod_attrs={
         "floor_plans": ["Place", "FloorPlan", "generate_floor_plan", "make_large_building", "interior_points"],
         "drawing": ["Sketch", "sketchify"],

@@ -54,7 +54,7 @@ def test_public_names_stay_importable():
 def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch):
     from ursim_core.segmentation.maoris import ZoneGraph, flat_zones, maoris_labels, quantize
     from ursim_core.segmentation.maoris.kernels import contacts, signatures
-    from ursim_core.synth.generator import make_large_building
+    from ursim_core.synth import make_large_building
 
     free = make_large_building(300, seed=3).free
     maoris_labels(free)

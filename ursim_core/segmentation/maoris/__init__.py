@@ -120,6 +120,6 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "remove_isolated_zones",
         ],
         "pipeline": ["maoris_labels", "compile_kernels"],
-        "kernel_cache": ["kernels_cached"],
+        "kernel_cache": ["kernels_cached", "compile_notice", "COMPILE_CPU_SECONDS"],
     },
 )
