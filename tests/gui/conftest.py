@@ -80,7 +80,7 @@ def map_files(tmp_path, labels3):
 @pytest.fixture(autouse=True)
 def _never_block_on_questions(monkeypatch):
     """Modal questions would hang a test; tests that check them patch their own answer."""
-    from ursim_gui import dialogs
+    from ursim_gui.window import dialogs
 
     monkeypatch.setattr(dialogs, "ask_unsaved_changes", lambda parent, what: "discard")
     monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: None)
@@ -90,7 +90,7 @@ def _never_block_on_questions(monkeypatch):
 def window(qtbot, tmp_path, map_files):
     """Main window with both maps open and segmented from their label images (no MAORIS)."""
     from ursim_core.segmentation import load_label_image
-    from ursim_gui.main_window import MainWindow
+    from ursim_gui.window.main_window import MainWindow
 
     win = MainWindow(data_dir=tmp_path / "userdata")
     qtbot.addWidget(win)

@@ -80,8 +80,8 @@ def test_excepthook_logs_and_shows_instead_of_crashing(qtbot, caplog, monkeypatc
 
 
 def test_without_arguments_the_example_is_opened_segmented_matched_and_scored(qtbot, tmp_path):
-    from ursim_gui.main_window import MainWindow
-    from ursim_gui.window_tools import example_inputs
+    from ursim_gui.model.example import example_inputs
+    from ursim_gui.window.main_window import MainWindow
 
     args = app.parse_args([])
     assert args.maps == [] and not args.no_example

@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import QApplication
 
-from ursim_gui.shortcuts import SHORTCUTS, ShortcutSheet
+from ursim_gui.window.shortcuts import SHORTCUTS, ShortcutSheet
 
 
 def click(qtbot, view, region, modifier=Qt.KeyboardModifier.NoModifier):

@@ -12,7 +12,7 @@ from PySide6.QtGui import QDropEvent
 from PySide6.QtWidgets import QFileDialog
 
 from ursim_gui.app import parse_args
-from ursim_gui.main_window import MainWindow
+from ursim_gui.window.main_window import MainWindow
 
 
 @pytest.fixture

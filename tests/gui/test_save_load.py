@@ -11,8 +11,8 @@ from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
 
 from ursim_core.correspondences.codec import load_correspondences, load_dat
-from ursim_gui import dialogs
-from ursim_gui.main_window import MainWindow
+from ursim_gui.window import dialogs
+from ursim_gui.window.main_window import MainWindow
 
 
 def save_to(monkeypatch, path):
@@ -46,7 +46,7 @@ def test_failed_save_shows_an_error_and_stays_dirty(window, tmp_path, monkeypatc
     boxes = error_boxes(window)
     assert boxes and "missing-folder" in boxes[0].text()
     assert window.session.dirty and window.windowTitle().endswith("*")
-    from ursim_gui.model import session as session_module
+    from ursim_gui.model import session_documents as session_module
 
     def disk_full(*args, **kwargs):
         raise OSError(28, "No space left on device")

@@ -8,7 +8,7 @@ from PySide6.QtCore import QPointF
 from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QFileDialog
 
-from ursim_gui.status_bar import format_cursor, format_zoom
+from ursim_gui.views.status_bar import format_cursor, format_zoom
 
 
 def test_status_bar_shows_pixel_region_and_zoom(window, qtbot):
@@ -67,7 +67,7 @@ def test_failed_figure_export_shows_an_error(window, tmp_path):
 
 
 def test_job_progress_starts_busy_and_becomes_a_percentage(qtbot):
-    from ursim_gui.status_bar import CursorStatusBar
+    from ursim_gui.views.status_bar import CursorStatusBar
 
     bar = CursorStatusBar()
     qtbot.addWidget(bar)

@@ -1,7 +1,7 @@
 """Long computations (segmentation, matching) packaged for a worker thread.
 
 A job holds its inputs and has one method, ``run(progress, cancelled)``. It never
-touches the session or any widget: ``ursim_gui/workers.py`` runs it in a Qt thread
+touches the session or any widget: ``ursim_gui.jobs`` runs it in its worker process
 and hands the result back to the GUI thread, which calls
 ``AnnotationSession.set_segmentation`` or ``apply_match``. Keeping the jobs free of
 Qt means they are tested like plain functions.

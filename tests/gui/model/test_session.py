@@ -627,7 +627,7 @@ def test_partners_clique_of_and_colours(session):
     colours = {session.color_of_clique(i) for i in range(1, 40)}
     assert len(colours) == 39
     assert all(0 <= channel <= 255 for colour in colours for channel in colour)
-    overlay = pytest.importorskip("ursim_gui.overlay")
+    overlay = pytest.importorskip("ursim_gui.model.region_style")
     assert all(color_of_clique(i) == overlay.clique_colour(i) for i in range(1, 100))
 
 

@@ -1,6 +1,6 @@
 """Main-window commands that open a tool or dialog: new sketch, label image, figure, inputs.
 
-Split from :mod:`ursim_gui.main_window` so that module stays pure composition.
+Split from :mod:`ursim_gui.window.main_window` so that module stays pure composition.
 """
 
 from __future__ import annotations
@@ -11,28 +11,18 @@ from pathlib import Path
 from PySide6.QtWidgets import QDialog, QFileDialog
 
 from ursim_core.errors import UrsimError
-from ursim_gui import dialogs
-from ursim_gui.figure_export import export_figure
-from ursim_gui.sketch_canvas import SketchSizeDialog, SketchWindow
+from ursim_gui.model.example import example_inputs
+from ursim_gui.tools.sketch_canvas import SketchSizeDialog, SketchWindow
+from ursim_gui.views.figure_export import export_figure
+from ursim_gui.window import dialogs
 
-__all__ = ["WindowTools", "example_inputs"]
+__all__ = ["WindowTools"]
 
 _log = logging.getLogger(__name__)
 
 
-def example_inputs() -> tuple[Path, Path, Path | None] | None:
-    """(sketch, metric, reference) of the bundled example, or None when it is missing."""
-    from ursim_gui.app import EXAMPLE_DIR
-
-    sketch, metric = EXAMPLE_DIR / "sketch.png", EXAMPLE_DIR / "metric.png"
-    if not (sketch.is_file() and metric.is_file()):
-        return None
-    reference = EXAMPLE_DIR / "ground_truth.json"
-    return sketch, metric, reference if reference.is_file() else None
-
-
 class WindowTools:
-    """Commands of ``window`` (a :class:`~ursim_gui.main_window.MainWindow`)."""
+    """Commands of ``window`` (a :class:`~ursim_gui.window.main_window.MainWindow`)."""
 
     def __init__(self, window):
         self.window = window
@@ -151,7 +141,7 @@ class WindowTools:
         With ``wait`` the jobs run in this thread (False when one failed); else they are
         queued in the worker and True is returned at once.
         """
-        from ursim_gui.job_controller import MatchRequest
+        from ursim_gui.jobs.controller import MatchRequest
         from ursim_gui.model.jobs import SegmentJob
 
         jobs, panel = self.window.jobs, self.window.segmentation_panel

@@ -16,8 +16,8 @@ from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QPainter, QPixmapCache
 from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
 
-from ursim_gui.map_items import ImageItem, grey_to_qimage
-from ursim_gui.region_layers import MIN_ID_REGION_PX, RegionLayers
+from ursim_gui.views.map_items import ImageItem, grey_to_qimage
+from ursim_gui.views.region_layers import MIN_ID_REGION_PX, RegionLayers
 
 __all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX"]
 

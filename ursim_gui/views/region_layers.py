@@ -15,8 +15,15 @@ from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QImage, QPainterPath, QPen
 from PySide6.QtWidgets import QGraphicsPathItem, QGraphicsScene
 
-from ursim_gui.map_items import ImageItem, LabelItem, lut_qimage, mask_qimage, pack_premultiplied, region_outline_path
-from ursim_gui.overlay import outline_mask, region_label_positions, region_mask
+from ursim_gui.model.region_style import outline_mask, region_label_positions, region_mask
+from ursim_gui.views.map_items import (
+    ImageItem,
+    LabelItem,
+    lut_qimage,
+    mask_qimage,
+    pack_premultiplied,
+    region_outline_path,
+)
 
 __all__ = ["RegionLayers", "MIN_ID_REGION_PX", "MARK_STYLES"]
 

@@ -1,4 +1,4 @@
-"""File > New sketch: a drawing window over :class:`~ursim_gui.sketch_document.SketchDocument`.
+"""File > New sketch: a drawing window over :class:`~ursim_gui.model.sketch_document.SketchDocument`.
 
 The window translates mouse events to document strokes and shows the image; the
 document owns the pixels, the tools and the undo stack.
@@ -20,9 +20,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from ursim_gui.dialogs import show_error
-from ursim_gui.map_items import grey_to_qimage
-from ursim_gui.sketch_document import TOOLS, SketchDocument
+from ursim_gui.model.sketch_document import TOOLS, SketchDocument
+from ursim_gui.views.map_items import grey_to_qimage
+from ursim_gui.views.messages import show_error
 
 __all__ = ["SketchSizeDialog", "SketchCanvas", "SketchWindow"]
 

@@ -13,21 +13,21 @@ from pathlib import Path
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
 
-from ursim_gui.connectors import ConnectorOverlay
-from ursim_gui.document_controller import DocumentController
-from ursim_gui.edit_commands import EditCommands
-from ursim_gui.job_controller import JobController
-from ursim_gui.map_view import MapView
+from ursim_gui.jobs.controller import JobController
 from ursim_gui.model.session import AnnotationSession
 from ursim_gui.panels.anchors_list import AnchorsList
 from ursim_gui.panels.correspondence_table import CorrespondenceTable
 from ursim_gui.panels.evaluation_panel import EvaluationPanel
 from ursim_gui.panels.matching_panel import MatchingPanel
 from ursim_gui.panels.segmentation_panel import SegmentationPanel
-from ursim_gui.session_binding import SIDES, ViewBinding
-from ursim_gui.shortcuts import SHORTCUTS, ShortcutSheet, make_action
-from ursim_gui.status_bar import CursorStatusBar
-from ursim_gui.window_tools import WindowTools
+from ursim_gui.views.connectors import ConnectorOverlay
+from ursim_gui.views.map_view import MapView
+from ursim_gui.views.session_binding import SIDES, ViewBinding
+from ursim_gui.views.status_bar import CursorStatusBar
+from ursim_gui.window.document_controller import DocumentController
+from ursim_gui.window.edit_commands import EditCommands
+from ursim_gui.window.shortcuts import SHORTCUTS, ShortcutSheet, make_action
+from ursim_gui.window.window_commands import WindowTools
 
 __all__ = ["MainWindow"]
 

@@ -1,4 +1,4 @@
-"""GUI timings: ``python -m ursim_gui.bench_gui`` (runs offscreen unless a platform is set).
+"""GUI timings: ``python -m ursim_gui.bench`` (runs offscreen unless a platform is set).
 
 Measures, on synthetic maps:
 
@@ -57,7 +57,7 @@ def bench_open(app, data_dir: Path, size: int) -> tuple[float, float]:
     from ursim_core.io.maps import map_from_array
     from ursim_core.segmentation import Segmentation
     from ursim_core.segmentation.graph import region_graph
-    from ursim_gui.main_window import MainWindow
+    from ursim_gui.window.main_window import MainWindow
 
     labels = room_grid_labels(size, size, 100)
     segmentation = Segmentation(labels=labels, graph=region_graph(labels), method="label-image")
@@ -85,7 +85,7 @@ def bench_hover_and_edit(app, data_dir) -> tuple[list[float], list[float]]:
     from ursim_core.io.maps import map_from_array
     from ursim_core.segmentation import Segmentation
     from ursim_core.segmentation.graph import region_graph
-    from ursim_gui.main_window import MainWindow
+    from ursim_gui.window.main_window import MainWindow
 
     labels = room_grid_labels(924, 1870, 90)
     segmentation = Segmentation(labels=labels, graph=region_graph(labels), method="label-image")
@@ -125,7 +125,7 @@ def bench_blocking(app, job) -> tuple[float, float]:
     """Run ``job`` in the worker; return (longest GUI-thread gap, job wall time)."""
     from PySide6.QtCore import QTimer
 
-    from ursim_gui.workers import JobRunner
+    from ursim_gui.jobs.runner import JobRunner
 
     runner = JobRunner()
     ticks: list[float] = []
@@ -144,7 +144,7 @@ def bench_blocking(app, job) -> tuple[float, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m ursim_gui.bench_gui", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m ursim_gui.bench", description=__doc__.splitlines()[0])
     parser.add_argument("--size", type=int, default=4000, help="side of the big map (default 4000)")
     args = parser.parse_args(argv)
     from PySide6.QtWidgets import QApplication

@@ -1,7 +1,7 @@
 """Binds the session to the two map views: model signals -> drawing, view input -> model calls.
 
 The binding holds no annotation state. It re-reads the session when it signals a change
-and draws with the pure helpers of :mod:`ursim_gui.view_state`; clicks become
+and draws with the pure helpers of :mod:`ursim_gui.model.view_state`; clicks become
 ``session.select`` calls. Hover is purely visual: it only re-draws the cheap highlight
 layer of the other view.
 """
@@ -13,7 +13,7 @@ import functools
 import numpy as np
 from PySide6.QtGui import QColor
 
-from ursim_gui.view_state import eval_badges, first_regions, side_colour_table
+from ursim_gui.model.view_state import eval_badges, first_regions, side_colour_table
 
 __all__ = ["ViewBinding", "SIDES"]
 

@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ursim_gui.overlay import NEUTRAL_REGION, Colour, region_colour_table
+from ursim_gui.model.region_style import NEUTRAL_REGION, Colour, region_colour_table
 
 __all__ = ["side_colour_table", "first_regions", "eval_badges"]
 

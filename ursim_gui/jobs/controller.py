@@ -1,7 +1,7 @@
 """Runs segmentation and matching jobs off the GUI thread and hands results to the session.
 
 Jobs are queued (segment sketch, segment metric, match) and run one at a time by a
-:class:`~ursim_gui.workers.JobRunner`; the status bar shows progress and a Cancel button
+:class:`~ursim_gui.jobs.runner.JobRunner`; the status bar shows progress and a Cancel button
 that drops the whole queue. Results are applied in the GUI thread through the session's
 own methods (``set_segmentation``, ``apply_match``).
 """
@@ -14,9 +14,9 @@ from collections import deque
 from PySide6.QtCore import QObject, Signal
 
 from ursim_core.errors import UrsimError
-from ursim_gui.dialogs import show_error
+from ursim_gui.jobs.runner import JobRunner
 from ursim_gui.model.jobs import MatchJob, SegmentJob
-from ursim_gui.workers import JobRunner
+from ursim_gui.views.messages import show_error
 
 __all__ = ["JobController", "MatchRequest"]
 

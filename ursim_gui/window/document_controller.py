@@ -15,8 +15,8 @@ from PySide6.QtCore import QObject, QTimer
 from PySide6.QtWidgets import QFileDialog
 
 from ursim_core.errors import UrsimError
-from ursim_gui import dialogs
 from ursim_gui.model.autosave import Autosaver, find_recoverable, recover
+from ursim_gui.window import dialogs
 
 __all__ = ["DocumentController", "MAP_FILTER", "JSON_FILTER", "DAT_FILTER"]
 
