@@ -4,19 +4,21 @@ question, failed saves, autosave and recovery."""
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import pytest
 from conftest import error_boxes
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QMessageBox
 
 from ursim_core.correspondences.codec import load_correspondences, load_dat
+from ursim_gui.views import file_dialogs
 from ursim_gui.window import dialogs
 from ursim_gui.window.main_window import MainWindow
 
 
 def save_to(monkeypatch, path):
-    monkeypatch.setattr(QFileDialog, "getSaveFileName", staticmethod(lambda *a, **k: (str(path), "")))
+    monkeypatch.setattr(file_dialogs, "ask_save_path", lambda *a, **k: Path(str(path)))
 
 
 def test_ctrl_s_saves_and_the_title_tracks_dirty(window, qtbot, tmp_path, monkeypatch):
@@ -65,7 +67,7 @@ def test_dat_export_and_import(window, tmp_path, monkeypatch):
     window.actions["export_dat"].trigger()
     assert len(load_dat(dat).cliques) == 1
     window.session.delete_clique(window.session.correspondences.cliques[0].id)
-    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(dat), "")))
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(str(dat)))
     window.actions["import_dat"].trigger()
     (clique,) = window.session.correspondences.cliques
     assert (clique.sketch_regions, clique.metric_regions) == ((1,), (3,))

@@ -3,11 +3,13 @@ both views with a legend can be exported."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from conftest import error_boxes
 from PySide6.QtCore import QPointF
 from PySide6.QtGui import QImage
-from PySide6.QtWidgets import QFileDialog
 
+from ursim_gui.views import file_dialogs
 from ursim_gui.views.status_bar import format_cursor, format_zoom
 
 
@@ -43,7 +45,7 @@ def test_export_figure_writes_a_png_with_a_legend(window, tmp_path, monkeypatch)
     window.actions["connectors"].setChecked(True)
     window.session.select_clique(window.session.correspondences.cliques[0].id)
     target = tmp_path / "figure.png"
-    monkeypatch.setattr(QFileDialog, "getSaveFileName", staticmethod(lambda *a, **k: (str(target), "")))
+    monkeypatch.setattr(file_dialogs, "ask_save_path", lambda *a, **k: Path(str(target)))
     window.actions["export_figure"].trigger()
     image = QImage(str(target))
     assert not image.isNull() and image.width() > 600 and image.height() > 600

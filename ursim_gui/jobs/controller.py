@@ -15,7 +15,7 @@ from PySide6.QtCore import QObject, Signal
 
 from ursim_core.errors import UrsimError
 from ursim_gui.jobs.runner import JobRunner
-from ursim_gui.model.jobs import MatchJob, SegmentJob
+from ursim_gui.model.jobs import MatchJob, SegmentJob, compiling_note
 from ursim_gui.views.messages import show_error
 
 __all__ = ["JobController", "MatchRequest"]
@@ -40,6 +40,7 @@ class JobController(QObject):
         self._parent = parent_widget
         self.runner = JobRunner(self)
         self._queue: deque = deque()
+        self._note = ""
         self.runner.progress.connect(self._progress)
         self.runner.finished.connect(self._finished)
         self.runner.failed.connect(self._failed)
@@ -112,7 +113,10 @@ class JobController(QObject):
             if job is None:
                 continue
             self._status.show_job(True)
-            self._status.showMessage(job.description + "…")
+            # Said for as long as the job runs: the first MAORIS run compiles for seconds.
+            self._note = compiling_note(job) or ""
+            self._status.progress_bar.setToolTip(self._note)
+            self._status.showMessage(job.description + "…" + (f"  {self._note}" if self._note else ""))
             self.runner.start(job)
             self.busy_changed.emit(True)
         if not self.busy:
@@ -153,7 +157,8 @@ class JobController(QObject):
     def _progress(self, fraction: float, message: str) -> None:
         job = self.runner.job
         prefix = f"{job.description}: " if job is not None and message else ""
-        self._status.show_progress(fraction, prefix + message)
+        suffix = f"  {self._note}" if message and self._note else ""
+        self._status.show_progress(fraction, prefix + message + suffix)
 
     def _finished(self, job, result) -> None:
         try:

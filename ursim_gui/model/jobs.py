@@ -18,7 +18,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["JobCancelled", "SegmentJob", "MatchJob", "ProgressCallback", "CancelledCallback"]
+__all__ = [
+    "JobCancelled",
+    "SegmentJob",
+    "MatchJob",
+    "ProgressCallback",
+    "CancelledCallback",
+    "COMPILING_NOTE",
+    "compiling_note",
+]
 
 #: ``progress(fraction, message)`` with ``fraction`` in [0, 1].
 ProgressCallback = Callable[[float, str], None]
@@ -33,6 +41,26 @@ class JobCancelled(Exception):
 def _check(cancelled: CancelledCallback, what: str) -> None:
     if cancelled():
         raise JobCancelled(f"{what} cancelled")
+
+
+#: Shown while the first segmentation of a fresh install compiles the numba kernels.
+COMPILING_NOTE = "Compiling the segmentation kernels (first run only)…"
+
+
+def compiling_note(job) -> str | None:
+    """:data:`COMPILING_NOTE` when ``job`` is a MAORIS segmentation that will compile the kernels.
+
+    Asks ``ursim_core.segmentation.maoris.kernels_cached()`` (a few directory listings)
+    when the core has it; without it, or once the kernels are cached, None.
+    """
+    if not isinstance(job, SegmentJob) or job.method != "maoris":
+        return None
+    from ursim_core.segmentation import maoris
+
+    cached = getattr(maoris, "kernels_cached", None)
+    if cached is None or cached():
+        return None
+    return COMPILING_NOTE
 
 
 class SegmentJob:

@@ -57,6 +57,10 @@ __all__ = [
 ]
 
 
+def _untouched_automatic(clique: Clique) -> bool:
+    return clique.source == "auto" and clique.status is None and not clique.note
+
+
 class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations):
     """State and operations of one annotation window (Qt-free).
 
@@ -112,6 +116,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self._history: History[Correspondences] = History()
         self._selection: dict[str, frozenset[int]] = {side: frozenset() for side in SIDES}
         self._selected_clique: int | None = None
+        self._focus: tuple[str, int] | None = None
         self._reference_corr: Correspondences | None = None
         self._reference: list[tuple[frozenset[int], frozenset[int]]] | None = None
         self._evaluation = None
@@ -154,10 +159,11 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
     def dirty(self) -> bool:
         """True when closing would lose work: the correspondences differ from the saved ones.
 
-        An untitled document without cliques is never dirty: it holds nothing that
-        re-opening the two maps would not restore.
+        An untitled document whose cliques are all untouched matcher output (automatic,
+        never reviewed, no note) is never dirty: it holds nothing that re-opening and
+        re-matching the two maps would not restore, so quitting it need not ask.
         """
-        if self._path is None and not self._corr.cliques:
+        if self._path is None and all(_untouched_automatic(clique) for clique in self._corr.cliques):
             return False
         return self._corr != self._saved
 
@@ -205,6 +211,11 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
     @property
     def selected_clique(self) -> int | None:
         return self._selected_clique
+
+    @property
+    def focus(self) -> tuple[str, int] | None:
+        """``(side, region)`` the user last picked by itself (what U unlinks), or None."""
+        return self._focus
 
     @property
     def history(self) -> History[Correspondences]:
@@ -264,6 +275,53 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
 
         self.set_map(side, load_map(_absolute(path)))
 
+    def is_document_map(self, side: str, path: str | os.PathLike) -> bool:
+        """True when ``path`` is the ``side`` map the document names, or it names none yet.
+
+        Opening any other map starts a new document (:meth:`new_document`): the cliques,
+        the reference and the file all belong to the old pair.
+        """
+        recorded = getattr(self._corr, _check_side(side)).path
+        return recorded is None or Path(recorded) == _absolute(path)
+
+    def new_document(self, *, keep: Iterable[str] = ()) -> None:
+        """Start an untitled, empty document; the maps (and segmentations) of ``keep`` stay.
+
+        The history, reference, selection and last match are cleared. Not undoable (like
+        opening a file): callers ask about unsaved changes first.
+        """
+        keep = {_check_side(side) for side in keep}
+        corr = Correspondences(annotator=self._corr.annotator)
+        for side in keep:
+            corr = dataclasses.replace(corr, **{side: getattr(self._corr, side)})
+        was_dirty = self.dirty
+        old_path = self._path
+        for side in SIDES:
+            if side not in keep:
+                self._maps[side] = None
+                self._segmentations[side] = None
+        self._corr = corr
+        self._saved = corr
+        self._path = None
+        self._history.clear()
+        self._selection = {side: frozenset() for side in SIDES}
+        self._selected_clique = None
+        self._focus = None
+        self._forget_match()
+        self._reference_corr = None
+        self._recompute_reference()
+        self._evaluate()
+        for side in SIDES:
+            if side not in keep:
+                self.map_changed.emit(side)
+                self.segmentation_changed.emit(side)
+        if old_path is not None:
+            self.path_changed.emit(None)
+        self.selection_changed.emit()
+        self.reference_changed.emit()
+        self._announce_value_change(was_dirty)
+        self.history_changed.emit()
+
     def set_map(self, side: str, map_) -> None:
         """Show ``map_`` on ``side``; its segmentation is dropped (it belonged to the old map).
 
@@ -290,6 +348,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         was_dirty = self.dirty
         self._maps[side] = map_
         self._segmentations[side] = None
+        self._forget_match()
         self._history.map_values(rebase)
         self._corr = rebase(self._corr)
         selection_cleared = self._clear_side_selection(side)
@@ -334,6 +393,8 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
 
         was_dirty = self.dirty
         self._segmentations[side] = segmentation
+        # The last match's anchors and pairs name regions of the old segmentation.
+        self._forget_match()
         self._history.map_values(rebase)
         self._corr = rebase(self._corr)
         # Region ids of the old segmentation mean nothing now.
@@ -353,28 +414,41 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         With ``add`` the regions join the current selection and the selected clique
         stays (so a region can be added to it); without, they replace the side's
         selection and the selected clique is cleared.
+
+        A plain selection after a selected clique also clears the other side: those
+        regions were the clique's, not picked by the user, and linking must not pull them in.
         """
         _check_side(side)
         chosen = frozenset(int(region) for region in regions)
         new_selection = dict(self._selection)
         new_selection[side] = new_selection[side] | chosen if add else chosen
+        if not add and self._selected_clique is not None:
+            new_selection[SIDES[1 - SIDES.index(side)]] = frozenset()
         new_clique = self._selected_clique if add else None
-        if new_selection == self._selection and new_clique == self._selected_clique:
+        new_focus = (side, next(iter(chosen))) if len(chosen) == 1 else (self._focus if add else None)
+        if new_selection == self._selection and new_clique == self._selected_clique and new_focus == self._focus:
             return
         self._selection = new_selection
         self._selected_clique = new_clique
+        self._focus = new_focus
         self.selection_changed.emit()
 
-    def select_clique(self, clique_id: int | None) -> None:
-        """Select a clique (its regions become the selection on both sides), or none."""
+    def select_clique(self, clique_id: int | None, *, focus: tuple[str, int] | None = None) -> None:
+        """Select a clique (its regions become the selection on both sides), or none.
+
+        ``focus`` is the ``(side, region)`` the user clicked to select it (what U then
+        unlinks from this clique); None when it was picked from a list.
+        """
         if clique_id is None:
             if self._selected_clique is None:
                 return
             self._selected_clique = None
+            self._focus = None
             self.selection_changed.emit()
             return
         clique = self._corr.clique(clique_id)
         self._selected_clique = clique.id
+        self._focus = None if focus is None else (_check_side(focus[0]), int(focus[1]))
         self._selection = {
             "sketch": frozenset(clique.sketch_regions),
             "metric": frozenset(clique.metric_regions),
@@ -387,6 +461,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
             return
         self._selection = {side: frozenset() for side in SIDES}
         self._selected_clique = None
+        self._focus = None
         self.selection_changed.emit()
 
     def undo(self) -> bool:
@@ -406,6 +481,10 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         return True
 
     # ------------------------------------------------------------------ internals
+    def _forget_match(self) -> None:
+        self._last_match = None
+        self._anchors = []
+
     def _commit(self, description: str, new: Correspondences) -> bool:
         """Apply one undoable edit: a history entry and the signals. False when nothing changed."""
         if new == self._corr:
@@ -421,6 +500,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         selection_changed = False
         if self._selected_clique is not None and not any(c.id == self._selected_clique for c in new.cliques):
             self._selected_clique = None
+            self._focus = None
             selection_changed = True
         self._evaluate()
         if selection_changed:
@@ -436,6 +516,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         changed = bool(self._selection[side]) or self._selected_clique is not None
         self._selection = {**self._selection, side: frozenset()}
         self._selected_clique = None
+        self._focus = None
         return changed
 
     def _checked_regions(self, side: str, regions: Iterable[int], *, stale_hint: bool = False) -> tuple[int, ...]:

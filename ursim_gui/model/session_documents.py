@@ -125,8 +125,13 @@ class DocumentOperations:
         self._commit(f"Import {path.name}", corr)
 
     def export_dat(self, path: str | os.PathLike) -> None:
-        """Write the cliques' points in the original ``.dat`` format (atomically)."""
-        save_dat(self._corr, _absolute(path))
+        """Write the cliques' points in the original ``.dat`` format (atomically).
+
+        Rejected cliques are left out: the format has no status, and a reader would take
+        every clique it holds for a correspondence.
+        """
+        kept = [clique for clique in self._corr.cliques if clique.effective_status != "rejected"]
+        save_dat(self._corr.with_cliques(kept), _absolute(path))
 
     def _install_document(self, corr: Correspondences, *, path: Path | None, saved: Correspondences | None) -> None:
         """Load the maps and segmentations ``corr`` names into temporaries, then swap them in."""
@@ -149,6 +154,7 @@ class DocumentOperations:
         self._history.clear()
         self._selection = {side: frozenset() for side in SIDES}
         self._selected_clique = None
+        self._focus = None
         self._last_match = None
         self._anchors = []
         self._recompute_reference()

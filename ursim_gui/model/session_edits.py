@@ -75,41 +75,59 @@ class EditOperations:
         self._commit(description, self._corr.with_clique(clique))
         return clique.id
 
-    def unlink(self, side: str, region: int) -> None:
-        """Remove ``region`` and its points from every clique; delete cliques left empty.
+    def unlink(self, side: str, region: int, *, clique: int | None = None) -> None:
+        """Remove ``region`` and its points from clique ``clique`` (default: from every clique).
 
-        A point belongs to the region it falls in on the current segmentation (with the
-        usual 10 px tolerance). A clique keeps living with one side empty (half-made
-        cliques are normal while annotating) and is deleted only when both sides are.
+        One undo step. See :meth:`unlink_regions`.
+        """
+        self.unlink_regions({side: [region]}, clique=clique)
+
+    def unlink_regions(self, regions: dict, *, clique: int | None = None) -> None:
+        """Remove regions (``{side: ids}``) and their points from cliques, as one undo step.
+
+        With ``clique`` only that clique's membership changes; otherwise every clique
+        that holds a region loses it. A point belongs to the region it falls in on the
+        current segmentation (with the usual 10 px tolerance). A clique keeps living with
+        one side empty (half-made cliques are normal while annotating) and is deleted
+        only when both sides are.
 
         Raises
         ------
         ValueError
-            ``side`` is not segmented (there is no way to tell which points are the region's).
+            A side with regions is not segmented (there is no way to tell which points
+            are the region's).
+        KeyError
+            ``clique`` is not a clique id.
         """
-        _check_side(side)
-        segmentation = self._segmentations[side]
-        if segmentation is None:
-            raise ValueError(f"the {side} map is not segmented")
-        region = int(region)
-        points_field, regions_field = f"{side}_points", f"{side}_regions"
+        chosen = {_check_side(side): {int(r) for r in ids} for side, ids in regions.items() if ids}
+        for side in chosen:
+            if self._segmentations[side] is None:
+                raise ValueError(f"the {side} map is not segmented")
+        if clique is not None:
+            self._corr.clique(clique)  # KeyError for an unknown id
         cliques = []
-        for clique in self._corr.cliques:
-            if region not in getattr(clique, regions_field):
-                cliques.append(clique)
+        for current in self._corr.cliques:
+            if clique is not None and current.id != clique:
+                cliques.append(current)
                 continue
-            points = getattr(clique, points_field)
-            owners = regions_at_points(segmentation.labels, points, tolerance=REFERENCE_TOLERANCE)
-            shrunk = dataclasses.replace(
-                clique,
-                **{
-                    points_field: tuple(point for point, owner in zip(points, owners) if owner != region),
-                    regions_field: tuple(r for r in getattr(clique, regions_field) if r != region),
-                },
-            )
-            if not shrunk.is_empty:
-                cliques.append(shrunk)
-        self._commit(f"Unlink {side} region {region}", self._corr.with_cliques(cliques))
+            for side, removed in chosen.items():
+                points_field, regions_field = f"{side}_points", f"{side}_regions"
+                if not removed & set(getattr(current, regions_field)):
+                    continue
+                points = getattr(current, points_field)
+                owners = regions_at_points(self._segmentations[side].labels, points, tolerance=REFERENCE_TOLERANCE)
+                current = dataclasses.replace(
+                    current,
+                    **{
+                        points_field: tuple(point for point, owner in zip(points, owners) if owner not in removed),
+                        regions_field: tuple(r for r in getattr(current, regions_field) if r not in removed),
+                    },
+                )
+            if not current.is_empty:
+                cliques.append(current)
+        names = [f"{side} region {_regions_text(sorted(ids))}" for side, ids in chosen.items()]
+        where = f" from clique {clique}" if clique is not None else ""
+        self._commit(f"Unlink {' and '.join(names)}{where}", self._corr.with_cliques(cliques))
 
     def delete_clique(self, clique_id: int) -> None:
         """Delete a clique (KeyError when there is none)."""

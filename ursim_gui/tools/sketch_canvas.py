@@ -11,7 +11,6 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QPainter
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
-    QFileDialog,
     QFormLayout,
     QLabel,
     QMainWindow,
@@ -21,6 +20,7 @@ from PySide6.QtWidgets import (
 )
 
 from ursim_gui.model.sketch_document import TOOLS, SketchDocument
+from ursim_gui.views import file_dialogs
 from ursim_gui.views.map_items import grey_to_qimage
 from ursim_gui.views.messages import show_error
 
@@ -177,9 +177,9 @@ class SketchWindow(QMainWindow):
         self.redo_action.setEnabled(self.document.can_redo)
 
     def save_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save sketch", "sketch.png", "PNG image (*.png)")
-        if path:
-            self.save_to(path)
+        path = file_dialogs.ask_save_path(self, "Save sketch", "sketch.png", "PNG image (*.png)")
+        if path is not None:
+            self.save_to(str(path))
 
     def save_to(self, path: str) -> bool:
         """Save the PNG; a failure is shown in a dialog and logged. True on success."""

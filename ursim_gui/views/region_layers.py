@@ -169,6 +169,22 @@ class RegionLayers:
             for item in items:
                 item.setVisible(True)
 
+    @contextlib.contextmanager
+    def ids_shown(self, zoom: float):
+        """Show the region ids inside the block, culled for ``zoom`` (figures always name regions)."""
+        was_visible = self._ids_visible
+        self._ids_visible = True
+        if not self._ids:
+            self._rebuild_ids()
+        before = [was_visible and item.isVisible() for item in self._ids]
+        self.cull_ids(zoom)
+        try:
+            yield
+        finally:
+            self._ids_visible = was_visible
+            for item, visible in zip(self._ids, before):
+                item.setVisible(visible)
+
     def _path(self, region: int) -> QPainterPath:
         # Outlines are computed on first use and cached until the segmentation changes.
         if region not in self._paths:

@@ -12,10 +12,10 @@ import time
 from pathlib import Path
 
 from PySide6.QtCore import QObject, QTimer
-from PySide6.QtWidgets import QFileDialog
 
 from ursim_core.errors import UrsimError
 from ursim_gui.model.autosave import Autosaver, find_recoverable, recover
+from ursim_gui.views import file_dialogs
 from ursim_gui.window import dialogs
 
 __all__ = ["DocumentController", "MAP_FILTER", "JSON_FILTER", "DAT_FILTER"]
@@ -61,13 +61,26 @@ class DocumentController(QObject):
 
     # ---- opening -------------------------------------------------------------------------
     def _ask_open(self, title: str, filters: str) -> Path | None:
-        path, _ = QFileDialog.getOpenFileName(self.window, title, "", filters)
-        return Path(path) if path else None
+        return file_dialogs.ask_open_path(self.window, title, filters)
 
     def open_map(self, side: str, path: Path | None = None) -> bool:
-        """Open a map image or ROS YAML as ``side``'s map."""
+        """Open a map image or ROS YAML as ``side``'s map.
+
+        A map that is not the one the document names starts a new, untitled document
+        that keeps the other side's map (after asking about unsaved changes): the old
+        cliques, reference and file belong to the old pair, and saving must never write
+        them under the new map's name.
+        """
         path = path or self._ask_open(f"Open {side} map", MAP_FILTER)
-        return path is not None and self._try(f"Cannot open the {side} map", self.session.load_map, side, path)
+        if path is None:
+            return False
+        session = self.session
+        if not session.is_document_map(side, path):
+            if not self.confirm_discard(f"opening another {side} map"):
+                return False
+            other = "metric" if side == "sketch" else "sketch"
+            session.new_document(keep=[other])
+        return self._try(f"Cannot open the {side} map", session.load_map, side, path)
 
     def open_correspondences(self, path: Path | None = None) -> bool:
         """Open a correspondence JSON (and its maps), after offering to save changes."""
@@ -101,12 +114,9 @@ class DocumentController(QObject):
 
     def save_as(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(
-                self.window, "Save correspondences", "correspondences.json", JSON_FILTER
-            )
-            if not chosen:
+            path = file_dialogs.ask_save_path(self.window, "Save correspondences", "correspondences.json", JSON_FILTER)
+            if path is None:
                 return False
-            path = Path(chosen)
         return self._save_to(path)
 
     def _save_to(self, path: Path | None) -> bool:
@@ -118,10 +128,9 @@ class DocumentController(QObject):
 
     def export_dat(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(self.window, "Export .dat", "correspondences.dat", DAT_FILTER)
-            if not chosen:
+            path = file_dialogs.ask_save_path(self.window, "Export .dat", "correspondences.dat", DAT_FILTER)
+            if path is None:
                 return False
-            path = Path(chosen)
         return self._try("Export failed", self.session.export_dat, path)
 
     def confirm_discard(self, what: str) -> bool:

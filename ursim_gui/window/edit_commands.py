@@ -38,10 +38,21 @@ class EditCommands:
             self.session.link(sketch, metric, into=self.session.selected_clique)
 
     def unlink(self) -> None:
-        """Remove each selected region from its cliques."""
-        for side in ("sketch", "metric"):
-            for region in self._selected(side):
-                self.session.unlink(side, region)
+        """One undo step: the clicked region leaves the selected clique, or the selected regions all theirs.
+
+        With a clique selected, only the region the user clicked (the session's focus)
+        leaves it; the clique's other regions, and other cliques, are untouched. A clique
+        picked from the table has no clicked region, so nothing is unlinked.
+        """
+        session = self.session
+        if session.selected_clique is not None:
+            if session.focus is not None:
+                side, region = session.focus
+                session.unlink(side, region, clique=session.selected_clique)
+            return
+        selected = {side: self._selected(side) for side in ("sketch", "metric")}
+        if any(selected.values()):
+            session.unlink_regions(selected)
 
     def delete_clique(self) -> None:
         if self.session.selected_clique is not None:

@@ -8,11 +8,12 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from PySide6.QtWidgets import QDialog, QFileDialog
+from PySide6.QtWidgets import QDialog
 
 from ursim_core.errors import UrsimError
 from ursim_gui.model.example import example_inputs
 from ursim_gui.tools.sketch_canvas import SketchSizeDialog, SketchWindow
+from ursim_gui.views import file_dialogs
 from ursim_gui.views.figure_export import export_figure
 from ursim_gui.window import dialogs
 
@@ -61,12 +62,11 @@ class WindowTools:
             dialogs.show_error(self.window, "No map", f"Open the {side} map before its label image.")
             return False
         if path is None:
-            chosen, _ = QFileDialog.getOpenFileName(
-                self.window, f"Load {side} label image", "", "Label images (*.png *.tif *.tiff)"
+            path = file_dialogs.ask_open_path(
+                self.window, f"Load {side} label image", "Label images (*.png *.tif *.tiff)"
             )
-            if not chosen:
+            if path is None:
                 return False
-            path = Path(chosen)
         try:
             self.session.set_segmentation(side, load_label_image(path, shape=map_.shape))
         except (UrsimError, OSError) as error:
@@ -77,10 +77,9 @@ class WindowTools:
     # ---- figure and status --------------------------------------------------------------------
     def export_figure(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(self.window, "Export figure", "figure.png", "PNG image (*.png)")
-            if not chosen:
+            path = file_dialogs.ask_save_path(self.window, "Export figure", "figure.png", "PNG image (*.png)")
+            if path is None:
                 return False
-            path = Path(chosen)
         views = self.window.views
         try:
             export_figure(
