@@ -115,3 +115,19 @@ def error_boxes(parent):
     from PySide6.QtWidgets import QMessageBox
 
     return [box for box in parent.findChildren(QMessageBox, "error_box") if box.isVisible()]
+
+
+def dead_pid() -> int:
+    """The id of a process that has just exited (as a crashed run's)."""
+    import subprocess
+    import sys
+
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+def simulate_crash(autosaver) -> None:
+    """Leave ``autosaver``'s copy as a crashed run would: its lock names a dead process."""
+    lock = autosaver.folder / f"{autosaver._instance_id}.lock"
+    lock.write_text(f"{dead_pid()}\n", encoding="ascii")

@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import error_boxes
+from conftest import error_boxes, simulate_crash
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QApplication, QMessageBox
 
@@ -111,8 +111,10 @@ def test_autosave_and_recovery(window, qtbot, tmp_path, monkeypatch):
     folder = window.documents.autosave_dir
     (copy,) = folder.glob("*.autosave.json")
     assert load_correspondences(copy).cliques[0].metric_regions == (2,)
-    # A crash: the window goes away without a clean close; the copy stays.
+    # A crash: the window goes away without a clean close; the copy stays, its lock
+    # names a process that is gone.
     window.documents.autosave_timer.stop()
+    simulate_crash(window.documents.autosaver)
 
     offered = []
     monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: offered.append(paths) or paths[0])

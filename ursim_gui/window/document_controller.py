@@ -42,6 +42,7 @@ class DocumentController(QObject):
         self.autosave_timer.setInterval(1000)
         self.autosave_timer.timeout.connect(self.flush_autosave)
         self.autosave_timer.start()
+        self._autosave_failing = False
         session.dirty_changed.connect(lambda _dirty: self.update_title())
         session.path_changed.connect(lambda _path: self.update_title())
         session.error.connect(lambda message: dialogs.show_error(window, "Error", message))
@@ -53,11 +54,24 @@ class DocumentController(QObject):
         self.window.setWindowTitle(self.session.window_title())
 
     def flush_autosave(self) -> None:
+        """The timer's call. Any failure is logged each time and shown once per failing streak."""
         try:
-            self.autosaver.flush_if_due(time.monotonic())
-        except OSError as error:
-            # Autosave must never interrupt the user; log it and try again later.
-            _log.warning("autosave failed: %s", error)
+            written = self.autosaver.flush_if_due(time.monotonic())
+        except Exception as error:
+            # Whatever went wrong (disk, permissions, a value the codec refuses), the user
+            # must know the work is not backed up, but one box, not one per tick.
+            _log.warning("autosave failed: %s: %s", type(error).__name__, error)
+            if not self._autosave_failing:
+                self._autosave_failing = True
+                dialogs.show_error(
+                    self.window,
+                    "Autosave failed",
+                    f"The unsaved changes could not be backed up to {self.autosave_dir}:\n"
+                    f"{type(error).__name__}: {error}\n\nSave the document to keep them; autosave keeps retrying.",
+                )
+            return
+        if written:
+            self._autosave_failing = False
 
     # ---- opening -------------------------------------------------------------------------
     def _ask_open(self, title: str, filters: str) -> Path | None:
