@@ -84,6 +84,9 @@ def _never_block_on_questions(monkeypatch):
 
     monkeypatch.setattr(dialogs, "ask_unsaved_changes", lambda parent, what: "discard")
     monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: None)
+    from PySide6.QtWidgets import QInputDialog
+
+    monkeypatch.setattr(QInputDialog, "getText", staticmethod(lambda *args, **kwargs: ("tester", True)))
 
 
 @pytest.fixture

@@ -32,6 +32,8 @@ class JobController(QObject):
     """
 
     busy_changed = Signal(bool)
+    #: A job's result was applied to the session (SegmentJob or MatchJob).
+    applied = Signal(object)
 
     def __init__(self, session, status_bar, parent_widget=None):
         super().__init__(parent_widget)
@@ -153,6 +155,7 @@ class JobController(QObject):
         else:
             self._session.apply_match(result)
             self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)
+        self.applied.emit(job)
 
     def _progress(self, fraction: float, message: str) -> None:
         job = self.runner.job

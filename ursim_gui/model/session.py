@@ -107,6 +107,8 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self.error = Signal("error")
 
         self._timestamp = timestamp
+        #: Annotator of the documents :meth:`new_document` starts.
+        self.annotator = annotator
         self._maps: dict[str, Any] = {side: None for side in SIDES}
         self._segmentations: dict[str, Any] = {side: None for side in SIDES}
         self._presets = dict(DEFAULT_PRESETS)
@@ -291,7 +293,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         opening a file): callers ask about unsaved changes first.
         """
         keep = {_check_side(side) for side in keep}
-        corr = Correspondences(annotator=self._corr.annotator)
+        corr = Correspondences(annotator=self.annotator or self._corr.annotator)
         for side in keep:
             corr = dataclasses.replace(corr, **{side: getattr(self._corr, side)})
         was_dirty = self.dirty

@@ -143,6 +143,42 @@ class EditOperations:
             self._corr.with_clique(dataclasses.replace(clique, status=status)),
         )
 
+    def set_statuses(self, clique_ids: Iterable[int], status: str) -> None:
+        """Set the review status of several cliques as one undo step (e.g. accept all)."""
+        if status not in STATUSES:
+            raise ValueError(f"status must be one of {STATUSES}, got {status!r}")
+        ids = set(int(i) for i in clique_ids)
+        cliques = [
+            dataclasses.replace(clique, status=status) if clique.id in ids else clique for clique in self._corr.cliques
+        ]
+        self._commit(f"{_STATUS_VERBS[status]} {len(ids)} cliques", self._corr.with_cliques(cliques))
+
+    def relink(self, clique_id: int, side: str, regions: Iterable[int]) -> None:
+        """Replace one side of a clique by ``regions`` (one undo step): fixes a wrong match.
+
+        The clique turns manual and accepted: a person has just said which regions
+        correspond. Its other side is untouched.
+
+        Raises
+        ------
+        ValueError
+            No region given, or one not in the current segmentation.
+        KeyError
+            ``clique_id`` is not a clique id.
+        """
+        _check_side(side)
+        chosen = self._checked_regions(side, regions)
+        if not chosen:
+            raise ValueError("relink needs at least one region")
+        clique = self._corr.clique(clique_id)
+        fixed = dataclasses.replace(
+            clique,
+            **{f"{side}_points": self._interior_points(side, chosen), f"{side}_regions": chosen},
+            source="manual",
+            status="accepted",
+        )
+        self._commit(f"Relink clique {clique.id} to {side} {_regions_text(chosen)}", self._corr.with_clique(fixed))
+
     def set_note(self, clique_id: int, text: str) -> None:
         """Set a clique's free-text note."""
         clique = self._corr.clique(clique_id)

@@ -16,7 +16,7 @@ from PySide6.QtCore import QSortFilterProxyModel
 from PySide6.QtGui import QAbstractFileIconProvider
 from PySide6.QtWidgets import QFileDialog, QWidget
 
-__all__ = ["ask_open_path", "ask_save_path", "make_file_dialog", "TypeOnlyIconProvider"]
+__all__ = ["ask_open_path", "ask_save_path", "ask_folder", "make_file_dialog", "TypeOnlyIconProvider"]
 
 
 class TypeOnlyIconProvider(QAbstractFileIconProvider):
@@ -81,3 +81,17 @@ def ask_open_path(parent: QWidget | None, title: str, filters: str) -> Path | No
 def ask_save_path(parent: QWidget | None, title: str, name: str, filters: str) -> Path | None:
     """Ask where to save (``name`` is the suggested file name); None when cancelled."""
     return _run(make_file_dialog(parent, title, filters, save=True, name=name))
+
+
+def ask_folder(parent: QWidget | None, title: str) -> Path | None:
+    """Ask for a folder (a campaign); None when cancelled."""
+    global _ICONS
+    if _ICONS is None:
+        _ICONS = TypeOnlyIconProvider()
+    dialog = QFileDialog(parent, title)
+    dialog.setObjectName("file_dialog")
+    dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
+    dialog.setIconProvider(_ICONS)
+    dialog.setFileMode(QFileDialog.FileMode.Directory)
+    dialog.setOption(QFileDialog.Option.ShowDirsOnly, True)
+    return _run(dialog)

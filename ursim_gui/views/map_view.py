@@ -191,6 +191,28 @@ class MapView(QGraphicsView):
             self.zoom_changed.emit(self.zoom_factor())
             self.viewport_changed.emit()
 
+    def zoom_to_regions(self, regions, *, margin: float = 0.25) -> bool:
+        """Zoom onto the bounding box of ``regions`` (graph ``bbox`` attributes), with a margin.
+
+        False when none of them is in the segmentation (the view is left as it is).
+        """
+        graph = self.layers.graph
+        boxes = [
+            graph.nodes[r]["bbox"] for r in regions if graph is not None and r in graph and "bbox" in graph.nodes[r]
+        ]
+        if not boxes:
+            return False
+        top, left = min(b[0] for b in boxes), min(b[1] for b in boxes)
+        bottom, right = max(b[2] for b in boxes), max(b[3] for b in boxes)
+        pad = margin * max(bottom - top, right - left, 10)
+        rect = QRectF(left - pad, top - pad, right - left + 2 * pad, bottom - top + 2 * pad)
+        self._fitted = False
+        self.fitInView(rect.intersected(self.sceneRect()), Qt.AspectRatioMode.KeepAspectRatio)
+        self.layers.cull_ids(self.zoom_factor())
+        self.zoom_changed.emit(self.zoom_factor())
+        self.viewport_changed.emit()
+        return True
+
     def _fit_factor(self) -> float:
         rect = self.sceneRect()
         if rect.isEmpty():

@@ -20,6 +20,8 @@ class EditCommands:
         actions["delete_clique"].triggered.connect(self.delete_clique)
         actions["accept"].triggered.connect(lambda: self.set_status("accepted"))
         actions["reject"].triggered.connect(lambda: self.set_status("rejected"))
+        actions["accept_all"].triggered.connect(self.accept_all)
+        actions["relink"].triggered.connect(self.relink)
         actions["undo"].triggered.connect(self.undo)
         actions["redo"].triggered.connect(self.redo)
         actions["clear_selection"].triggered.connect(session.clear_selection)
@@ -62,6 +64,38 @@ class EditCommands:
         if self.session.selected_clique is not None:
             self.session.set_status(self.session.selected_clique, status)
 
+    def accept_next(self) -> int | None:
+        """Accept the selected clique and select the next one not yet reviewed; returns its id."""
+        session = self.session
+        current = session.selected_clique
+        if current is not None:
+            session.set_status(current, "accepted")
+        cliques = session.correspondences.cliques
+        ids = [clique.id for clique in cliques]
+        start = ids.index(current) + 1 if current in ids else 0
+        ordered = cliques[start:] + cliques[:start]
+        following = next((clique.id for clique in ordered if clique.status is None), None)
+        if following is not None:
+            session.select_clique(following)
+        return following
+
+    def accept_all(self) -> None:
+        """Accept every clique not yet reviewed (one undo step)."""
+        pending = [clique.id for clique in self.session.correspondences.cliques if clique.status is None]
+        if pending:
+            self.session.set_statuses(pending, "accepted")
+
+    def relink(self) -> None:
+        """The selected clique's side of the last Ctrl+clicked region becomes that region (one step)."""
+        session = self.session
+        clique_id, focus = session.selected_clique, session.focus
+        if clique_id is None or focus is None:
+            return
+        side, region = focus
+        if region in getattr(session.clique(clique_id), f"{side}_regions"):
+            return  # already its region: nothing to fix
+        session.relink(clique_id, side, [region])
+
     def undo(self) -> None:
         if self.session.can_undo:
             self.session.undo()
@@ -80,5 +114,6 @@ class EditCommands:
         actions["redo"].setText(f"&Redo {session.redo_text}" if session.can_redo else "&Redo")
         actions["link"].setEnabled(has_regions)
         actions["unlink"].setEnabled(has_regions)
-        for key in ("delete_clique", "accept", "reject"):
+        for key in ("delete_clique", "accept", "reject", "relink"):
             actions[key].setEnabled(has_clique)
+        actions["accept_all"].setEnabled(any(clique.status is None for clique in session.correspondences.cliques))

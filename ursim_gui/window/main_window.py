@@ -11,11 +11,21 @@ import logging
 from pathlib import Path
 
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QApplication,
+    QDockWidget,
+    QLabel,
+    QMainWindow,
+    QScrollArea,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
 
 from ursim_gui.jobs.controller import JobController
 from ursim_gui.model.session import AnnotationSession
 from ursim_gui.panels.anchors_list import AnchorsList
+from ursim_gui.panels.campaign_panel import CampaignPanel
 from ursim_gui.panels.correspondence_table import CorrespondenceTable
 from ursim_gui.panels.evaluation_panel import EvaluationPanel
 from ursim_gui.panels.matching_panel import MatchingPanel
@@ -24,8 +34,10 @@ from ursim_gui.views.connectors import ConnectorOverlay
 from ursim_gui.views.map_view import MapView
 from ursim_gui.views.session_binding import SIDES, ViewBinding
 from ursim_gui.views.status_bar import CursorStatusBar
+from ursim_gui.window.campaign_controller import CampaignController
 from ursim_gui.window.document_controller import DocumentController
 from ursim_gui.window.edit_commands import EditCommands
+from ursim_gui.window.preferences import Preferences
 from ursim_gui.window.shortcuts import SHORTCUTS, ShortcutSheet, make_action
 from ursim_gui.window.window_commands import WindowTools
 
@@ -51,6 +63,8 @@ _TOOLBAR = (
     "connectors",
 )
 _DISPLAY = ("outlines", "region_ids", "graph")
+#: Display toggles remembered between runs, with their first-run state.
+_TOGGLE_DEFAULTS = {"outlines": True, "region_ids": False, "graph": False, "connectors": False, "link_zoom": False}
 
 
 class MainWindow(QMainWindow):
@@ -67,7 +81,8 @@ class MainWindow(QMainWindow):
     def __init__(self, data_dir: Path, session: AnnotationSession | None = None):
         super().__init__()
         self.setObjectName("main_window")
-        self.session = session if session is not None else AnnotationSession()
+        self.preferences = Preferences(data_dir, self)
+        self.session = session if session is not None else AnnotationSession(annotator=self.preferences.annotator())
         self.actions = {spec.id: make_action(spec, self) for spec in SHORTCUTS}
         for action in self.actions.values():
             self.addAction(action)  # shortcuts work wherever the focus is in the window
@@ -84,12 +99,16 @@ class MainWindow(QMainWindow):
         self.table = CorrespondenceTable(self.session)
         self.anchors = AnchorsList(self.session)
         self.evaluation = EvaluationPanel(self.session)
+        self.campaign_panel = CampaignPanel()
         self._build_docks()
         self._build_menus()
         self._connect()
-        self.actions["outlines"].setChecked(True)
-        self.actions["connectors"].setChecked(False)
-        self.resize(1600, 980)
+        self.campaigns = CampaignController(self, self.campaign_panel, data_dir)
+        self._connect_review()
+        for name, default in _TOGGLE_DEFAULTS.items():
+            self.actions[name].setChecked(self.preferences.toggle(name, default))
+        if not self.preferences.restore_window(self):
+            self._fit_to_screen()
 
     # ---- layout ------------------------------------------------------------------------------
     def _build_centre(self) -> None:
@@ -138,10 +157,13 @@ class MainWindow(QMainWindow):
             "table": self._dock("Correspondences", self.table, bottom, "dock_table"),
             "evaluation": self._dock("Evaluation", self.evaluation, bottom, "dock_evaluation"),
             "anchors": self._dock("Anchors", self.anchors, bottom, "dock_anchors"),
+            "campaign": self._dock("Campaign", self.campaign_panel, right, "dock_campaign"),
         }
+        self.tabifyDockWidget(self.docks["segmentation"], self.docks["campaign"])
+        self.docks["segmentation"].raise_()
         self.tabifyDockWidget(self.docks["evaluation"], self.docks["anchors"])
         self.docks["evaluation"].raise_()
-        self.docks["segmentation"].setMinimumWidth(330)
+        self.docks["segmentation"].setMinimumWidth(300)
         self.resizeDocks([self.docks["table"]], [240], Qt.Orientation.Vertical)
         self.resizeDocks([self.docks["segmentation"], self.docks["matching"]], [620, 220], Qt.Orientation.Vertical)
         self.resizeDocks([self.docks["table"], self.docks["evaluation"]], [800, 380], Qt.Orientation.Horizontal)
@@ -213,6 +235,37 @@ class MainWindow(QMainWindow):
         self.tools = WindowTools(self)
         self._update_ready()
 
+    def _connect_review(self) -> None:
+        a = self.actions
+        a["open_campaign"].triggered.connect(lambda: self.campaigns.open())
+        a["next_pair"].triggered.connect(self.campaigns.next)
+        a["prev_pair"].triggered.connect(self.campaigns.previous)
+        a["accept_next"].triggered.connect(self.accept_and_next)
+        a["zoom_clique"].triggered.connect(self.zoom_to_clique)
+
+    def accept_and_next(self) -> None:
+        """Accept the selected clique, select the next one to review and zoom to it."""
+        if self.edits.accept_next() is not None:
+            self.zoom_to_clique()
+
+    def zoom_to_clique(self) -> None:
+        clique_id = self.session.selected_clique
+        if clique_id is None:
+            return
+        clique = self.session.clique(clique_id)
+        for side, view in self.views.items():
+            if not view.zoom_to_regions(getattr(clique, f"{side}_regions")):
+                view.fit_to_window()
+
+    def _fit_to_screen(self) -> None:
+        """First run: most of the screen, never more (1366x768 at a 1.5 scale factor included)."""
+        screen = self.screen() or QApplication.primaryScreen()
+        if screen is None:
+            self.resize(1280, 720)
+            return
+        available = screen.availableGeometry()
+        self.resize(min(1600, int(available.width() * 0.92)), min(980, int(available.height() * 0.9)))
+
     def _zoom_changed(self, side: str, factor: float) -> None:
         self.status.show_zoom(factor)
         if self.actions["link_zoom"].isChecked():
@@ -268,9 +321,14 @@ class MainWindow(QMainWindow):
         self.close()
 
     def closeEvent(self, event) -> None:
-        if not getattr(self, "_discard_on_close", False) and not self.documents.confirm_discard("closing"):
-            event.ignore()
-            return
+        if not getattr(self, "_discard_on_close", False):
+            if self.campaigns.campaign is not None and not self.campaigns.save_current():
+                event.ignore()
+                return
+            if not self.documents.confirm_discard("closing"):
+                event.ignore()
+                return
+        self.preferences.save_window(self, {name: self.actions[name].isChecked() for name in _TOGGLE_DEFAULTS})
         self.jobs.cancel()
         self.jobs.runner.shutdown()
         self.documents.close_document()
