@@ -34,6 +34,8 @@ class JobController(QObject):
     busy_changed = Signal(bool)
     #: A job's result was applied to the session (SegmentJob or MatchJob).
     applied = Signal(object)
+    #: Any other job finished: (job, result), for the code that queued it (see :meth:`submit`).
+    result_ready = Signal(object, object)
 
     def __init__(self, session, status_bar, parent_widget=None):
         super().__init__(parent_widget)
@@ -135,8 +137,14 @@ class JobController(QObject):
             return None
         return MatchJob(sketch, metric, job.config)
 
+    def submit(self, job) -> None:
+        """Queue any other job (``run(progress, cancelled)``); its result comes as ``result_ready``."""
+        self._enqueue(job)
+
     def _is_stale(self, job) -> bool:
         """True when the inputs changed while the job ran (its result belongs to nothing now)."""
+        if not isinstance(job, (SegmentJob, MatchJob)):
+            return False
         if isinstance(job, SegmentJob):
             return self._session.map(job.side) is not job.map
         return (
@@ -152,9 +160,13 @@ class JobController(QObject):
         if isinstance(job, SegmentJob):
             self._session.set_segmentation(job.side, result)
             self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
-        else:
+        elif isinstance(job, MatchJob):
             self._session.apply_match(result)
             self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)
+        else:
+            self._status.showMessage(f"{job.description}: done", 5000)
+            self.result_ready.emit(job, result)
+            return
         self.applied.emit(job)
 
     def _progress(self, fraction: float, message: str) -> None:

@@ -61,7 +61,8 @@ class EvaluationOperations:
             self._reference = None
             return
         sets = []
-        for clique in self._reference_corr.cliques:
+        # A rejected clique is no correspondence: it cannot be found or missed.
+        for clique in (c for c in self._reference_corr.cliques if c.effective_status != "rejected"):
             pair = []
             for side in SIDES:
                 segmentation = self._segmentations[side]

@@ -34,9 +34,11 @@ class CampaignController(QObject):
     Signals
     -------
     pair_ready(int) : a pair is open and matched (or reopened from its file)
+    opened() : a campaign was opened (before its first pair)
     """
 
     pair_ready = Signal(int)
+    opened = Signal()
 
     def __init__(self, window, panel, data_dir: Path):
         super().__init__(window)
@@ -77,6 +79,7 @@ class CampaignController(QObject):
         self.window.docks["campaign"].show()
         self.window.docks["campaign"].raise_()
         self.window.preferences.add_recent("campaigns", str(source))
+        self.opened.emit()
         return self._open_pair(campaign.current)
 
     # ---- navigation ------------------------------------------------------------------------

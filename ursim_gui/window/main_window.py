@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
 
 from ursim_gui.jobs.controller import JobController
 from ursim_gui.model.session import AnnotationSession
+from ursim_gui.panels.agreement_panel import AgreementPanel
 from ursim_gui.panels.anchors_list import AnchorsList
 from ursim_gui.panels.campaign_panel import CampaignPanel
 from ursim_gui.panels.correspondence_table import CorrespondenceTable
@@ -34,6 +35,7 @@ from ursim_gui.views.connectors import ConnectorOverlay
 from ursim_gui.views.map_view import MapView
 from ursim_gui.views.session_binding import SIDES, ViewBinding
 from ursim_gui.views.status_bar import CursorStatusBar
+from ursim_gui.window.agreement_controller import AgreementController
 from ursim_gui.window.campaign_controller import CampaignController
 from ursim_gui.window.document_controller import DocumentController
 from ursim_gui.window.edit_commands import EditCommands
@@ -100,10 +102,12 @@ class MainWindow(QMainWindow):
         self.anchors = AnchorsList(self.session)
         self.evaluation = EvaluationPanel(self.session)
         self.campaign_panel = CampaignPanel()
+        self.agreement_panel = AgreementPanel()
         self._build_docks()
         self._build_menus()
         self._connect()
         self.campaigns = CampaignController(self, self.campaign_panel, data_dir)
+        self.agreement = AgreementController(self, self.agreement_panel)
         self._connect_review()
         for name, default in _TOGGLE_DEFAULTS.items():
             self.actions[name].setChecked(self.preferences.toggle(name, default))
@@ -158,7 +162,9 @@ class MainWindow(QMainWindow):
             "evaluation": self._dock("Evaluation", self.evaluation, bottom, "dock_evaluation"),
             "anchors": self._dock("Anchors", self.anchors, bottom, "dock_anchors"),
             "campaign": self._dock("Campaign", self.campaign_panel, right, "dock_campaign"),
+            "agreement": self._dock("Agreement", self.agreement_panel, bottom, "dock_agreement"),
         }
+        self.tabifyDockWidget(self.docks["evaluation"], self.docks["agreement"])
         self.tabifyDockWidget(self.docks["segmentation"], self.docks["campaign"])
         self.docks["segmentation"].raise_()
         self.tabifyDockWidget(self.docks["evaluation"], self.docks["anchors"])
