@@ -93,6 +93,24 @@ class AgreementPanel(QWidget):
                 self.table.setItem(index, 1 + 2 * column, QTableWidgetItem(_text(value and value.f1)))
                 self.table.setItem(index, 2 + 2 * column, QTableWidgetItem(_text(value and value.place)))
         self.export_button.setEnabled(bool(rows))
+        # Place accuracy needs the core's scoring.place_accuracy: no empty columns without it.
+        has_place = any(value.place is not None for _name, comparisons in lines for value in comparisons.values())
+        for column in range(len(COMPARISONS)):
+            self.table.setColumnHidden(2 + 2 * column, not has_place)
+        self.table.resizeColumnsToContents()
+
+    def show_second(self, name: str, pairs: int | None = None) -> None:
+        """Reflect the chosen second annotator (also when chosen by code)."""
+        index = self.second.findText(name)
+        if index >= 0:
+            self.second.setCurrentIndex(index)
+        elif name:
+            self.second.insertItem(self.second.count() - 1, name)
+            self.second.setCurrentIndex(self.second.count() - 2)
+        suffix = "" if pairs is None else f": {pairs} pairs compared"
+        self.note.setText(
+            f"A = your files, B = {name or '(none)'}{suffix}. On the maps: FP = A's clique B does not share, FN = B's clique A misses."
+        )
 
     def cell(self, row: int, column: int) -> str:
         item = self.table.item(row, column)

@@ -47,6 +47,7 @@ class AgreementController(QObject):
         if choice == FOLDER_CHOICE:
             choice = file_dialogs.ask_folder(self.window, "Folder of the second annotator's files")
         self.second = None if choice in (None, "(none)") else choice
+        self.panel.show_second("" if self.second is None else str(self.second))
         self._pair_ready(self.window.campaigns.campaign.current if self.window.campaigns.campaign else -1)
 
     def b_file(self, pair) -> Path | None:
@@ -104,3 +105,4 @@ class AgreementController(QObject):
         if isinstance(job, AgreementJob):
             self.rows = list(rows)
             self.panel.show_rows(self.rows)
+            self.panel.show_second(str(self.second), len(self.rows))
