@@ -32,6 +32,7 @@ from ursim_gui.model.history import History
 from ursim_gui.model.session_documents import DocumentOperations
 from ursim_gui.model.session_edits import EditOperations
 from ursim_gui.model.session_evaluation import EvaluationOperations
+from ursim_gui.model.session_label_edits import LabelEditOperations
 from ursim_gui.model.session_values import (
     APP_TITLE,
     AUTOSAVE_ORIGIN_KEY,
@@ -61,7 +62,7 @@ def _untouched_automatic(clique: Clique) -> bool:
     return clique.source == "auto" and clique.status is None and not clique.note
 
 
-class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations):
+class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations, LabelEditOperations):
     """State and operations of one annotation window (Qt-free).
 
     Parameters
@@ -126,6 +127,8 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self._last_match = None
         self._anchors: list[tuple[int, int]] = []
         self._match_config = None
+        self._label_versions: dict = {}
+        self._label_edit_count = 0
 
     # ------------------------------------------------------------------ read-only state
     def map(self, side: str):
@@ -276,53 +279,6 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         from ursim_core.io.maps import load_map
 
         self.set_map(side, load_map(_absolute(path)))
-
-    def is_document_map(self, side: str, path: str | os.PathLike) -> bool:
-        """True when ``path`` is the ``side`` map the document names, or it names none yet.
-
-        Opening any other map starts a new document (:meth:`new_document`): the cliques,
-        the reference and the file all belong to the old pair.
-        """
-        recorded = getattr(self._corr, _check_side(side)).path
-        return recorded is None or Path(recorded) == _absolute(path)
-
-    def new_document(self, *, keep: Iterable[str] = ()) -> None:
-        """Start an untitled, empty document; the maps (and segmentations) of ``keep`` stay.
-
-        The history, reference, selection and last match are cleared. Not undoable (like
-        opening a file): callers ask about unsaved changes first.
-        """
-        keep = {_check_side(side) for side in keep}
-        corr = Correspondences(annotator=self.annotator or self._corr.annotator)
-        for side in keep:
-            corr = dataclasses.replace(corr, **{side: getattr(self._corr, side)})
-        was_dirty = self.dirty
-        old_path = self._path
-        for side in SIDES:
-            if side not in keep:
-                self._maps[side] = None
-                self._segmentations[side] = None
-        self._corr = corr
-        self._saved = corr
-        self._path = None
-        self._history.clear()
-        self._selection = {side: frozenset() for side in SIDES}
-        self._selected_clique = None
-        self._focus = None
-        self._forget_match()
-        self._reference_corr = None
-        self._recompute_reference()
-        self._evaluate()
-        for side in SIDES:
-            if side not in keep:
-                self.map_changed.emit(side)
-                self.segmentation_changed.emit(side)
-        if old_path is not None:
-            self.path_changed.emit(None)
-        self.selection_changed.emit()
-        self.reference_changed.emit()
-        self._announce_value_change(was_dirty)
-        self.history_changed.emit()
 
     def set_map(self, side: str, map_) -> None:
         """Show ``map_`` on ``side``; its segmentation is dropped (it belonged to the old map).
@@ -499,6 +455,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
     def _replace_value(self, new: Correspondences) -> None:
         was_dirty = self.dirty
         self._corr = new
+        self._sync_segmentations()
         selection_changed = False
         if self._selected_clique is not None and not any(c.id == self._selected_clique for c in new.cliques):
             self._selected_clique = None

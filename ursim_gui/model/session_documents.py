@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 from ursim_core.correspondences.codec import (
@@ -19,7 +20,7 @@ from ursim_core.correspondences.codec import (
     save_dat,
 )
 from ursim_core.errors import UrsimError
-from ursim_gui.model.session_values import AUTOSAVE_ORIGIN_KEY, SIDES, _absolute, _with_side_regions
+from ursim_gui.model.session_values import AUTOSAVE_ORIGIN_KEY, SIDES, _absolute, _check_side, _with_side_regions
 
 __all__ = ["DocumentOperations"]
 
@@ -28,6 +29,54 @@ class DocumentOperations:
     """Open, restore, save, import/export ``.dat`` and the reference of a session."""
 
     # ------------------------------------------------------------------ documents
+    def is_document_map(self, side: str, path: str | os.PathLike) -> bool:
+        """True when ``path`` is the ``side`` map the document names, or it names none yet.
+
+        Opening any other map starts a new document (:meth:`new_document`): the cliques,
+        the reference and the file all belong to the old pair.
+        """
+        recorded = getattr(self._corr, _check_side(side)).path
+        return recorded is None or Path(recorded) == _absolute(path)
+
+    def new_document(self, *, keep: Iterable[str] = ()) -> None:
+        """Start an untitled, empty document; the maps (and segmentations) of ``keep`` stay.
+
+        The history, reference, selection and last match are cleared. Not undoable (like
+        opening a file): callers ask about unsaved changes first.
+        """
+        keep = {_check_side(side) for side in keep}
+        corr = Correspondences(annotator=self.annotator or self._corr.annotator)
+        for side in keep:
+            corr = dataclasses.replace(corr, **{side: getattr(self._corr, side)})
+        was_dirty = self.dirty
+        old_path = self._path
+        for side in SIDES:
+            if side not in keep:
+                self._maps[side] = None
+                self._segmentations[side] = None
+        self._corr = corr
+        self._saved = corr
+        self._path = None
+        self._history.clear()
+        self._selection = {side: frozenset() for side in SIDES}
+        self._selected_clique = None
+        self._focus = None
+        self._label_versions = {}
+        self._forget_match()
+        self._reference_corr = None
+        self._recompute_reference()
+        self._evaluate()
+        for side in SIDES:
+            if side not in keep:
+                self.map_changed.emit(side)
+                self.segmentation_changed.emit(side)
+        if old_path is not None:
+            self.path_changed.emit(None)
+        self.selection_changed.emit()
+        self.reference_changed.emit()
+        self._announce_value_change(was_dirty)
+        self.history_changed.emit()
+
     def open(self, path: str | os.PathLike) -> None:
         """Open a correspondence JSON with the maps it names; clears the history.
 
@@ -97,6 +146,8 @@ class DocumentOperations:
         moment = self._timestamp()
         created = self._corr.created or moment
         stamped = dataclasses.replace(self._corr, created=created, modified=moment)
+        # An edited segmentation is saved beside the file and referenced in it.
+        stamped = self._write_edited_labels(stamped, target)
         save_correspondences(stamped, target, now=moment)
 
         was_dirty = self.dirty
@@ -155,6 +206,7 @@ class DocumentOperations:
         self._selection = {side: frozenset() for side in SIDES}
         self._selected_clique = None
         self._focus = None
+        self._label_versions = {}
         self._last_match = None
         self._anchors = []
         self._recompute_reference()

@@ -46,6 +46,8 @@ class MapView(QGraphicsView):
     zoom_changed = Signal(float)
     viewport_changed = Signal()
     files_dropped = Signal(list)
+    #: A left-button stroke in stroke mode: list of (row, col) map pixels, press to release.
+    stroke_drawn = Signal(list)
 
     def __init__(self, side: str, parent=None):
         super().__init__(parent)
@@ -72,6 +74,8 @@ class MapView(QGraphicsView):
         self._fitted = False
         self._press_pos = None
         self._panning = False
+        self._stroke: list[tuple[int, int]] | None = None
+        self.stroke_mode = False
         self.placeholder = "Drop a map here or use the File menu"
         self.horizontalScrollBar().valueChanged.connect(self.viewport_changed)
         self.verticalScrollBar().valueChanged.connect(self.viewport_changed)
@@ -227,7 +231,17 @@ class MapView(QGraphicsView):
             self.set_zoom(self.zoom_factor() * _WHEEL_STEP**steps, event.position())
         event.accept()
 
+    def set_stroke_mode(self, on: bool) -> None:
+        """Left drags draw a stroke (``stroke_drawn``) instead of selecting or panning; middle still pans."""
+        self.stroke_mode = bool(on)
+        self._stroke = None
+        self.viewport().setCursor(Qt.CursorShape.CrossCursor) if on else self.viewport().unsetCursor()
+
     def mousePressEvent(self, event) -> None:
+        if self.stroke_mode and event.button() == Qt.MouseButton.LeftButton:
+            self._stroke = [self._pixel_at(event.position())]
+            event.accept()
+            return
         if event.button() in (Qt.MouseButton.LeftButton, Qt.MouseButton.MiddleButton):
             self._press_pos = event.position()
             self._panning = event.button() == Qt.MouseButton.MiddleButton
@@ -236,6 +250,13 @@ class MapView(QGraphicsView):
 
     def mouseMoveEvent(self, event) -> None:
         position = event.position()
+        if self._stroke is not None:
+            point = self._pixel_at(position)
+            if point != self._stroke[-1]:
+                self._stroke.append(point)
+            self._report_cursor(position)
+            event.accept()
+            return
         if self._press_pos is not None:
             moved = (position - self._press_pos).manhattanLength()
             if self._panning or moved >= QApplication.startDragDistance():
@@ -249,6 +270,11 @@ class MapView(QGraphicsView):
         event.accept()
 
     def mouseReleaseEvent(self, event) -> None:
+        if self._stroke is not None and event.button() == Qt.MouseButton.LeftButton:
+            stroke, self._stroke = self._stroke, None
+            self.stroke_drawn.emit(stroke)
+            event.accept()
+            return
         if self._press_pos is not None and not self._panning and event.button() == Qt.MouseButton.LeftButton:
             row, col = self._pixel_at(event.position())
             additive = bool(

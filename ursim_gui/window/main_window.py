@@ -31,6 +31,7 @@ from ursim_gui.panels.correspondence_table import CorrespondenceTable
 from ursim_gui.panels.evaluation_panel import EvaluationPanel
 from ursim_gui.panels.matching_panel import MatchingPanel
 from ursim_gui.panels.segmentation_panel import SegmentationPanel
+from ursim_gui.tools.segmentation_editor import SegmentationEditor
 from ursim_gui.views.connectors import ConnectorOverlay
 from ursim_gui.views.map_view import MapView
 from ursim_gui.views.session_binding import SIDES, ViewBinding
@@ -248,6 +249,21 @@ class MainWindow(QMainWindow):
         a["prev_pair"].triggered.connect(self.campaigns.previous)
         a["accept_next"].triggered.connect(self.accept_and_next)
         a["zoom_clique"].triggered.connect(self.zoom_to_clique)
+        self.segmentation_editor = editor = SegmentationEditor(self.session, self.views, self)
+        modes = {"split_mode": "split", "paint_wall_mode": "paint_wall", "erase_wall_mode": "erase_wall"}
+        for action_id, mode in modes.items():
+            a[action_id].toggled.connect(lambda on, mode=mode: self._stroke_mode_toggled(mode, on))
+        editor.mode_changed.connect(lambda mode: [a[i].setChecked(modes[i] == mode) for i in modes])
+        a["clear_selection"].triggered.connect(lambda: editor.set_mode(""))
+        a["merge_regions"].triggered.connect(editor.merge_selected)
+        editor.message.connect(lambda text: self.statusBar().showMessage(text, 4000))
+
+    def _stroke_mode_toggled(self, mode: str, on: bool) -> None:
+        editor = self.segmentation_editor
+        if on:
+            editor.set_mode(mode)
+        elif editor.mode == mode:
+            editor.set_mode("")
 
     def accept_and_next(self) -> None:
         """Accept the selected clique, select the next one to review and zoom to it."""

@@ -87,6 +87,21 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("outlines", "Region &outlines", ("O",), "Show region outlines", "View", checkable=True),
     ActionSpec("region_ids", "Region &ids", ("I",), "Show region ids", "View", checkable=True),
     ActionSpec("graph", "Adjacency &graph", ("G",), "Show the region adjacency graph", "View", checkable=True),
+    ActionSpec(
+        "merge_regions", "&Merge regions", ("M",), "Merge the regions selected on one map (Ctrl+click them)", "Segment"
+    ),
+    ActionSpec(
+        "split_mode", "&Split region", ("K",), "Draw a line across a region to cut it in two", "Segment", checkable=True
+    ),
+    ActionSpec("paint_wall_mode", "&Paint wall", ("W",), "Draw a wall stroke on a map", "Segment", checkable=True),
+    ActionSpec(
+        "erase_wall_mode",
+        "&Erase wall",
+        ("Shift+W",),
+        "Erase a wall stroke (joins it to the region around)",
+        "Segment",
+        checkable=True,
+    ),
     ActionSpec("next_pair", "&Next pair", ("D",), "Save this pair and open the next one of the campaign", "Campaign"),
     ActionSpec("prev_pair", "&Previous pair", ("A",), "Save this pair and open the previous one", "Campaign"),
     ActionSpec("shortcuts", "&Keyboard shortcuts", ("F1",), "This sheet", "Help"),
