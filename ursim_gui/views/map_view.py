@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QPainter, QPixmapCache
+from PySide6.QtGui import QColor, QImage, QPainter, QPixmapCache, QTransform
 from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
 
 from ursim_gui.views.map_items import ImageItem, grey_to_qimage
@@ -76,6 +76,8 @@ class MapView(QGraphicsView):
         self._panning = False
         self._stroke: list[tuple[int, int]] | None = None
         self.stroke_mode = False
+        #: (degrees counter-clockwise, mirrored) the map is shown at.
+        self.orientation = (0.0, False)
         self.placeholder = "Drop a map here or use the File menu"
         self.horizontalScrollBar().valueChanged.connect(self.viewport_changed)
         self.verticalScrollBar().valueChanged.connect(self.viewport_changed)
@@ -162,7 +164,25 @@ class MapView(QGraphicsView):
 
     # ---- zoom ----------------------------------------------------------------------
     def zoom_factor(self) -> float:
-        return self.transform().m11()
+        # The scale of the transform, whatever its rotation or mirror.
+        transform = self.transform()
+        if transform.m12() == 0.0:
+            return abs(transform.m11())  # exact when not turned (hypot would round)
+        return math.hypot(transform.m11(), transform.m12())
+
+    def set_orientation(self, angle: float, mirrored: bool) -> None:
+        """Show the map mirrored (left-right) and then turned ``angle`` degrees counter-clockwise.
+
+        Only the view turns: scene coordinates stay the image's pixels, so clicks and
+        points keep the original frame.
+        """
+        self.orientation = (float(angle), bool(mirrored))
+        transform = QTransform()
+        transform.rotate(-float(angle))  # Qt turns clockwise for a positive angle (y down)
+        if mirrored:
+            transform.scale(-1.0, 1.0)
+        self.setTransform(transform)
+        self.fit_to_window()
 
     def set_zoom(self, factor: float, anchor: QPointF | None = None) -> None:
         """Zoom to ``factor`` (clamped to [fit / 4, 32]).

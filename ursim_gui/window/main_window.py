@@ -231,6 +231,9 @@ class MainWindow(QMainWindow):
             box.segment_requested.connect(lambda s, preset, params: self.jobs.segment(s, preset, params))
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
+        self.matching_panel.orientation_changed.connect(
+            lambda o: self.views["sketch"].set_orientation(o.angle or 0.0, o.mirrored)
+        )
         self.evaluation.load_requested.connect(lambda: docs.load_reference())
         self.jobs.busy_changed.connect(lambda _busy: self._update_ready())
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
