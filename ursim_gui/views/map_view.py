@@ -177,12 +177,16 @@ class MapView(QGraphicsView):
         points keep the original frame.
         """
         self.orientation = (float(angle), bool(mirrored))
-        transform = QTransform()
-        transform.rotate(-float(angle))  # Qt turns clockwise for a positive angle (y down)
-        if mirrored:
-            transform.scale(-1.0, 1.0)
-        self.setTransform(transform)
+        self.setTransform(self._oriented(1.0))
         self.fit_to_window()
+
+    def _oriented(self, factor: float) -> QTransform:
+        angle, mirrored = self.orientation
+        transform = QTransform()
+        if angle:
+            transform.rotate(-angle)  # Qt turns clockwise for a positive angle (y down)
+        transform.scale(-factor if mirrored else factor, factor)
+        return transform
 
     def set_zoom(self, factor: float, anchor: QPointF | None = None) -> None:
         """Zoom to ``factor`` (clamped to [fit / 4, 32]).
@@ -197,8 +201,8 @@ class MapView(QGraphicsView):
         self._fitted = False
         anchor = QPointF(self.viewport().rect().center()) if anchor is None else QPointF(anchor)
         fixed = self.mapToScene(anchor.toPoint())
-        step = factor / self.zoom_factor()
-        self.scale(step, step)
+        # Rebuilt from the orientation rather than scaled by a step: the factor is exact.
+        self.setTransform(self._oriented(factor))
         moved = self.mapFromScene(fixed) - anchor.toPoint()
         self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + moved.x())
         self.verticalScrollBar().setValue(self.verticalScrollBar().value() + moved.y())
