@@ -12,8 +12,8 @@ import math
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QPainter, QPixmapCache, QTransform
+from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QImage, QPainter, QPalette, QPixmapCache, QTransform
 from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
 
 from ursim_gui.views.map_items import ImageItem, grey_to_qimage
@@ -63,7 +63,7 @@ class MapView(QGraphicsView):
         self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
         self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
         self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.SmartViewportUpdate)
-        self.setBackgroundBrush(QColor(236, 237, 240))
+        self._follow_palette()
         self.setMouseTracking(True)
         self.setAcceptDrops(True)
         self.viewport().setAcceptDrops(True)
@@ -342,12 +342,22 @@ class MapView(QGraphicsView):
             event.acceptProposedAction()
             self.files_dropped.emit(paths)
 
+    def _follow_palette(self) -> None:
+        # The area around the map follows the theme (a light grey on light, dark on dark).
+        window = self.palette().color(QPalette.ColorRole.Window)
+        self.setBackgroundBrush(window.darker(106) if window.lightness() > 128 else window.darker(130))
+
+    def changeEvent(self, event) -> None:
+        if event.type() == QEvent.Type.PaletteChange:
+            self._follow_palette()
+        super().changeEvent(event)
+
     def drawForeground(self, painter: QPainter, rect: QRectF) -> None:
         if self.has_image():
             return
         painter.save()
         painter.resetTransform()
-        painter.setPen(QColor(110, 110, 120))
+        painter.setPen(self.palette().color(QPalette.ColorRole.PlaceholderText))
         painter.drawText(self.viewport().rect(), Qt.AlignmentFlag.AlignCenter, self.placeholder)
         painter.restore()
 

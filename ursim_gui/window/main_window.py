@@ -36,6 +36,7 @@ from ursim_gui.views.connectors import ConnectorOverlay
 from ursim_gui.views.map_view import MapView
 from ursim_gui.views.session_binding import SIDES, ViewBinding
 from ursim_gui.views.status_bar import CursorStatusBar
+from ursim_gui.views.theme import apply_theme
 from ursim_gui.window.agreement_controller import AgreementController
 from ursim_gui.window.campaign_controller import CampaignController
 from ursim_gui.window.document_controller import DocumentController
@@ -67,7 +68,14 @@ _TOOLBAR = (
 )
 _DISPLAY = ("outlines", "region_ids", "graph")
 #: Display toggles remembered between runs, with their first-run state.
-_TOGGLE_DEFAULTS = {"outlines": True, "region_ids": False, "graph": False, "connectors": False, "link_zoom": False}
+_TOGGLE_DEFAULTS = {
+    "dark_theme": False,
+    "outlines": True,
+    "region_ids": False,
+    "graph": False,
+    "connectors": False,
+    "link_zoom": False,
+}
 
 
 class MainWindow(QMainWindow):
@@ -213,6 +221,7 @@ class MainWindow(QMainWindow):
         a["zoom_in"].triggered.connect(lambda: self._zoom_all(1.25))
         a["zoom_out"].triggered.connect(lambda: self._zoom_all(0.8))
         a["connectors"].toggled.connect(self.connectors.setVisible)
+        a["dark_theme"].toggled.connect(lambda on: apply_theme("dark" if on else "system"))
         a["outlines"].toggled.connect(lambda on: [v.set_outlines_visible(on) for v in self.views.values()])
         a["region_ids"].toggled.connect(lambda on: [v.set_ids_visible(on) for v in self.views.values()])
         a["graph"].toggled.connect(lambda on: [v.set_graph_visible(on) for v in self.views.values()])

@@ -86,6 +86,7 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("connectors", "&Connector lines", ("C",), "Draw lines between matched regions", "View", checkable=True),
     ActionSpec("outlines", "Region &outlines", ("O",), "Show region outlines", "View", checkable=True),
     ActionSpec("region_ids", "Region &ids", ("I",), "Show region ids", "View", checkable=True),
+    ActionSpec("dark_theme", "&Dark theme", (), "Dark window and map backgrounds (remembered)", "View", checkable=True),
     ActionSpec("graph", "Adjacency &graph", ("G",), "Show the region adjacency graph", "View", checkable=True),
     ActionSpec(
         "merge_regions", "&Merge regions", ("M",), "Merge the regions selected on one map (Ctrl+click them)", "Segment"
