@@ -15,6 +15,7 @@ then discarded instead of being applied.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
 from typing import Any
 
@@ -170,14 +171,26 @@ class MatchJob:
         progress(0.0, "preparing")
         _check(cancelled, "matching")
         config = self.config if self.config is not None else MatchConfig()
-        prepared = prepare(self.sketch_seg, self.metric_seg, config)
-        _check(cancelled, "matching")
-        progress(0.05, "matching")
+        reached = [0.0]
 
-        def sweep_progress(fraction: float, message: str) -> None:
-            # The automatic m runs the matcher once per m: cancel between two of them.
-            _check(cancelled, "matching")
-            progress(0.05 + 0.95 * fraction, message)
+        def phase(start: float, end: float):
+            def report(fraction: float, message: str) -> None:
+                # Each matcher run (an m of the sweep, an orientation candidate) is a point
+                # to cancel at; the bar never goes back.
+                _check(cancelled, "matching")
+                reached[0] = max(reached[0], start + (end - start) * min(max(float(fraction), 0.0), 1.0))
+                progress(reached[0], message)
+
+            return report
+
+        # A core whose prepare() searches the sketch's orientation reports it too.
+        if "progress" in inspect.signature(prepare).parameters:
+            prepared = prepare(self.sketch_seg, self.metric_seg, config, progress=phase(0.0, 0.5))
+        else:
+            prepared = prepare(self.sketch_seg, self.metric_seg, config)
+        _check(cancelled, "matching")
+        progress(max(reached[0], 0.05), "matching")
+        sweep_progress = phase(max(reached[0], 0.05), 1.0)
 
         result = match_prepared(prepared, progress=sweep_progress)
         _check(cancelled, "matching")
