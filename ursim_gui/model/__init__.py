@@ -16,6 +16,10 @@ only ``ursim_core``. See ``docs/gui_contract.md``.
 - :mod:`~ursim_gui.model.region_style`, :mod:`~ursim_gui.model.view_state`: colours, masks and
   badges the views draw, as arrays.
 - :mod:`~ursim_gui.model.example`: the bundled example pair.
+- :mod:`~ursim_gui.model.campaign`: a dataset's pairs, their files (naming rule) and statuses.
+- :mod:`~ursim_gui.model.agreement`: annotator A vs B and the matcher vs each, CSV.
+- :mod:`~ursim_gui.model.label_edits` (pure) and ``session_label_edits``: segmentation editing.
+- :mod:`~ursim_gui.model.orientation`: the sketch's known turn and mirror.
 """
 
 from ursim_gui.model.autosave import Autosaver, discard, find_recoverable, recover, recover_with_origin

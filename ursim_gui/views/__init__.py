@@ -8,5 +8,6 @@ They draw what the model holds and forward input to it; they keep no annotation 
 - :mod:`~ursim_gui.views.connectors`: lines between matched regions across the two views.
 - :mod:`~ursim_gui.views.session_binding`: session signals -> drawing, clicks -> session calls.
 - :mod:`~ursim_gui.views.status_bar`, :mod:`~ursim_gui.views.figure_export`,
-  :mod:`~ursim_gui.views.messages` (error boxes).
+  :mod:`~ursim_gui.views.messages` (error boxes), :mod:`~ursim_gui.views.file_dialogs`
+  (dialogs that cannot freeze on /proc), :mod:`~ursim_gui.views.theme` (dark palette).
 """

@@ -101,7 +101,10 @@ class DocumentController(QObject):
         if not self.confirm_discard("opening another file"):
             return False
         path = path or self._ask_open("Open correspondences", JSON_FILTER)
-        return path is not None and self._try("Cannot open the correspondences", self.session.open, path)
+        if path is None or not self._try("Cannot open the correspondences", self.session.open, path):
+            return False
+        self._remember(path)
+        return True
 
     def open_dropped(self, side: str, paths: list[Path]) -> None:
         """Files dropped on a view: a .json opens correspondences, anything else a map."""
@@ -137,8 +140,14 @@ class DocumentController(QObject):
         if not self._try("Save failed", self.session.save, path):
             return False
         self.autosaver.discard()
+        self._remember(self.session.path)
         self.window.statusBar().showMessage(f"Saved {self.session.path}", 4000)
         return True
+
+    def _remember(self, path: Path) -> None:
+        preferences = getattr(self.window, "preferences", None)
+        if preferences is not None:
+            preferences.add_recent("documents", str(path))
 
     def export_dat(self, path: Path | None = None) -> bool:
         if path is None:

@@ -197,6 +197,10 @@ class MainWindow(QMainWindow):
                 menu.addSeparator()
                 for dock in self.docks.values():
                     menu.addAction(dock.toggleViewAction())
+            if group == "File":
+                self.recent_menu = menu.addMenu("Open &recent")
+                self.recent_menu.setObjectName("recent_menu")
+                self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         toolbar = self.addToolBar("Main")
         toolbar.setObjectName("main_toolbar")
         toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
@@ -253,6 +257,17 @@ class MainWindow(QMainWindow):
         )
         self.tools = WindowTools(self)
         self._update_ready()
+
+    def _fill_recent_menu(self) -> None:
+        """Recent campaigns and correspondence files (from the preferences), newest first."""
+        menu = self.recent_menu
+        menu.clear()
+        for kind, opener in (("campaigns", self.campaigns.open), ("documents", self.documents.open_correspondences)):
+            for path in self.preferences.recent(kind):
+                menu.addAction(path, lambda path=path, opener=opener: opener(Path(path)))
+            menu.addSeparator()
+        if not menu.actions() or all(action.isSeparator() for action in menu.actions()):
+            menu.addAction("(none yet)").setEnabled(False)
 
     def _connect_review(self) -> None:
         a = self.actions
