@@ -14,11 +14,11 @@ import sys
 import traceback
 from pathlib import Path
 
+from ursim_gui.model.example import EXAMPLE_DIR
+
 __all__ = ["main", "parse_args", "user_data_dir", "configure_logging", "install_excepthook", "EXAMPLE_DIR"]
 
 APP_NAME = "ursim-studio"
-#: The bundled example pair opened when the app starts without inputs.
-EXAMPLE_DIR = Path(__file__).resolve().parents[1] / "resources" / "example"
 _log = logging.getLogger("ursim_gui")
 
 
@@ -86,7 +86,7 @@ def install_excepthook(parent_getter=lambda: None) -> None:
         from PySide6.QtWidgets import QApplication
 
         if QApplication.instance() is not None:
-            from ursim_gui.dialogs import show_error
+            from ursim_gui.views.messages import show_error
 
             show_error(
                 parent_getter(), "Unexpected error", f"{kind.__name__}: {value}\n\nThe details are in the log file."
@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     log_path = configure_logging(folder)
     from PySide6.QtWidgets import QApplication
 
-    from ursim_gui.main_window import MainWindow
+    from ursim_gui.window.main_window import MainWindow
 
     app = QApplication.instance() or QApplication([sys.argv[0] if sys.argv else "ursim-gui"])
     app.setApplicationName(APP_NAME)

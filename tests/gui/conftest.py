@@ -80,17 +80,20 @@ def map_files(tmp_path, labels3):
 @pytest.fixture(autouse=True)
 def _never_block_on_questions(monkeypatch):
     """Modal questions would hang a test; tests that check them patch their own answer."""
-    from ursim_gui import dialogs
+    from ursim_gui.window import dialogs
 
     monkeypatch.setattr(dialogs, "ask_unsaved_changes", lambda parent, what: "discard")
     monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: None)
+    from PySide6.QtWidgets import QInputDialog
+
+    monkeypatch.setattr(QInputDialog, "getText", staticmethod(lambda *args, **kwargs: ("tester", True)))
 
 
 @pytest.fixture
 def window(qtbot, tmp_path, map_files):
     """Main window with both maps open and segmented from their label images (no MAORIS)."""
     from ursim_core.segmentation import load_label_image
-    from ursim_gui.main_window import MainWindow
+    from ursim_gui.window.main_window import MainWindow
 
     win = MainWindow(data_dir=tmp_path / "userdata")
     qtbot.addWidget(win)
@@ -115,3 +118,19 @@ def error_boxes(parent):
     from PySide6.QtWidgets import QMessageBox
 
     return [box for box in parent.findChildren(QMessageBox, "error_box") if box.isVisible()]
+
+
+def dead_pid() -> int:
+    """The id of a process that has just exited (as a crashed run's)."""
+    import subprocess
+    import sys
+
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+def simulate_crash(autosaver) -> None:
+    """Leave ``autosaver``'s copy as a crashed run would: its lock names a dead process."""
+    lock = autosaver.folder / f"{autosaver._instance_id}.lock"
+    lock.write_text(f"{dead_pid()}\n", encoding="ascii")

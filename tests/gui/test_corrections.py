@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import QApplication
 
-from ursim_gui.shortcuts import SHORTCUTS, ShortcutSheet
+from ursim_gui.window.shortcuts import SHORTCUTS, ShortcutSheet
 
 
 def click(qtbot, view, region, modifier=Qt.KeyboardModifier.NoModifier):
@@ -41,7 +41,7 @@ def test_link_unlink_delete_accept_reject_undo_redo_with_keys(window, qtbot):
     key(qtbot, window, Qt.Key.Key_R)
     assert session.clique(clique.id).status == "rejected"
     assert "rejected" in window.table.model.data(window.table.model.index(0, 5))
-    key(qtbot, window, Qt.Key.Key_A)
+    key(qtbot, window, Qt.Key.Key_Y)
     assert session.clique(clique.id).status == "accepted"
 
     session.select("metric", [3])
@@ -69,7 +69,7 @@ def test_escape_clears_and_keys_without_a_selection_do_nothing(window, qtbot):
     click(qtbot, window.views["sketch"], 2)
     key(qtbot, window, Qt.Key.Key_Escape)
     assert session.selection == {"sketch": frozenset(), "metric": frozenset()}
-    for name in (Qt.Key.Key_L, Qt.Key.Key_A, Qt.Key.Key_Delete):
+    for name in (Qt.Key.Key_L, Qt.Key.Key_Y, Qt.Key.Key_A, Qt.Key.Key_D, Qt.Key.Key_Delete):
         key(qtbot, window, name)
     assert session.correspondences.cliques == () and not session.can_undo
 

@@ -3,10 +3,12 @@ table and the views, and the missed reference cliques."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
-from PySide6.QtWidgets import QFileDialog
 
 from ursim_core.correspondences.codec import Clique, Correspondences, save_correspondences, save_dat
+from ursim_gui.views import file_dialogs
 
 
 def reference_cliques():
@@ -23,7 +25,7 @@ def reference_cliques():
 def test_reference_scores_live_and_marks_cliques(window, tmp_path, monkeypatch, suffix):
     path = tmp_path / f"reference{suffix}"
     (save_correspondences if suffix == ".json" else save_dat)(reference_cliques(), path)
-    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(path), "")))
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(str(path)))
     session, panel = window.session, window.evaluation
     good = session.link([1], [1])
     bad = session.link([2], [3])
@@ -35,7 +37,7 @@ def test_reference_scores_live_and_marks_cliques(window, tmp_path, monkeypatch, 
     model = window.table.model
     assert model.data(model.index(model.row_of(good), 6)) == "TP"
     assert model.data(model.index(model.row_of(bad), 6)) == "FP"
-    assert window.views["sketch"].badge_texts() == {1: "TP", 2: "FP"}
+    assert window.views["sketch"].badge_texts() == {1: "TP", 2: "FP", 3: "FN"}  # FN: a missed clique
     assert panel.missed.count() == 2 and panel.missed.item(0).text() == "2  ↔  2"
 
     session.delete_clique(bad)  # live: every edit re-scores

@@ -9,8 +9,8 @@ from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QPainter, QWheelEvent
 from PySide6.QtWidgets import QApplication
 
-from ursim_gui.map_view import MAX_ZOOM, MapView
-from ursim_gui.overlay import region_colour_table
+from ursim_gui.model.region_style import region_colour_table
+from ursim_gui.views.map_view import MAX_ZOOM, MapView
 
 
 def wheel(view: MapView, position: QPoint, steps: int) -> None:
@@ -144,8 +144,8 @@ def test_drop_reports_paths(view, tmp_path):
 
 def test_lut_image_equals_the_numpy_overlay(labels3):
     """The view's one-gather ARGB image shows exactly overlay_rgba's colours."""
-    from ursim_gui.map_items import lut_qimage
-    from ursim_gui.overlay import overlay_rgba
+    from ursim_gui.model.region_style import overlay_rgba
+    from ursim_gui.views.map_items import lut_qimage
 
     table = region_colour_table(3, alpha=255)
     image, _pixels = lut_qimage(labels3, table)

@@ -4,15 +4,16 @@ through a correspondence JSON; unreadable files give an error dialog, never a cr
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from conftest import error_boxes
 from PySide6.QtCore import QMimeData, QPointF, Qt, QUrl
 from PySide6.QtGui import QDropEvent
-from PySide6.QtWidgets import QFileDialog
 
 from ursim_gui.app import parse_args
-from ursim_gui.main_window import MainWindow
+from ursim_gui.views import file_dialogs
+from ursim_gui.window.main_window import MainWindow
 
 
 @pytest.fixture
@@ -24,7 +25,7 @@ def empty_window(qtbot, tmp_path):
 
 
 def choose_file(monkeypatch, path):
-    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *args, **kwargs: (str(path), "")))
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(str(path)))
 
 
 def test_file_menu_opens_each_map(empty_window, map_files, monkeypatch):

@@ -1,4 +1,4 @@
-"""ursim_gui.overlay and ursim_gui.view_state: Qt-free, tested without widgets."""
+"""ursim_gui.model.region_style and ursim_gui.model.view_state: Qt-free, tested without widgets."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from conftest import three_room_labels
 
 from ursim_core.correspondences.codec import Clique, Correspondences
 from ursim_core.segmentation.graph import region_graph
-from ursim_gui.overlay import (
+from ursim_gui.model.region_style import (
     NEUTRAL_REGION,
     clique_colour,
     outline_mask,
@@ -17,7 +17,7 @@ from ursim_gui.overlay import (
     region_label_positions,
     region_mask,
 )
-from ursim_gui.view_state import eval_badges, first_regions, side_colour_table
+from ursim_gui.model.view_state import eval_badges, first_regions, side_colour_table
 
 
 def test_colour_table_makes_background_transparent_and_regions_distinct():

@@ -4,19 +4,21 @@ question, failed saves, autosave and recovery."""
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import pytest
-from conftest import error_boxes
+from conftest import error_boxes, simulate_crash
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QMessageBox
 
 from ursim_core.correspondences.codec import load_correspondences, load_dat
-from ursim_gui import dialogs
-from ursim_gui.main_window import MainWindow
+from ursim_gui.views import file_dialogs
+from ursim_gui.window import dialogs
+from ursim_gui.window.main_window import MainWindow
 
 
 def save_to(monkeypatch, path):
-    monkeypatch.setattr(QFileDialog, "getSaveFileName", staticmethod(lambda *a, **k: (str(path), "")))
+    monkeypatch.setattr(file_dialogs, "ask_save_path", lambda *a, **k: Path(str(path)))
 
 
 def test_ctrl_s_saves_and_the_title_tracks_dirty(window, qtbot, tmp_path, monkeypatch):
@@ -46,7 +48,7 @@ def test_failed_save_shows_an_error_and_stays_dirty(window, tmp_path, monkeypatc
     boxes = error_boxes(window)
     assert boxes and "missing-folder" in boxes[0].text()
     assert window.session.dirty and window.windowTitle().endswith("*")
-    from ursim_gui.model import session as session_module
+    from ursim_gui.model import session_documents as session_module
 
     def disk_full(*args, **kwargs):
         raise OSError(28, "No space left on device")
@@ -65,7 +67,7 @@ def test_dat_export_and_import(window, tmp_path, monkeypatch):
     window.actions["export_dat"].trigger()
     assert len(load_dat(dat).cliques) == 1
     window.session.delete_clique(window.session.correspondences.cliques[0].id)
-    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(dat), "")))
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(str(dat)))
     window.actions["import_dat"].trigger()
     (clique,) = window.session.correspondences.cliques
     assert (clique.sketch_regions, clique.metric_regions) == ((1,), (3,))
@@ -109,8 +111,10 @@ def test_autosave_and_recovery(window, qtbot, tmp_path, monkeypatch):
     folder = window.documents.autosave_dir
     (copy,) = folder.glob("*.autosave.json")
     assert load_correspondences(copy).cliques[0].metric_regions == (2,)
-    # A crash: the window goes away without a clean close; the copy stays.
+    # A crash: the window goes away without a clean close; the copy stays, its lock
+    # names a process that is gone.
     window.documents.autosave_timer.stop()
+    simulate_crash(window.documents.autosaver)
 
     offered = []
     monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: offered.append(paths) or paths[0])

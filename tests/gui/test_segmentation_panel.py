@@ -3,10 +3,13 @@ parameters, loads a label image instead, and drives the overlay display options.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from conftest import error_boxes
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QFileDialog
+
+from ursim_gui.views import file_dialogs
 
 
 def test_segment_button_runs_maoris_with_the_chosen_preset(window, qtbot):
@@ -26,9 +29,7 @@ def test_segment_button_runs_maoris_with_the_chosen_preset(window, qtbot):
 
 
 def test_load_label_image_button(window, map_files, monkeypatch):
-    monkeypatch.setattr(
-        QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["metric_labels"]), ""))
-    )
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(str(map_files["metric_labels"])))
     window.session.set_map("metric", window.session.map("metric"))  # drops the segmentation
     assert window.session.segmentation("metric") is None
     window.segmentation_panel.boxes["metric"].load_button.click()
@@ -37,9 +38,7 @@ def test_load_label_image_button(window, map_files, monkeypatch):
 
 
 def test_label_image_of_the_wrong_size_is_refused(window, map_files, monkeypatch):
-    monkeypatch.setattr(
-        QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(map_files["sketch_labels"]), ""))
-    )
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(str(map_files["sketch_labels"])))
     before = window.session.segmentation("metric")
     window.segmentation_panel.boxes["metric"].load_button.click()
     assert error_boxes(window)

@@ -8,8 +8,8 @@ import numpy as np
 from PySide6.QtCore import QPoint, Qt, QTimer
 from PySide6.QtWidgets import QApplication
 
-from ursim_gui.sketch_canvas import SketchSizeDialog, SketchWindow
-from ursim_gui.sketch_document import INK, PAPER
+from ursim_gui.model.sketch_document import INK, PAPER
+from ursim_gui.tools.sketch_canvas import SketchSizeDialog, SketchWindow
 
 
 def drag(qtbot, widget, start: QPoint, end: QPoint, steps: int = 5) -> None:

@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ursim_gui.sketch_document import INK, PAPER, SketchDocument
+from ursim_gui.model.sketch_document import INK, PAPER, SketchDocument
 
 
 def test_pen_stroke_draws_and_undo_redo_are_exact():
@@ -72,7 +72,7 @@ def test_too_small_canvas_is_refused():
 
 
 def test_map_image_keeps_open_drawings_and_fills_outside_closed_ones():
-    from ursim_gui.sketch_document import INK, PAPER, SketchDocument
+    from ursim_gui.model.sketch_document import INK, PAPER, SketchDocument
 
     doc = SketchDocument(30, 40)
     doc.image[15, 5:35] = INK  # one wall, no outline: nothing is outside

@@ -3,12 +3,14 @@ both views with a legend can be exported."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from conftest import error_boxes
 from PySide6.QtCore import QPointF
 from PySide6.QtGui import QImage
-from PySide6.QtWidgets import QFileDialog
 
-from ursim_gui.status_bar import format_cursor, format_zoom
+from ursim_gui.views import file_dialogs
+from ursim_gui.views.status_bar import format_cursor, format_zoom
 
 
 def test_status_bar_shows_pixel_region_and_zoom(window, qtbot):
@@ -43,7 +45,7 @@ def test_export_figure_writes_a_png_with_a_legend(window, tmp_path, monkeypatch)
     window.actions["connectors"].setChecked(True)
     window.session.select_clique(window.session.correspondences.cliques[0].id)
     target = tmp_path / "figure.png"
-    monkeypatch.setattr(QFileDialog, "getSaveFileName", staticmethod(lambda *a, **k: (str(target), "")))
+    monkeypatch.setattr(file_dialogs, "ask_save_path", lambda *a, **k: Path(str(target)))
     window.actions["export_figure"].trigger()
     image = QImage(str(target))
     assert not image.isNull() and image.width() > 600 and image.height() > 600
@@ -67,7 +69,7 @@ def test_failed_figure_export_shows_an_error(window, tmp_path):
 
 
 def test_job_progress_starts_busy_and_becomes_a_percentage(qtbot):
-    from ursim_gui.status_bar import CursorStatusBar
+    from ursim_gui.views.status_bar import CursorStatusBar
 
     bar = CursorStatusBar()
     qtbot.addWidget(bar)

@@ -8,7 +8,7 @@ import time
 
 from PySide6.QtCore import QThread, QTimer
 
-from ursim_gui.workers import JobRunner
+from ursim_gui.jobs.runner import JobRunner
 
 
 class SlowJob:

@@ -12,6 +12,11 @@ Writes are debounced: an edit marks the copy stale (:meth:`Autosaver.mark_dirty`
 the view's timer calls :meth:`Autosaver.flush_if_due` with the current time. Time is
 always passed in (``time.monotonic()`` in the app), so tests control it exactly.
 
+Each autosaver holds a lock file ``<folder>/<id>.lock`` naming its process id while it
+lives; :func:`find_recoverable` skips the copies of autosavers whose process still runs
+(another window, or this one), so only a crashed run's copy is offered. A lock whose
+process is gone is stale: its copy is recoverable.
+
 The folder is, by priority: the constructor argument, ``$URSIM_AUTOSAVE_DIR``,
 ``$URSIM_GUI_DATA_DIR/autosave`` (the app's data folder), then the platform's user data
 folder (``~/.local/share/ursim-studio/autosave`` on Linux).
@@ -28,6 +33,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ursim_core.correspondences.codec import Correspondences, load_correspondences, save_correspondences
+from ursim_core.io.atomic import atomic_write_bytes
 from ursim_gui.model.session import AUTOSAVE_ORIGIN_KEY, AnnotationSession
 
 __all__ = [
@@ -39,9 +45,12 @@ __all__ = [
     "recover",
     "recover_with_origin",
     "discard",
+    "owner_running",
+    "LOCK_SUFFIX",
 ]
 
 AUTOSAVE_SUFFIX = ".autosave.json"
+LOCK_SUFFIX = ".lock"
 AUTOSAVE_DIR_ENV = "URSIM_AUTOSAVE_DIR"
 _APP_DATA_ENV = "URSIM_GUI_DATA_DIR"
 _APP_FOLDER = "ursim-studio"
@@ -70,15 +79,49 @@ def default_autosave_folder() -> Path:
     return base / _APP_FOLDER / "autosave"
 
 
-def find_recoverable(folder: str | os.PathLike | None = None) -> list[Path]:
-    """Autosave files in ``folder`` (default: :func:`default_autosave_folder`), newest first.
+def _instance_of(copy: Path) -> str:
+    """The autosaver id in a copy's name ``<stem>-<id>.autosave.json``."""
+    return copy.name[: -len(AUTOSAVE_SUFFIX)].rsplit("-", 1)[-1]
 
-    A missing folder simply has none.
+
+def _process_alive(pid: int) -> bool:
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # it exists, owned by someone else
+    except OSError:
+        return False
+    return True
+
+
+def owner_running(folder: Path, instance_id: str) -> bool:
+    """True when the lock of autosaver ``instance_id`` names a process that still runs."""
+    try:
+        text = (folder / f"{instance_id}{LOCK_SUFFIX}").read_text(encoding="ascii")
+        pid = int(text.split()[0])
+    except (OSError, ValueError, IndexError, UnicodeDecodeError):
+        return False
+    return _process_alive(pid)
+
+
+def find_recoverable(folder: str | os.PathLike | None = None) -> list[Path]:
+    """Autosave files of crashed runs in ``folder`` (default: :func:`default_autosave_folder`), newest first.
+
+    A copy whose autosaver's process still runs (see the lock files in the module
+    docstring) is not a crash copy and is left out. A missing folder simply has none.
     """
     folder = default_autosave_folder() if folder is None else Path(folder)
     if not folder.is_dir():
         return []
-    found = [path for path in folder.glob(f"*{AUTOSAVE_SUFFIX}") if path.is_file()]
+    found = [
+        path
+        for path in folder.glob(f"*{AUTOSAVE_SUFFIX}")
+        if path.is_file() and not owner_running(folder, _instance_of(path))
+    ]
 
     def modified(path: Path) -> float:
         try:
@@ -164,6 +207,8 @@ class Autosaver:
         self._last_pending: float | None = None
         self._written: Path | None = None
         self._closed = False
+        self._lock: Path | None = None
+        self._take_lock()
         session.correspondences_changed.connect(self._on_correspondences_changed)
         session.dirty_changed.connect(self._on_dirty_changed)
         session.path_changed.connect(self._on_path_changed)
@@ -204,15 +249,16 @@ class Autosaver:
 
         Raises
         ------
-        OSError
-            The write failed. The edit stays pending and is retried after another
-            ``delay_s``; the caller logs the failure (autosave must not interrupt the user).
+        Exception
+            The write failed, for whatever reason (a full disk, a value the codec
+            refuses...). The edit stays pending and is retried after another
+            ``delay_s``; the caller reports the failure (autosave must not interrupt the user).
         """
         if self._closed or not self.due(now):
             return False
         try:
             self.flush()
-        except OSError:
+        except Exception:
             # Back off instead of failing again on every timer tick.
             self._first_pending = self._last_pending = now
             raise
@@ -229,6 +275,8 @@ class Autosaver:
         extra = {**corr.extra, AUTOSAVE_ORIGIN_KEY: None if document is None else str(document)}
         target = self.path
         self.folder.mkdir(parents=True, exist_ok=True)
+        if self._lock is None:
+            self._take_lock()
         # ``now`` keeps the document's own timestamps: the copy must be the value in the
         # session, not a re-stamped one.
         save_correspondences(dataclasses.replace(corr, extra=extra), target, now=corr.modified)
@@ -253,9 +301,23 @@ class Autosaver:
             return
         self.discard()
         self._closed = True
+        if self._lock is not None:
+            self._lock.unlink(missing_ok=True)
+            self._lock = None
         self.session.correspondences_changed.disconnect(self._on_correspondences_changed)
         self.session.dirty_changed.disconnect(self._on_dirty_changed)
         self.session.path_changed.disconnect(self._on_path_changed)
+
+    def _take_lock(self) -> None:
+        # Best effort: without a lock (read-only folder) a copy could only be offered
+        # to another running window, never lost.
+        lock = self.folder / f"{self._instance_id}{LOCK_SUFFIX}"
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            atomic_write_bytes(lock, f"{os.getpid()}\n".encode("ascii"))
+        except OSError:
+            return
+        self._lock = lock
 
     # ------------------------------------------------------------------ session signals
     def _on_correspondences_changed(self) -> None:

@@ -1,7 +1,7 @@
 """Long computations (segmentation, matching) packaged for a worker thread.
 
 A job holds its inputs and has one method, ``run(progress, cancelled)``. It never
-touches the session or any widget: ``ursim_gui/workers.py`` runs it in a Qt thread
+touches the session or any widget: ``ursim_gui.jobs`` runs it in its worker process
 and hands the result back to the GUI thread, which calls
 ``AnnotationSession.set_segmentation`` or ``apply_match``. Keeping the jobs free of
 Qt means they are tested like plain functions.
@@ -15,10 +15,19 @@ then discarded instead of being applied.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["JobCancelled", "SegmentJob", "MatchJob", "ProgressCallback", "CancelledCallback"]
+__all__ = [
+    "JobCancelled",
+    "SegmentJob",
+    "MatchJob",
+    "ProgressCallback",
+    "CancelledCallback",
+    "COMPILING_NOTE",
+    "compiling_note",
+]
 
 #: ``progress(fraction, message)`` with ``fraction`` in [0, 1].
 ProgressCallback = Callable[[float, str], None]
@@ -33,6 +42,26 @@ class JobCancelled(Exception):
 def _check(cancelled: CancelledCallback, what: str) -> None:
     if cancelled():
         raise JobCancelled(f"{what} cancelled")
+
+
+#: Shown while the first segmentation of a fresh install compiles the numba kernels.
+COMPILING_NOTE = "Compiling the segmentation kernels (first run only)…"
+
+
+def compiling_note(job) -> str | None:
+    """:data:`COMPILING_NOTE` when ``job`` is a MAORIS segmentation that will compile the kernels.
+
+    Asks ``ursim_core.segmentation.maoris.kernels_cached()`` (a few directory listings)
+    when the core has it; without it, or once the kernels are cached, None.
+    """
+    if not isinstance(job, SegmentJob) or job.method != "maoris":
+        return None
+    from ursim_core.segmentation import maoris
+
+    cached = getattr(maoris, "kernels_cached", None)
+    if cached is None or cached():
+        return None
+    return COMPILING_NOTE
 
 
 class SegmentJob:
@@ -142,14 +171,26 @@ class MatchJob:
         progress(0.0, "preparing")
         _check(cancelled, "matching")
         config = self.config if self.config is not None else MatchConfig()
-        prepared = prepare(self.sketch_seg, self.metric_seg, config)
-        _check(cancelled, "matching")
-        progress(0.05, "matching")
+        reached = [0.0]
 
-        def sweep_progress(fraction: float, message: str) -> None:
-            # The automatic m runs the matcher once per m: cancel between two of them.
-            _check(cancelled, "matching")
-            progress(0.05 + 0.95 * fraction, message)
+        def phase(start: float, end: float):
+            def report(fraction: float, message: str) -> None:
+                # Each matcher run (an m of the sweep, an orientation candidate) is a point
+                # to cancel at; the bar never goes back.
+                _check(cancelled, "matching")
+                reached[0] = max(reached[0], start + (end - start) * min(max(float(fraction), 0.0), 1.0))
+                progress(reached[0], message)
+
+            return report
+
+        # A core whose prepare() searches the sketch's orientation reports it too.
+        if "progress" in inspect.signature(prepare).parameters:
+            prepared = prepare(self.sketch_seg, self.metric_seg, config, progress=phase(0.0, 0.5))
+        else:
+            prepared = prepare(self.sketch_seg, self.metric_seg, config)
+        _check(cancelled, "matching")
+        progress(max(reached[0], 0.05), "matching")
+        sweep_progress = phase(max(reached[0], 0.05), 1.0)
 
         result = match_prepared(prepared, progress=sweep_progress)
         _check(cancelled, "matching")

@@ -1,4 +1,4 @@
-"""Evaluation panel: load a reference (.json or .dat), live precision / recall / F1, misses.
+"""Evaluation panel: load a reference (.json or .dat), live precision / recall / F1, clickable misses.
 
 The score is the session's (recomputed by the model on every change); the panel only
 shows it. Loading the file is the main window's job (it owns dialogs and errors).
@@ -6,13 +6,14 @@ shows it. Loading the file is the main window's job (it owns dialogs and errors)
 
 from __future__ import annotations
 
-from PySide6.QtCore import Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QFormLayout,
     QGroupBox,
     QHBoxLayout,
     QLabel,
     QListWidget,
+    QListWidgetItem,
     QPushButton,
     QVBoxLayout,
     QWidget,
@@ -69,6 +70,7 @@ class EvaluationPanel(QWidget):
         layout.addWidget(box)
         self.load_button.clicked.connect(self.load_requested)
         self.clear_button.clicked.connect(lambda: self._session.clear_reference())
+        self.missed.itemClicked.connect(self._select_missed)
         session.reference_changed.connect(self.refresh)
         session.correspondences_changed.connect(self.refresh)
         self.refresh()
@@ -85,11 +87,28 @@ class EvaluationPanel(QWidget):
             self.missed.clear()
             return
         self.source.setText(f"{len(reference)} reference cliques")
-        self.values["precision"].setText(f"{score.precision:.3f}")
-        self.values["recall"].setText(f"{score.recall:.3f}")
-        self.values["f1"].setText(f"{score.f1:.3f}")
+        # A ratio over nothing is undefined, not perfect: no pairs means no precision, and
+        # a reference none of whose cliques falls on a region means no recall.
+        predicted, findable = score.tp + score.fp, score.tp + score.fn
+        self.values["precision"].setText(f"{score.precision:.3f}" if predicted else "– (no matched pairs)")
+        self.values["recall"].setText(f"{score.recall:.3f}" if findable else "– (nothing to find)")
+        self.values["f1"].setText(f"{score.f1:.3f}" if predicted and findable else "–")
         self.values["counts"].setText(f"{score.tp} / {score.fp} / {score.fn}")
         self.missed.clear()
         for index in self._session.missed_reference():
             sketch, metric = reference[index]
-            self.missed.addItem(f"{format_regions(sketch)}  ↔  {format_regions(metric)}")
+            item = QListWidgetItem(f"{format_regions(sketch)}  ↔  {format_regions(metric)}")
+            item.setData(Qt.ItemDataRole.UserRole, index)
+            item.setToolTip("Click to select these regions on both maps")
+            self.missed.addItem(item)
+
+    def _select_missed(self, item: QListWidgetItem) -> None:
+        """Select a missed reference clique's regions on both maps (then L links them)."""
+        reference = self._session.reference
+        index = item.data(Qt.ItemDataRole.UserRole)
+        if reference is None or index is None or index >= len(reference):
+            return
+        sketch, metric = reference[index]
+        self._session.clear_selection()
+        self._session.select("sketch", sorted(sketch))
+        self._session.select("metric", sorted(metric))

@@ -1,7 +1,13 @@
-"""Matching panel: m (auto or a value), descriptor variant, matcher, Match; last result summary."""
+"""Matching panel: m (auto or a value), descriptor variant, matcher, sketch orientation, Match; last result.
+
+The orientation buttons turn (90-degree steps or a free angle) and mirror the sketch
+view and tell the matcher the orientation is known (when the core's ``MatchConfig`` has
+``orientation`` / ``mirrored``; until then only the view turns).
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from PySide6.QtCore import Signal
@@ -17,6 +23,8 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
+
+from ursim_gui.model.orientation import SketchOrientation
 
 __all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "describe_result"]
 
@@ -52,6 +60,8 @@ class MatchingPanel(QWidget):
     """
 
     match_requested = Signal(object)
+    #: The sketch orientation changed (a :class:`~ursim_gui.model.orientation.SketchOrientation`).
+    orientation_changed = Signal(object)
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -76,6 +86,37 @@ class MatchingPanel(QWidget):
         self.matcher = _combo("match_matcher", MATCHERS)
         form.addRow("Variant", self.variant)
         form.addRow("Matcher", self.matcher)
+        self.orientation = SketchOrientation()
+        self.turn_left = QPushButton("⟲ 90°")
+        self.turn_left.setObjectName("orient_left")
+        self.turn_left.setToolTip("Turn the sketch 90° counter-clockwise")
+        self.turn_right = QPushButton("⟳ 90°")
+        self.turn_right.setObjectName("orient_right")
+        self.angle = QDoubleSpinBox()
+        self.angle.setObjectName("orient_angle")
+        self.angle.setRange(0.0, 359.9)
+        self.angle.setDecimals(1)
+        self.angle.setSuffix("°")
+        self.angle.setWrapping(True)
+        self.angle.setToolTip("Free angle, counter-clockwise")
+        self.mirror = QCheckBox("mirror")
+        self.mirror.setObjectName("orient_mirror")
+        self.unknown = QPushButton("unknown")
+        self.unknown.setObjectName("orient_unknown")
+        self.unknown.setToolTip("Let the matcher try every orientation")
+        orient_row = QHBoxLayout()
+        for widget in (self.turn_left, self.turn_right, self.angle, self.mirror, self.unknown):
+            orient_row.addWidget(widget)
+        form.addRow("Sketch", orient_row)
+        self.orientation_label = QLabel("")
+        self.orientation_label.setObjectName("orient_summary")
+        form.addRow(self.orientation_label)
+        self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
+        self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
+        self.angle.editingFinished.connect(lambda: self.set_orientation(self.orientation.at(self.angle.value())))
+        self.mirror.clicked.connect(lambda on: self.set_orientation(self.orientation.with_mirror(on)))
+        self.unknown.clicked.connect(lambda: self.set_orientation(SketchOrientation()))
+        self._show_orientation()
         self.match_button = QPushButton("Match")
         self.match_button.setObjectName("match_button")
         self.match_button.clicked.connect(lambda: self.match_requested.emit(self.config()))
@@ -93,7 +134,33 @@ class MatchingPanel(QWidget):
         from ursim_core.matching import MatchConfig
 
         m = "auto" if self.m_auto.isChecked() else float(self.m_value.value())
-        return MatchConfig(variant=self.variant.currentData(), matcher=self.matcher.currentData(), m=m)
+        fields = {field.name for field in dataclasses.fields(MatchConfig)}
+        return MatchConfig(
+            variant=self.variant.currentData(),
+            matcher=self.matcher.currentData(),
+            m=m,
+            **self.orientation.match_options(fields),
+        )
+
+    def set_orientation(self, orientation: SketchOrientation) -> None:
+        """Show and announce a new sketch orientation."""
+        if orientation == self.orientation:
+            return
+        self.orientation = orientation
+        self._show_orientation()
+        self.orientation_changed.emit(orientation)
+
+    def _show_orientation(self) -> None:
+        orientation = self.orientation
+        self.angle.blockSignals(True)
+        self.angle.setValue(orientation.angle or 0.0)
+        self.angle.blockSignals(False)
+        self.mirror.setChecked(orientation.mirrored)
+        if not orientation.known:
+            self.orientation_label.setText("orientation unknown: the matcher tries them")
+        else:
+            mirrored = ", mirrored" if orientation.mirrored else ""
+            self.orientation_label.setText(f"known: turned {orientation.angle:g}° counter-clockwise{mirrored}")
 
     def set_ready(self, ready: bool) -> None:
         """Enable Match only when both maps are segmented and no job runs."""

@@ -8,6 +8,7 @@ import time
 import cv2
 import numpy as np
 import pytest
+from conftest import simulate_crash
 
 from ursim_core.correspondences.codec import load_correspondences
 from ursim_core.segmentation import Segmentation, load_label_image, save_label_image
@@ -117,6 +118,8 @@ def test_the_copy_holds_the_correspondences_and_the_document_path(files, clock, 
     assert raw.extra == {"autosave_of": str(files / "doc.json")}
     corr, origin = recover_with_origin(saver.path)
     assert corr == session.correspondences and origin == files / "doc.json"
+    assert find_recoverable(autosave_dir) == []  # its session still runs: not a crash copy
+    simulate_crash(saver)
     assert find_recoverable(autosave_dir) == [saver.path]
 
 
@@ -128,6 +131,7 @@ def test_recovery_reopens_the_maps_and_is_dirty(files, clock, autosave_dir):
     saver = Autosaver(session, autosave_dir, clock=clock)
     saver.flush()
     expected = session.correspondences
+    simulate_crash(saver)
     del session, saver  # the "crash"
 
     (path,) = find_recoverable(autosave_dir)
@@ -173,7 +177,7 @@ def test_the_copy_is_removed_on_save_on_undo_to_saved_and_on_close(files, clock,
 
     session.redo()
     saver.flush()
-    assert find_recoverable(autosave_dir) == [saver.path]
+    assert saver.path.exists() and find_recoverable(autosave_dir) == []  # running, not crashed
     saver.close()
     assert find_recoverable(autosave_dir) == []
     session.link([3], [3])  # no longer watched
@@ -279,7 +283,9 @@ def test_a_crash_copy_of_the_same_document_is_not_removed_by_a_new_session(files
     crashed.link([1], [1])
     crashed.save(files / "doc.json")
     crashed.link([2], [2])
-    Autosaver(crashed, autosave_dir, clock=clock).flush()
+    crashed_saver = Autosaver(crashed, autosave_dir, clock=clock)
+    crashed_saver.flush()
+    simulate_crash(crashed_saver)
     (crash_copy,) = find_recoverable(autosave_dir)
 
     # The user declined recovery for now and opens the document again.
@@ -289,7 +295,8 @@ def test_a_crash_copy_of_the_same_document_is_not_removed_by_a_new_session(files
     saver.flush_if_due(clock.now + 60)
     session.link([3], [3])
     saver.flush_if_due(clock.now + 120)
-    assert saver.path != crash_copy and set(find_recoverable(autosave_dir)) == {crash_copy, saver.path}
+    assert saver.path != crash_copy and saver.path.exists()
+    assert find_recoverable(autosave_dir) == [crash_copy]  # the running session's copy is not offered
     saver.close()
     assert find_recoverable(autosave_dir) == [crash_copy]
     assert recover_with_origin(crash_copy)[0] == crashed.correspondences

@@ -2,14 +2,15 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
-MODULES = (
-    "ursim_gui.model",
-    "ursim_gui.model.signals",
-    "ursim_gui.model.history",
-    "ursim_gui.model.session",
-    "ursim_gui.model.autosave",
-    "ursim_gui.model.jobs",
+import ursim_gui.model
+
+#: Every module of the model package, found on disk so a new one cannot be forgotten.
+MODULES = ("ursim_gui.model",) + tuple(
+    f"ursim_gui.model.{path.stem}"
+    for path in sorted(Path(ursim_gui.model.__file__).parent.glob("*.py"))
+    if path.stem != "__init__"
 )
 
 

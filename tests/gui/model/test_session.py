@@ -627,7 +627,7 @@ def test_partners_clique_of_and_colours(session):
     colours = {session.color_of_clique(i) for i in range(1, 40)}
     assert len(colours) == 39
     assert all(0 <= channel <= 255 for colour in colours for channel in colour)
-    overlay = pytest.importorskip("ursim_gui.overlay")
+    overlay = pytest.importorskip("ursim_gui.model.region_style")
     assert all(color_of_clique(i) == overlay.clique_colour(i) for i in range(1, 100))
 
 
@@ -748,7 +748,9 @@ def test_match_config_defaults_to_the_core_defaults(session):
 def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(session):
     from ursim_core.matching import MatchConfig
 
-    config = MatchConfig(m="auto")
+    fields = {field.name for field in dataclasses.fields(MatchConfig)}
+    # One orientation: the sweep of m is then one matcher run per m of the grid.
+    config = MatchConfig(m="auto", **({"orientation": "upright", "mirrored": False} if "orientation" in fields else {}))
     reports = []
     MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
         lambda fraction, message: reports.append((fraction, message)), lambda: False

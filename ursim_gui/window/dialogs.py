@@ -1,35 +1,17 @@
-"""Message dialogs of the app: errors (logged too), the unsaved-changes question, recovery.
+"""Questions of the main window: unsaved changes, crash recovery (modal: the answer is needed to go on).
 
-Errors use non-blocking window-modal boxes so a failing background job never stacks
-nested event loops; questions that need an answer before going on are modal.
+``show_error`` (from :mod:`ursim_gui.views.messages`) is re-exported for the window's modules.
 """
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
-from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QMessageBox, QWidget
 
+from ursim_gui.views.messages import show_error
+
 __all__ = ["show_error", "ask_unsaved_changes", "ask_recover"]
-
-_log = logging.getLogger("ursim_gui")
-#: Parentless error boxes are kept here while shown; Python would otherwise delete them.
-_open_boxes: set[QMessageBox] = set()
-
-
-def show_error(parent: QWidget | None, title: str, message: str) -> QMessageBox:
-    """Log ``message`` and show it in a window-modal box (returns at once)."""
-    _log.error("%s: %s", title, message)
-    box = QMessageBox(QMessageBox.Icon.Critical, title, message, QMessageBox.StandardButton.Ok, parent)
-    box.setObjectName("error_box")
-    box.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose, True)
-    if parent is None:
-        _open_boxes.add(box)
-        box.finished.connect(lambda _result: _open_boxes.discard(box))
-    box.open()
-    return box
 
 
 def ask_unsaved_changes(parent: QWidget | None, what: str) -> str:

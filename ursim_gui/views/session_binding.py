@@ -1,7 +1,7 @@
 """Binds the session to the two map views: model signals -> drawing, view input -> model calls.
 
 The binding holds no annotation state. It re-reads the session when it signals a change
-and draws with the pure helpers of :mod:`ursim_gui.view_state`; clicks become
+and draws with the pure helpers of :mod:`ursim_gui.model.view_state`; clicks become
 ``session.select`` calls. Hover is purely visual: it only re-draws the cheap highlight
 layer of the other view.
 """
@@ -13,12 +13,12 @@ import functools
 import numpy as np
 from PySide6.QtGui import QColor
 
-from ursim_gui.view_state import eval_badges, first_regions, side_colour_table
+from ursim_gui.model.view_state import eval_badges, first_regions, side_colour_table
 
 __all__ = ["ViewBinding", "SIDES"]
 
 SIDES = ("sketch", "metric")
-_BADGE_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
+_BADGE_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40), "FN": QColor(200, 120, 0)}
 
 
 class ViewBinding:
@@ -69,7 +69,7 @@ class ViewBinding:
             return
         cliques = self.session.clique_of(side, region)
         if cliques:
-            self.session.select_clique(cliques[0])
+            self.session.select_clique(cliques[0], focus=(side, region))
         else:
             self.session.select(side, [region])
 
@@ -115,7 +115,9 @@ class ViewBinding:
 
     def _badges_changed(self, *_args) -> None:
         for side in SIDES:
-            badges = eval_badges(self.session.correspondences, side, self.session.clique_status)
+            reference = self.session.reference or []
+            missed = [reference[index] for index in self.session.missed_reference()]
+            badges = eval_badges(self.session.correspondences, side, self.session.clique_status, missed)
             self.views[side].set_badges({region: (mark, _BADGE_COLOURS[mark]) for region, mark in badges.items()})
 
     def _paint(self, side: str) -> None:

@@ -1,4 +1,4 @@
-"""File > New sketch: a drawing window over :class:`~ursim_gui.sketch_document.SketchDocument`.
+"""File > New sketch: a drawing window over :class:`~ursim_gui.model.sketch_document.SketchDocument`.
 
 The window translates mouse events to document strokes and shows the image; the
 document owns the pixels, the tools and the undo stack.
@@ -11,7 +11,6 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QPainter
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
-    QFileDialog,
     QFormLayout,
     QLabel,
     QMainWindow,
@@ -20,9 +19,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from ursim_gui.dialogs import show_error
-from ursim_gui.map_items import grey_to_qimage
-from ursim_gui.sketch_document import TOOLS, SketchDocument
+from ursim_gui.model.sketch_document import TOOLS, SketchDocument
+from ursim_gui.views import file_dialogs
+from ursim_gui.views.map_items import grey_to_qimage
+from ursim_gui.views.messages import show_error
 
 __all__ = ["SketchSizeDialog", "SketchCanvas", "SketchWindow"]
 
@@ -177,9 +177,9 @@ class SketchWindow(QMainWindow):
         self.redo_action.setEnabled(self.document.can_redo)
 
     def save_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save sketch", "sketch.png", "PNG image (*.png)")
-        if path:
-            self.save_to(path)
+        path = file_dialogs.ask_save_path(self, "Save sketch", "sketch.png", "PNG image (*.png)")
+        if path is not None:
+            self.save_to(str(path))
 
     def save_to(self, path: str) -> bool:
         """Save the PNG; a failure is shown in a dialog and logged. True on success."""

@@ -1,7 +1,7 @@
 """Export a PNG figure: both maps as shown (overlays, marks) side by side, with a legend.
 
 The maps are rendered from the views' scenes, so the figure shows exactly the layers the
-user has switched on; the legend lists each clique's colour, regions, status and, with a
+user has switched on, plus the region ids (the legend names regions by id); the legend lists each clique's colour, regions, status and, with a
 reference loaded, its TP / FP mark and the scores.
 """
 
@@ -96,7 +96,8 @@ def render_figure(sketch_view, metric_view, session, *, map_height: int = 600, c
             f"{side.capitalize()}: {title}",
         )
         if not view.sceneRect().isEmpty():
-            with view.layers.hidden("selection", "highlight"):
+            scale = rect.height() / view.sceneRect().height()
+            with view.layers.hidden("selection", "highlight"), view.layers.ids_shown(scale):
                 view.scene().render(painter, rect, view.sceneRect(), Qt.AspectRatioMode.KeepAspectRatio)
         painter.setPen(QPen(QColor(120, 120, 120), 1))
         painter.setBrush(Qt.BrushStyle.NoBrush)

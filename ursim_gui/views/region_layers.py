@@ -15,8 +15,15 @@ from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QImage, QPainterPath, QPen
 from PySide6.QtWidgets import QGraphicsPathItem, QGraphicsScene
 
-from ursim_gui.map_items import ImageItem, LabelItem, lut_qimage, mask_qimage, pack_premultiplied, region_outline_path
-from ursim_gui.overlay import outline_mask, region_label_positions, region_mask
+from ursim_gui.model.region_style import outline_mask, region_label_positions, region_mask
+from ursim_gui.views.map_items import (
+    ImageItem,
+    LabelItem,
+    lut_qimage,
+    mask_qimage,
+    pack_premultiplied,
+    region_outline_path,
+)
 
 __all__ = ["RegionLayers", "MIN_ID_REGION_PX", "MARK_STYLES"]
 
@@ -161,6 +168,22 @@ class RegionLayers:
         finally:
             for item in items:
                 item.setVisible(True)
+
+    @contextlib.contextmanager
+    def ids_shown(self, zoom: float):
+        """Show the region ids inside the block, culled for ``zoom`` (figures always name regions)."""
+        was_visible = self._ids_visible
+        self._ids_visible = True
+        if not self._ids:
+            self._rebuild_ids()
+        before = [was_visible and item.isVisible() for item in self._ids]
+        self.cull_ids(zoom)
+        try:
+            yield
+        finally:
+            self._ids_visible = was_visible
+            for item, visible in zip(self._ids, before):
+                item.setVisible(visible)
 
     def _path(self, region: int) -> QPainterPath:
         # Outlines are computed on first use and cached until the segmentation changes.

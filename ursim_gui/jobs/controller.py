@@ -1,7 +1,7 @@
 """Runs segmentation and matching jobs off the GUI thread and hands results to the session.
 
 Jobs are queued (segment sketch, segment metric, match) and run one at a time by a
-:class:`~ursim_gui.workers.JobRunner`; the status bar shows progress and a Cancel button
+:class:`~ursim_gui.jobs.runner.JobRunner`; the status bar shows progress and a Cancel button
 that drops the whole queue. Results are applied in the GUI thread through the session's
 own methods (``set_segmentation``, ``apply_match``).
 """
@@ -14,9 +14,9 @@ from collections import deque
 from PySide6.QtCore import QObject, Signal
 
 from ursim_core.errors import UrsimError
-from ursim_gui.dialogs import show_error
-from ursim_gui.model.jobs import MatchJob, SegmentJob
-from ursim_gui.workers import JobRunner
+from ursim_gui.jobs.runner import JobRunner
+from ursim_gui.model.jobs import MatchJob, SegmentJob, compiling_note
+from ursim_gui.views.messages import show_error
 
 __all__ = ["JobController", "MatchRequest"]
 
@@ -32,6 +32,10 @@ class JobController(QObject):
     """
 
     busy_changed = Signal(bool)
+    #: A job's result was applied to the session (SegmentJob or MatchJob).
+    applied = Signal(object)
+    #: Any other job finished: (job, result), for the code that queued it (see :meth:`submit`).
+    result_ready = Signal(object, object)
 
     def __init__(self, session, status_bar, parent_widget=None):
         super().__init__(parent_widget)
@@ -40,6 +44,7 @@ class JobController(QObject):
         self._parent = parent_widget
         self.runner = JobRunner(self)
         self._queue: deque = deque()
+        self._note = ""
         self.runner.progress.connect(self._progress)
         self.runner.finished.connect(self._finished)
         self.runner.failed.connect(self._failed)
@@ -112,7 +117,10 @@ class JobController(QObject):
             if job is None:
                 continue
             self._status.show_job(True)
-            self._status.showMessage(job.description + "…")
+            # Said for as long as the job runs: the first MAORIS run compiles for seconds.
+            self._note = compiling_note(job) or ""
+            self._status.progress_bar.setToolTip(self._note)
+            self._status.showMessage(job.description + "…" + (f"  {self._note}" if self._note else ""))
             self.runner.start(job)
             self.busy_changed.emit(True)
         if not self.busy:
@@ -129,8 +137,14 @@ class JobController(QObject):
             return None
         return MatchJob(sketch, metric, job.config)
 
+    def submit(self, job) -> None:
+        """Queue any other job (``run(progress, cancelled)``); its result comes as ``result_ready``."""
+        self._enqueue(job)
+
     def _is_stale(self, job) -> bool:
         """True when the inputs changed while the job ran (its result belongs to nothing now)."""
+        if not isinstance(job, (SegmentJob, MatchJob)):
+            return False
         if isinstance(job, SegmentJob):
             return self._session.map(job.side) is not job.map
         return (
@@ -146,14 +160,20 @@ class JobController(QObject):
         if isinstance(job, SegmentJob):
             self._session.set_segmentation(job.side, result)
             self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
-        else:
+        elif isinstance(job, MatchJob):
             self._session.apply_match(result)
             self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)
+        else:
+            self._status.showMessage(f"{job.description}: done", 5000)
+            self.result_ready.emit(job, result)
+            return
+        self.applied.emit(job)
 
     def _progress(self, fraction: float, message: str) -> None:
         job = self.runner.job
         prefix = f"{job.description}: " if job is not None and message else ""
-        self._status.show_progress(fraction, prefix + message)
+        suffix = f"  {self._note}" if message and self._note else ""
+        self._status.show_progress(fraction, prefix + message + suffix)
 
     def _finished(self, job, result) -> None:
         try:

@@ -16,7 +16,7 @@ __all__ = ["ConnectorOverlay"]
 
 
 class ConnectorOverlay(QWidget):
-    """Lines between region pairs of two :class:`~ursim_gui.map_view.MapView`.
+    """Lines between region pairs of two :class:`~ursim_gui.views.map_view.MapView`.
 
     Parameters
     ----------

@@ -12,12 +12,12 @@ import math
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QPainter, QPixmapCache
+from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QImage, QPainter, QPalette, QPixmapCache, QTransform
 from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
 
-from ursim_gui.map_items import ImageItem, grey_to_qimage
-from ursim_gui.region_layers import MIN_ID_REGION_PX, RegionLayers
+from ursim_gui.views.map_items import ImageItem, grey_to_qimage
+from ursim_gui.views.region_layers import MIN_ID_REGION_PX, RegionLayers
 
 __all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX"]
 
@@ -46,6 +46,8 @@ class MapView(QGraphicsView):
     zoom_changed = Signal(float)
     viewport_changed = Signal()
     files_dropped = Signal(list)
+    #: A left-button stroke in stroke mode: list of (row, col) map pixels, press to release.
+    stroke_drawn = Signal(list)
 
     def __init__(self, side: str, parent=None):
         super().__init__(parent)
@@ -61,7 +63,7 @@ class MapView(QGraphicsView):
         self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
         self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
         self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.SmartViewportUpdate)
-        self.setBackgroundBrush(QColor(236, 237, 240))
+        self._follow_palette()
         self.setMouseTracking(True)
         self.setAcceptDrops(True)
         self.viewport().setAcceptDrops(True)
@@ -72,6 +74,10 @@ class MapView(QGraphicsView):
         self._fitted = False
         self._press_pos = None
         self._panning = False
+        self._stroke: list[tuple[int, int]] | None = None
+        self.stroke_mode = False
+        #: (degrees counter-clockwise, mirrored) the map is shown at.
+        self.orientation = (0.0, False)
         self.placeholder = "Drop a map here or use the File menu"
         self.horizontalScrollBar().valueChanged.connect(self.viewport_changed)
         self.verticalScrollBar().valueChanged.connect(self.viewport_changed)
@@ -158,7 +164,29 @@ class MapView(QGraphicsView):
 
     # ---- zoom ----------------------------------------------------------------------
     def zoom_factor(self) -> float:
-        return self.transform().m11()
+        # The scale of the transform, whatever its rotation or mirror.
+        transform = self.transform()
+        if transform.m12() == 0.0:
+            return abs(transform.m11())  # exact when not turned (hypot would round)
+        return math.hypot(transform.m11(), transform.m12())
+
+    def set_orientation(self, angle: float, mirrored: bool) -> None:
+        """Show the map mirrored (left-right) and then turned ``angle`` degrees counter-clockwise.
+
+        Only the view turns: scene coordinates stay the image's pixels, so clicks and
+        points keep the original frame.
+        """
+        self.orientation = (float(angle), bool(mirrored))
+        self.setTransform(self._oriented(1.0))
+        self.fit_to_window()
+
+    def _oriented(self, factor: float) -> QTransform:
+        angle, mirrored = self.orientation
+        transform = QTransform()
+        if angle:
+            transform.rotate(-angle)  # Qt turns clockwise for a positive angle (y down)
+        transform.scale(-factor if mirrored else factor, factor)
+        return transform
 
     def set_zoom(self, factor: float, anchor: QPointF | None = None) -> None:
         """Zoom to ``factor`` (clamped to [fit / 4, 32]).
@@ -173,8 +201,8 @@ class MapView(QGraphicsView):
         self._fitted = False
         anchor = QPointF(self.viewport().rect().center()) if anchor is None else QPointF(anchor)
         fixed = self.mapToScene(anchor.toPoint())
-        step = factor / self.zoom_factor()
-        self.scale(step, step)
+        # Rebuilt from the orientation rather than scaled by a step: the factor is exact.
+        self.setTransform(self._oriented(factor))
         moved = self.mapFromScene(fixed) - anchor.toPoint()
         self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + moved.x())
         self.verticalScrollBar().setValue(self.verticalScrollBar().value() + moved.y())
@@ -191,6 +219,28 @@ class MapView(QGraphicsView):
             self.zoom_changed.emit(self.zoom_factor())
             self.viewport_changed.emit()
 
+    def zoom_to_regions(self, regions, *, margin: float = 0.25) -> bool:
+        """Zoom onto the bounding box of ``regions`` (graph ``bbox`` attributes), with a margin.
+
+        False when none of them is in the segmentation (the view is left as it is).
+        """
+        graph = self.layers.graph
+        boxes = [
+            graph.nodes[r]["bbox"] for r in regions if graph is not None and r in graph and "bbox" in graph.nodes[r]
+        ]
+        if not boxes:
+            return False
+        top, left = min(b[0] for b in boxes), min(b[1] for b in boxes)
+        bottom, right = max(b[2] for b in boxes), max(b[3] for b in boxes)
+        pad = margin * max(bottom - top, right - left, 10)
+        rect = QRectF(left - pad, top - pad, right - left + 2 * pad, bottom - top + 2 * pad)
+        self._fitted = False
+        self.fitInView(rect.intersected(self.sceneRect()), Qt.AspectRatioMode.KeepAspectRatio)
+        self.layers.cull_ids(self.zoom_factor())
+        self.zoom_changed.emit(self.zoom_factor())
+        self.viewport_changed.emit()
+        return True
+
     def _fit_factor(self) -> float:
         rect = self.sceneRect()
         if rect.isEmpty():
@@ -205,7 +255,17 @@ class MapView(QGraphicsView):
             self.set_zoom(self.zoom_factor() * _WHEEL_STEP**steps, event.position())
         event.accept()
 
+    def set_stroke_mode(self, on: bool) -> None:
+        """Left drags draw a stroke (``stroke_drawn``) instead of selecting or panning; middle still pans."""
+        self.stroke_mode = bool(on)
+        self._stroke = None
+        self.viewport().setCursor(Qt.CursorShape.CrossCursor) if on else self.viewport().unsetCursor()
+
     def mousePressEvent(self, event) -> None:
+        if self.stroke_mode and event.button() == Qt.MouseButton.LeftButton:
+            self._stroke = [self._pixel_at(event.position())]
+            event.accept()
+            return
         if event.button() in (Qt.MouseButton.LeftButton, Qt.MouseButton.MiddleButton):
             self._press_pos = event.position()
             self._panning = event.button() == Qt.MouseButton.MiddleButton
@@ -214,6 +274,13 @@ class MapView(QGraphicsView):
 
     def mouseMoveEvent(self, event) -> None:
         position = event.position()
+        if self._stroke is not None:
+            point = self._pixel_at(position)
+            if point != self._stroke[-1]:
+                self._stroke.append(point)
+            self._report_cursor(position)
+            event.accept()
+            return
         if self._press_pos is not None:
             moved = (position - self._press_pos).manhattanLength()
             if self._panning or moved >= QApplication.startDragDistance():
@@ -227,6 +294,11 @@ class MapView(QGraphicsView):
         event.accept()
 
     def mouseReleaseEvent(self, event) -> None:
+        if self._stroke is not None and event.button() == Qt.MouseButton.LeftButton:
+            stroke, self._stroke = self._stroke, None
+            self.stroke_drawn.emit(stroke)
+            event.accept()
+            return
         if self._press_pos is not None and not self._panning and event.button() == Qt.MouseButton.LeftButton:
             row, col = self._pixel_at(event.position())
             additive = bool(
@@ -270,12 +342,22 @@ class MapView(QGraphicsView):
             event.acceptProposedAction()
             self.files_dropped.emit(paths)
 
+    def _follow_palette(self) -> None:
+        # The area around the map follows the theme (a light grey on light, dark on dark).
+        window = self.palette().color(QPalette.ColorRole.Window)
+        self.setBackgroundBrush(window.darker(106) if window.lightness() > 128 else window.darker(130))
+
+    def changeEvent(self, event) -> None:
+        if event.type() == QEvent.Type.PaletteChange:
+            self._follow_palette()
+        super().changeEvent(event)
+
     def drawForeground(self, painter: QPainter, rect: QRectF) -> None:
         if self.has_image():
             return
         painter.save()
         painter.resetTransform()
-        painter.setPen(QColor(110, 110, 120))
+        painter.setPen(self.palette().color(QPalette.ColorRole.PlaceholderText))
         painter.drawText(self.viewport().rect(), Qt.AlignmentFlag.AlignCenter, self.placeholder)
         painter.restore()
 

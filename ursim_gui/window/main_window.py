@@ -11,23 +11,39 @@ import logging
 from pathlib import Path
 
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QApplication,
+    QDockWidget,
+    QLabel,
+    QMainWindow,
+    QScrollArea,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
 
-from ursim_gui.connectors import ConnectorOverlay
-from ursim_gui.document_controller import DocumentController
-from ursim_gui.edit_commands import EditCommands
-from ursim_gui.job_controller import JobController
-from ursim_gui.map_view import MapView
+from ursim_gui.jobs.controller import JobController
 from ursim_gui.model.session import AnnotationSession
+from ursim_gui.panels.agreement_panel import AgreementPanel
 from ursim_gui.panels.anchors_list import AnchorsList
+from ursim_gui.panels.campaign_panel import CampaignPanel
 from ursim_gui.panels.correspondence_table import CorrespondenceTable
 from ursim_gui.panels.evaluation_panel import EvaluationPanel
 from ursim_gui.panels.matching_panel import MatchingPanel
 from ursim_gui.panels.segmentation_panel import SegmentationPanel
-from ursim_gui.session_binding import SIDES, ViewBinding
-from ursim_gui.shortcuts import SHORTCUTS, ShortcutSheet, make_action
-from ursim_gui.status_bar import CursorStatusBar
-from ursim_gui.window_tools import WindowTools
+from ursim_gui.tools.segmentation_editor import SegmentationEditor
+from ursim_gui.views.connectors import ConnectorOverlay
+from ursim_gui.views.map_view import MapView
+from ursim_gui.views.session_binding import SIDES, ViewBinding
+from ursim_gui.views.status_bar import CursorStatusBar
+from ursim_gui.views.theme import apply_theme
+from ursim_gui.window.agreement_controller import AgreementController
+from ursim_gui.window.campaign_controller import CampaignController
+from ursim_gui.window.document_controller import DocumentController
+from ursim_gui.window.edit_commands import EditCommands
+from ursim_gui.window.preferences import Preferences
+from ursim_gui.window.shortcuts import SHORTCUTS, ShortcutSheet, make_action
+from ursim_gui.window.window_commands import WindowTools
 
 __all__ = ["MainWindow"]
 
@@ -51,6 +67,15 @@ _TOOLBAR = (
     "connectors",
 )
 _DISPLAY = ("outlines", "region_ids", "graph")
+#: Display toggles remembered between runs, with their first-run state.
+_TOGGLE_DEFAULTS = {
+    "dark_theme": False,
+    "outlines": True,
+    "region_ids": False,
+    "graph": False,
+    "connectors": False,
+    "link_zoom": False,
+}
 
 
 class MainWindow(QMainWindow):
@@ -67,7 +92,8 @@ class MainWindow(QMainWindow):
     def __init__(self, data_dir: Path, session: AnnotationSession | None = None):
         super().__init__()
         self.setObjectName("main_window")
-        self.session = session if session is not None else AnnotationSession()
+        self.preferences = Preferences(data_dir, self)
+        self.session = session if session is not None else AnnotationSession(annotator=self.preferences.annotator())
         self.actions = {spec.id: make_action(spec, self) for spec in SHORTCUTS}
         for action in self.actions.values():
             self.addAction(action)  # shortcuts work wherever the focus is in the window
@@ -84,12 +110,18 @@ class MainWindow(QMainWindow):
         self.table = CorrespondenceTable(self.session)
         self.anchors = AnchorsList(self.session)
         self.evaluation = EvaluationPanel(self.session)
+        self.campaign_panel = CampaignPanel()
+        self.agreement_panel = AgreementPanel()
         self._build_docks()
         self._build_menus()
         self._connect()
-        self.actions["outlines"].setChecked(True)
-        self.actions["connectors"].setChecked(False)
-        self.resize(1600, 980)
+        self.campaigns = CampaignController(self, self.campaign_panel, data_dir)
+        self.agreement = AgreementController(self, self.agreement_panel)
+        self._connect_review()
+        for name, default in _TOGGLE_DEFAULTS.items():
+            self.actions[name].setChecked(self.preferences.toggle(name, default))
+        if not self.preferences.restore_window(self):
+            self._fit_to_screen()
 
     # ---- layout ------------------------------------------------------------------------------
     def _build_centre(self) -> None:
@@ -138,10 +170,15 @@ class MainWindow(QMainWindow):
             "table": self._dock("Correspondences", self.table, bottom, "dock_table"),
             "evaluation": self._dock("Evaluation", self.evaluation, bottom, "dock_evaluation"),
             "anchors": self._dock("Anchors", self.anchors, bottom, "dock_anchors"),
+            "campaign": self._dock("Campaign", self.campaign_panel, right, "dock_campaign"),
+            "agreement": self._dock("Agreement", self.agreement_panel, bottom, "dock_agreement"),
         }
+        self.tabifyDockWidget(self.docks["evaluation"], self.docks["agreement"])
+        self.tabifyDockWidget(self.docks["segmentation"], self.docks["campaign"])
+        self.docks["segmentation"].raise_()
         self.tabifyDockWidget(self.docks["evaluation"], self.docks["anchors"])
         self.docks["evaluation"].raise_()
-        self.docks["segmentation"].setMinimumWidth(330)
+        self.docks["segmentation"].setMinimumWidth(300)
         self.resizeDocks([self.docks["table"]], [240], Qt.Orientation.Vertical)
         self.resizeDocks([self.docks["segmentation"], self.docks["matching"]], [620, 220], Qt.Orientation.Vertical)
         self.resizeDocks([self.docks["table"], self.docks["evaluation"]], [800, 380], Qt.Orientation.Horizontal)
@@ -160,6 +197,10 @@ class MainWindow(QMainWindow):
                 menu.addSeparator()
                 for dock in self.docks.values():
                     menu.addAction(dock.toggleViewAction())
+            if group == "File":
+                self.recent_menu = menu.addMenu("Open &recent")
+                self.recent_menu.setObjectName("recent_menu")
+                self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         toolbar = self.addToolBar("Main")
         toolbar.setObjectName("main_toolbar")
         toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
@@ -184,6 +225,7 @@ class MainWindow(QMainWindow):
         a["zoom_in"].triggered.connect(lambda: self._zoom_all(1.25))
         a["zoom_out"].triggered.connect(lambda: self._zoom_all(0.8))
         a["connectors"].toggled.connect(self.connectors.setVisible)
+        a["dark_theme"].toggled.connect(lambda on: apply_theme("dark" if on else "system"))
         a["outlines"].toggled.connect(lambda on: [v.set_outlines_visible(on) for v in self.views.values()])
         a["region_ids"].toggled.connect(lambda on: [v.set_ids_visible(on) for v in self.views.values()])
         a["graph"].toggled.connect(lambda on: [v.set_graph_visible(on) for v in self.views.values()])
@@ -202,6 +244,9 @@ class MainWindow(QMainWindow):
             box.segment_requested.connect(lambda s, preset, params: self.jobs.segment(s, preset, params))
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
+        self.matching_panel.orientation_changed.connect(
+            lambda o: self.views["sketch"].set_orientation(o.angle or 0.0, o.mirrored)
+        )
         self.evaluation.load_requested.connect(lambda: docs.load_reference())
         self.jobs.busy_changed.connect(lambda _busy: self._update_ready())
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
@@ -212,6 +257,63 @@ class MainWindow(QMainWindow):
         )
         self.tools = WindowTools(self)
         self._update_ready()
+
+    def _fill_recent_menu(self) -> None:
+        """Recent campaigns and correspondence files (from the preferences), newest first."""
+        menu = self.recent_menu
+        menu.clear()
+        for kind, opener in (("campaigns", self.campaigns.open), ("documents", self.documents.open_correspondences)):
+            for path in self.preferences.recent(kind):
+                menu.addAction(path, lambda path=path, opener=opener: opener(Path(path)))
+            menu.addSeparator()
+        if not menu.actions() or all(action.isSeparator() for action in menu.actions()):
+            menu.addAction("(none yet)").setEnabled(False)
+
+    def _connect_review(self) -> None:
+        a = self.actions
+        a["open_campaign"].triggered.connect(lambda: self.campaigns.open())
+        a["next_pair"].triggered.connect(self.campaigns.next)
+        a["prev_pair"].triggered.connect(self.campaigns.previous)
+        a["accept_next"].triggered.connect(self.accept_and_next)
+        a["zoom_clique"].triggered.connect(self.zoom_to_clique)
+        self.segmentation_editor = editor = SegmentationEditor(self.session, self.views, self)
+        modes = {"split_mode": "split", "paint_wall_mode": "paint_wall", "erase_wall_mode": "erase_wall"}
+        for action_id, mode in modes.items():
+            a[action_id].toggled.connect(lambda on, mode=mode: self._stroke_mode_toggled(mode, on))
+        editor.mode_changed.connect(lambda mode: [a[i].setChecked(modes[i] == mode) for i in modes])
+        a["clear_selection"].triggered.connect(lambda: editor.set_mode(""))
+        a["merge_regions"].triggered.connect(editor.merge_selected)
+        editor.message.connect(lambda text: self.statusBar().showMessage(text, 4000))
+
+    def _stroke_mode_toggled(self, mode: str, on: bool) -> None:
+        editor = self.segmentation_editor
+        if on:
+            editor.set_mode(mode)
+        elif editor.mode == mode:
+            editor.set_mode("")
+
+    def accept_and_next(self) -> None:
+        """Accept the selected clique, select the next one to review and zoom to it."""
+        if self.edits.accept_next() is not None:
+            self.zoom_to_clique()
+
+    def zoom_to_clique(self) -> None:
+        clique_id = self.session.selected_clique
+        if clique_id is None:
+            return
+        clique = self.session.clique(clique_id)
+        for side, view in self.views.items():
+            if not view.zoom_to_regions(getattr(clique, f"{side}_regions")):
+                view.fit_to_window()
+
+    def _fit_to_screen(self) -> None:
+        """First run: most of the screen, never more (1366x768 at a 1.5 scale factor included)."""
+        screen = self.screen() or QApplication.primaryScreen()
+        if screen is None:
+            self.resize(1280, 720)
+            return
+        available = screen.availableGeometry()
+        self.resize(min(1600, int(available.width() * 0.92)), min(980, int(available.height() * 0.9)))
 
     def _zoom_changed(self, side: str, factor: float) -> None:
         self.status.show_zoom(factor)
@@ -268,9 +370,14 @@ class MainWindow(QMainWindow):
         self.close()
 
     def closeEvent(self, event) -> None:
-        if not getattr(self, "_discard_on_close", False) and not self.documents.confirm_discard("closing"):
-            event.ignore()
-            return
+        if not getattr(self, "_discard_on_close", False):
+            if self.campaigns.campaign is not None and not self.campaigns.save_current():
+                event.ignore()
+                return
+            if not self.documents.confirm_discard("closing"):
+                event.ignore()
+                return
+        self.preferences.save_window(self, {name: self.actions[name].isChecked() for name in _TOGGLE_DEFAULTS})
         self.jobs.cancel()
         self.jobs.runner.shutdown()
         self.documents.close_document()

@@ -29,6 +29,13 @@ class ActionSpec:
 
 SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("new_sketch", "&New sketch…", ("Ctrl+N",), "Draw a sketch on a blank canvas", "File"),
+    ActionSpec(
+        "open_campaign",
+        "Open &campaign…",
+        ("Ctrl+Shift+O",),
+        "Open a dataset folder, a folder of sketches with one metric map, or a campaign manifest",
+        "File",
+    ),
     ActionSpec("open_sketch", "Open &sketch…", (), "Open the sketch map (image or ROS YAML)", "File"),
     ActionSpec("open_metric", "Open &metric map…", (), "Open the metric map (image or ROS YAML)", "File"),
     ActionSpec(
@@ -53,17 +60,51 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ),
     ActionSpec("unlink", "U&nlink region", ("U",), "Remove the selected region(s) from their cliques", "Edit"),
     ActionSpec("delete_clique", "&Delete clique", ("Delete",), "Delete the selected clique", "Edit"),
-    ActionSpec("accept", "&Accept clique", ("A",), "Mark the selected clique accepted", "Edit"),
+    ActionSpec("accept", "&Accept clique", ("Y",), "Mark the selected clique accepted", "Edit"),
+    ActionSpec(
+        "accept_next",
+        "Accept and &next clique",
+        ("Space",),
+        "Accept the selected clique, then select and zoom to the next one to review",
+        "Edit",
+    ),
     ActionSpec("reject", "Re&ject clique", ("R",), "Mark the selected clique rejected", "Edit"),
+    ActionSpec(
+        "relink",
+        "Re&link clique",
+        ("E",),
+        "Replace the selected clique's side by the region Ctrl+clicked last (fixes a wrong match)",
+        "Edit",
+    ),
+    ActionSpec("accept_all", "Accept a&ll", ("Ctrl+Shift+Y",), "Accept every clique not yet reviewed", "Edit"),
     ActionSpec("clear_selection", "Clear selection", ("Esc",), "Deselect all regions", "Edit"),
     ActionSpec("fit", "&Fit to window", ("F",), "Fit both maps to their views", "View"),
+    ActionSpec("zoom_clique", "&Zoom to clique", ("Z",), "Zoom both views to the selected clique", "View"),
     ActionSpec("zoom_in", "Zoom &in", ("Ctrl++", "Ctrl+="), "Zoom both views in", "View"),
     ActionSpec("zoom_out", "Zoom &out", ("Ctrl+-",), "Zoom both views out", "View"),
     ActionSpec("link_zoom", "&Linked zoom", ("Ctrl+K",), "Zoom both views together", "View", checkable=True),
     ActionSpec("connectors", "&Connector lines", ("C",), "Draw lines between matched regions", "View", checkable=True),
     ActionSpec("outlines", "Region &outlines", ("O",), "Show region outlines", "View", checkable=True),
     ActionSpec("region_ids", "Region &ids", ("I",), "Show region ids", "View", checkable=True),
+    ActionSpec("dark_theme", "&Dark theme", (), "Dark window and map backgrounds (remembered)", "View", checkable=True),
     ActionSpec("graph", "Adjacency &graph", ("G",), "Show the region adjacency graph", "View", checkable=True),
+    ActionSpec(
+        "merge_regions", "&Merge regions", ("M",), "Merge the regions selected on one map (Ctrl+click them)", "Segment"
+    ),
+    ActionSpec(
+        "split_mode", "&Split region", ("K",), "Draw a line across a region to cut it in two", "Segment", checkable=True
+    ),
+    ActionSpec("paint_wall_mode", "&Paint wall", ("W",), "Draw a wall stroke on a map", "Segment", checkable=True),
+    ActionSpec(
+        "erase_wall_mode",
+        "&Erase wall",
+        ("Shift+W",),
+        "Erase a wall stroke (joins it to the region around)",
+        "Segment",
+        checkable=True,
+    ),
+    ActionSpec("next_pair", "&Next pair", ("D",), "Save this pair and open the next one of the campaign", "Campaign"),
+    ActionSpec("prev_pair", "&Previous pair", ("A",), "Save this pair and open the previous one", "Campaign"),
     ActionSpec("shortcuts", "&Keyboard shortcuts", ("F1",), "This sheet", "Help"),
 )
 

@@ -1,6 +1,6 @@
 """Graphics items of a map view: numpy-backed image layers, labels and region outlines.
 
-Kept apart from :mod:`ursim_gui.map_view` so the view module only deals with
+Kept apart from :mod:`ursim_gui.views.map_view` so the view module only deals with
 interaction and layer bookkeeping.
 """
 
@@ -12,7 +12,7 @@ from PySide6.QtCore import QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QFont, QFontMetricsF, QImage, QPainter, QPainterPath, QPen
 from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem
 
-from ursim_gui.overlay import region_mask
+from ursim_gui.model.region_style import region_mask
 
 __all__ = [
     "ImageItem",

@@ -1,6 +1,6 @@
 """Main-window commands that open a tool or dialog: new sketch, label image, figure, inputs.
 
-Split from :mod:`ursim_gui.main_window` so that module stays pure composition.
+Split from :mod:`ursim_gui.window.main_window` so that module stays pure composition.
 """
 
 from __future__ import annotations
@@ -8,31 +8,22 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from PySide6.QtWidgets import QDialog, QFileDialog
+from PySide6.QtWidgets import QDialog
 
 from ursim_core.errors import UrsimError
-from ursim_gui import dialogs
-from ursim_gui.figure_export import export_figure
-from ursim_gui.sketch_canvas import SketchSizeDialog, SketchWindow
+from ursim_gui.model.example import example_inputs
+from ursim_gui.tools.sketch_canvas import SketchSizeDialog, SketchWindow
+from ursim_gui.views import file_dialogs
+from ursim_gui.views.figure_export import export_figure
+from ursim_gui.window import dialogs
 
-__all__ = ["WindowTools", "example_inputs"]
+__all__ = ["WindowTools"]
 
 _log = logging.getLogger(__name__)
 
 
-def example_inputs() -> tuple[Path, Path, Path | None] | None:
-    """(sketch, metric, reference) of the bundled example, or None when it is missing."""
-    from ursim_gui.app import EXAMPLE_DIR
-
-    sketch, metric = EXAMPLE_DIR / "sketch.png", EXAMPLE_DIR / "metric.png"
-    if not (sketch.is_file() and metric.is_file()):
-        return None
-    reference = EXAMPLE_DIR / "ground_truth.json"
-    return sketch, metric, reference if reference.is_file() else None
-
-
 class WindowTools:
-    """Commands of ``window`` (a :class:`~ursim_gui.main_window.MainWindow`)."""
+    """Commands of ``window`` (a :class:`~ursim_gui.window.main_window.MainWindow`)."""
 
     def __init__(self, window):
         self.window = window
@@ -71,12 +62,11 @@ class WindowTools:
             dialogs.show_error(self.window, "No map", f"Open the {side} map before its label image.")
             return False
         if path is None:
-            chosen, _ = QFileDialog.getOpenFileName(
-                self.window, f"Load {side} label image", "", "Label images (*.png *.tif *.tiff)"
+            path = file_dialogs.ask_open_path(
+                self.window, f"Load {side} label image", "Label images (*.png *.tif *.tiff)"
             )
-            if not chosen:
+            if path is None:
                 return False
-            path = Path(chosen)
         try:
             self.session.set_segmentation(side, load_label_image(path, shape=map_.shape))
         except (UrsimError, OSError) as error:
@@ -87,10 +77,9 @@ class WindowTools:
     # ---- figure and status --------------------------------------------------------------------
     def export_figure(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(self.window, "Export figure", "figure.png", "PNG image (*.png)")
-            if not chosen:
+            path = file_dialogs.ask_save_path(self.window, "Export figure", "figure.png", "PNG image (*.png)")
+            if path is None:
                 return False
-            path = Path(chosen)
         views = self.window.views
         try:
             export_figure(
@@ -151,7 +140,7 @@ class WindowTools:
         With ``wait`` the jobs run in this thread (False when one failed); else they are
         queued in the worker and True is returned at once.
         """
-        from ursim_gui.job_controller import MatchRequest
+        from ursim_gui.jobs.controller import MatchRequest
         from ursim_gui.model.jobs import SegmentJob
 
         jobs, panel = self.window.jobs, self.window.segmentation_panel

@@ -6,11 +6,11 @@ every rule about cliques (partners, TP/FP marks, misses) stays in the session.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from ursim_gui.overlay import NEUTRAL_REGION, Colour, region_colour_table
+from ursim_gui.model.region_style import NEUTRAL_REGION, Colour, region_colour_table
 
 __all__ = ["side_colour_table", "first_regions", "eval_badges"]
 
@@ -54,12 +54,24 @@ def first_regions(correspondences) -> list[tuple[int, int, int]]:
     ]
 
 
-def eval_badges(correspondences, side: str, status_of: Callable[[int], str | None]) -> dict[int, str]:
-    """'TP' / 'FP' tag per region of ``side``: on each marked clique's first region."""
+def eval_badges(
+    correspondences, side: str, status_of: Callable[[int], str | None], missed: Iterable = ()
+) -> dict[int, str]:
+    """'TP' / 'FP' tag per region of ``side`` on each marked clique's first region, then 'FN'.
+
+    ``missed`` holds the reference cliques no predicted pair hits, as (sketch regions,
+    metric regions); each gets 'FN' on its lowest region of ``side`` that has no tag yet,
+    so a miss is visible on the map and not only in the evaluation list.
+    """
     badges: dict[int, str] = {}
     for clique in correspondences.cliques:
         mark = status_of(clique.id)
         regions = getattr(clique, f"{side}_regions")
         if mark and regions:
             badges.setdefault(regions[0], mark.upper())
+    index = 0 if side == "sketch" else 1
+    for reference in missed:
+        free = sorted(region for region in reference[index] if region not in badges)
+        if free:
+            badges[free[0]] = "FN"
     return badges

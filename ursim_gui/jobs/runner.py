@@ -2,7 +2,7 @@
 
 A job is any picklable object with ``run(progress, cancelled)`` (see
 :mod:`ursim_gui.model.jobs`). :class:`JobRunner` runs one job at a time: a pool thread
-hands it to a child process (:class:`~ursim_gui.job_process.JobProcess`, so the GUI
+hands it to a child process (:class:`~ursim_gui.jobs.process.JobProcess`, so the GUI
 thread never waits for the interpreter lock) and relays progress and the outcome as
 signals delivered in the GUI thread (queued connections), so slots may touch widgets and
 the session. Cancel stops the child at once; a cancelled job's result is never applied.
@@ -18,7 +18,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
-from ursim_gui.job_process import JobProcess
+from ursim_gui.jobs.process import JobProcess
 
 __all__ = ["JobRunner"]
 

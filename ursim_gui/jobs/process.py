@@ -3,7 +3,7 @@
 Segmentation spends long stretches in C code that keeps Python's GIL (a single
 ``scipy.ndimage`` call can take a second on a big map), so a worker *thread* still
 freezes the window. A worker *process* cannot, and it can be stopped at once, which
-makes Cancel real. Qt-free: :mod:`ursim_gui.workers` calls :meth:`JobProcess.run` from
+makes Cancel real. Qt-free: :mod:`ursim_gui.jobs.runner` calls :meth:`JobProcess.run` from
 a worker thread and turns the outcome into Qt signals.
 
 Protocol over a pipe: the parent sends a job (any picklable object with

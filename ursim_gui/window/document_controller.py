@@ -12,11 +12,11 @@ import time
 from pathlib import Path
 
 from PySide6.QtCore import QObject, QTimer
-from PySide6.QtWidgets import QFileDialog
 
 from ursim_core.errors import UrsimError
-from ursim_gui import dialogs
 from ursim_gui.model.autosave import Autosaver, find_recoverable, recover
+from ursim_gui.views import file_dialogs
+from ursim_gui.window import dialogs
 
 __all__ = ["DocumentController", "MAP_FILTER", "JSON_FILTER", "DAT_FILTER"]
 
@@ -42,6 +42,7 @@ class DocumentController(QObject):
         self.autosave_timer.setInterval(1000)
         self.autosave_timer.timeout.connect(self.flush_autosave)
         self.autosave_timer.start()
+        self._autosave_failing = False
         session.dirty_changed.connect(lambda _dirty: self.update_title())
         session.path_changed.connect(lambda _path: self.update_title())
         session.error.connect(lambda message: dialogs.show_error(window, "Error", message))
@@ -53,28 +54,57 @@ class DocumentController(QObject):
         self.window.setWindowTitle(self.session.window_title())
 
     def flush_autosave(self) -> None:
+        """The timer's call. Any failure is logged each time and shown once per failing streak."""
         try:
-            self.autosaver.flush_if_due(time.monotonic())
-        except OSError as error:
-            # Autosave must never interrupt the user; log it and try again later.
-            _log.warning("autosave failed: %s", error)
+            written = self.autosaver.flush_if_due(time.monotonic())
+        except Exception as error:
+            # Whatever went wrong (disk, permissions, a value the codec refuses), the user
+            # must know the work is not backed up, but one box, not one per tick.
+            _log.warning("autosave failed: %s: %s", type(error).__name__, error)
+            if not self._autosave_failing:
+                self._autosave_failing = True
+                dialogs.show_error(
+                    self.window,
+                    "Autosave failed",
+                    f"The unsaved changes could not be backed up to {self.autosave_dir}:\n"
+                    f"{type(error).__name__}: {error}\n\nSave the document to keep them; autosave keeps retrying.",
+                )
+            return
+        if written:
+            self._autosave_failing = False
 
     # ---- opening -------------------------------------------------------------------------
     def _ask_open(self, title: str, filters: str) -> Path | None:
-        path, _ = QFileDialog.getOpenFileName(self.window, title, "", filters)
-        return Path(path) if path else None
+        return file_dialogs.ask_open_path(self.window, title, filters)
 
     def open_map(self, side: str, path: Path | None = None) -> bool:
-        """Open a map image or ROS YAML as ``side``'s map."""
+        """Open a map image or ROS YAML as ``side``'s map.
+
+        A map that is not the one the document names starts a new, untitled document
+        that keeps the other side's map (after asking about unsaved changes): the old
+        cliques, reference and file belong to the old pair, and saving must never write
+        them under the new map's name.
+        """
         path = path or self._ask_open(f"Open {side} map", MAP_FILTER)
-        return path is not None and self._try(f"Cannot open the {side} map", self.session.load_map, side, path)
+        if path is None:
+            return False
+        session = self.session
+        if not session.is_document_map(side, path):
+            if not self.confirm_discard(f"opening another {side} map"):
+                return False
+            other = "metric" if side == "sketch" else "sketch"
+            session.new_document(keep=[other])
+        return self._try(f"Cannot open the {side} map", session.load_map, side, path)
 
     def open_correspondences(self, path: Path | None = None) -> bool:
         """Open a correspondence JSON (and its maps), after offering to save changes."""
         if not self.confirm_discard("opening another file"):
             return False
         path = path or self._ask_open("Open correspondences", JSON_FILTER)
-        return path is not None and self._try("Cannot open the correspondences", self.session.open, path)
+        if path is None or not self._try("Cannot open the correspondences", self.session.open, path):
+            return False
+        self._remember(path)
+        return True
 
     def open_dropped(self, side: str, paths: list[Path]) -> None:
         """Files dropped on a view: a .json opens correspondences, anything else a map."""
@@ -101,27 +131,29 @@ class DocumentController(QObject):
 
     def save_as(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(
-                self.window, "Save correspondences", "correspondences.json", JSON_FILTER
-            )
-            if not chosen:
+            path = file_dialogs.ask_save_path(self.window, "Save correspondences", "correspondences.json", JSON_FILTER)
+            if path is None:
                 return False
-            path = Path(chosen)
         return self._save_to(path)
 
     def _save_to(self, path: Path | None) -> bool:
         if not self._try("Save failed", self.session.save, path):
             return False
         self.autosaver.discard()
+        self._remember(self.session.path)
         self.window.statusBar().showMessage(f"Saved {self.session.path}", 4000)
         return True
 
+    def _remember(self, path: Path) -> None:
+        preferences = getattr(self.window, "preferences", None)
+        if preferences is not None:
+            preferences.add_recent("documents", str(path))
+
     def export_dat(self, path: Path | None = None) -> bool:
         if path is None:
-            chosen, _ = QFileDialog.getSaveFileName(self.window, "Export .dat", "correspondences.dat", DAT_FILTER)
-            if not chosen:
+            path = file_dialogs.ask_save_path(self.window, "Export .dat", "correspondences.dat", DAT_FILTER)
+            if path is None:
                 return False
-            path = Path(chosen)
         return self._try("Export failed", self.session.export_dat, path)
 
     def confirm_discard(self, what: str) -> bool:

@@ -1,0 +1,302 @@
+"""An annotation campaign: the map pairs of a dataset, where each pair's file goes, and its status.
+
+Qt-free. A campaign comes from a dataset folder, a plain folder, or a small JSON manifest
+(:func:`open_campaign`); the window walks it pair by pair and saves each pair's
+correspondences under the naming rule below, so reopening the campaign restores every
+status (read back from the files) and the pair the user was on (the state file).
+
+Sources
+-------
+- A dataset folder in a layout :func:`ursim_core.evaluation.layouts.discover` knows
+  (``ursim_kth_sketches``, the Halmstad robot maps): one pair per experiment, named like it.
+- A plain folder of sketches with one metric map: the metric map is the one file named
+  ``metric.*`` (or the one ROS ``.yaml``); every other image is a sketch.
+- A manifest ``*.json``: ``{"metric": PATH, "sketches": [PATH, ...], "annotator": NAME,
+  "output": FOLDER, "references": {SKETCH_STEM: PATH}}``; relative paths are relative to
+  the manifest; only ``metric`` and ``sketches`` are required.
+
+Naming rule
+-----------
+Pair ``NAME``'s correspondences are ``<output>/NAME.json`` and the campaign state
+(position) is ``<output>/campaign.json``. ``<output>`` is the manifest's ``output``, else
+``<source folder>/ursim_annotations/<annotator>`` (``annotator`` = "anonymous" when the
+name is empty), else, when that folder cannot be written (a read-only dataset), the same
+path under the user data folder: ``<data>/campaigns/<source folder name>/<annotator>``.
+
+Statuses
+--------
+Read from a pair's file: "not started" (no file), "automatic" (only matcher output, none
+reviewed), "in review" (some cliques reviewed or edited), "done" (every clique accepted
+or rejected).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ursim_core.correspondences.codec import Correspondences, load_correspondences
+from ursim_core.errors import FormatError, UrsimError
+from ursim_core.io.atomic import atomic_write_bytes
+
+__all__ = [
+    "PAIR_STATUSES",
+    "STATE_FILE",
+    "CampaignPair",
+    "Campaign",
+    "open_campaign",
+    "status_of",
+    "pair_summary",
+    "summary_of",
+]
+
+PAIR_STATUSES = ("not started", "automatic", "in review", "done")
+STATE_FILE = "campaign.json"
+_IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".pgm", ".tif", ".tiff", ".bmp"}
+
+
+@dataclass(frozen=True)
+class CampaignPair:
+    """One sketch / metric pair of a campaign and the file its correspondences go to."""
+
+    name: str
+    sketch: Path
+    metric: Path
+    output: Path
+    reference: Path | None = None
+
+
+@dataclass
+class Campaign:
+    """The pairs, the annotator, the output folder and the current position."""
+
+    name: str
+    source: Path
+    pairs: tuple[CampaignPair, ...]
+    output_dir: Path
+    annotator: str = ""
+    current: int = 0
+    #: Other annotators' ground truth per pair name (annotator -> file), when the source has it.
+    ground_truth: dict[str, dict[str, Path]] = field(default_factory=dict)
+
+    @property
+    def state_path(self) -> Path:
+        return self.output_dir / STATE_FILE
+
+    def statuses(self) -> list[str]:
+        """Status of every pair, read from its file."""
+        return [status_of(pair.output) for pair in self.pairs]
+
+    def index_of(self, name: str) -> int:
+        return next(index for index, pair in enumerate(self.pairs) if pair.name == name)
+
+    def save_state(self) -> None:
+        """Write the position (atomically); the statuses live in the pairs' files."""
+        self.output_dir.mkdir(parents=True, exist_ok=True)
+        state = {"source": str(self.source), "annotator": self.annotator, "current": self.pairs[self.current].name}
+        atomic_write_bytes(self.state_path, (json.dumps(state, indent=2) + "\n").encode("utf-8"))
+
+    def _load_state(self) -> None:
+        try:
+            state = json.loads(self.state_path.read_text(encoding="utf-8"))
+            self.current = self.index_of(str(state["current"]))
+        except (OSError, ValueError, KeyError, TypeError, StopIteration):
+            self.current = 0  # no state yet, or one that names no pair: start at the top
+
+
+def status_of(path: Path) -> str:
+    """A pair's status from its correspondence file (see the module docstring)."""
+    return pair_summary(path)[0]
+
+
+def pair_summary(path: Path) -> tuple[str, int, int]:
+    """(status, cliques, reviewed cliques) of a pair's correspondence file."""
+    if not path.is_file():
+        return "not started", 0, 0
+    try:
+        corr = load_correspondences(path)
+    except UrsimError:
+        return "in review", 0, 0  # a file the user must look at
+    return summary_of(corr)
+
+
+def summary_of(corr: Correspondences) -> tuple[str, int, int]:
+    """(status, cliques, reviewed cliques) of a correspondence value."""
+    cliques = corr.cliques
+    reviewed = sum(clique.status is not None for clique in cliques)
+    if cliques and reviewed == len(cliques):
+        status = "done"
+    elif all(clique.source == "auto" and clique.status is None and not clique.note for clique in cliques):
+        status = "automatic"
+    else:
+        status = "in review"
+    return status, len(cliques), reviewed
+
+
+def open_campaign(
+    source: str | os.PathLike,
+    *,
+    annotator: str = "",
+    output_dir: str | os.PathLike | None = None,
+    data_dir: str | os.PathLike | None = None,
+) -> Campaign:
+    """Read a campaign from a dataset folder, a plain folder or a JSON manifest.
+
+    Parameters
+    ----------
+    source : path
+        Folder or ``*.json`` manifest (see the module docstring).
+    annotator : str, keyword-only
+        Whose annotations these are (names the output folder).
+    output_dir : path, keyword-only
+        Where the pairs' files go; overrides the naming rule's folder.
+    data_dir : path, keyword-only
+        The app's user data folder, the fallback for a read-only source.
+
+    Raises
+    ------
+    UrsimError
+        The source is not a campaign: the message names it and what is missing.
+    """
+    source = Path(source).expanduser().absolute()
+    manifest: dict = {}
+    if source.is_file():
+        manifest = _read_manifest(source)
+        annotator = annotator or str(manifest.get("annotator", ""))
+        folder = source.parent
+        pairs_in = _manifest_pairs(source, manifest)
+        name = source.stem
+    elif source.is_dir():
+        folder = source
+        pairs_in = _folder_pairs(source)
+        name = source.name
+    else:
+        raise FormatError(
+            "campaign not found: give a dataset folder, a folder of sketches or a manifest .json", path=source
+        )
+    if output_dir is None and manifest.get("output"):
+        output_dir = (folder / str(manifest["output"])).absolute()
+    if output_dir is None:
+        output_dir = _default_output(folder, annotator, data_dir)
+    output_dir = Path(output_dir)
+    pairs = tuple(
+        CampaignPair(
+            name=pair_name, sketch=sketch, metric=metric, output=output_dir / f"{pair_name}.json", reference=ref
+        )
+        for pair_name, sketch, metric, ref, _gt in pairs_in
+    )
+    if not pairs:
+        raise FormatError("the campaign has no map pairs", path=source)
+    campaign = Campaign(
+        name=name,
+        source=source,
+        pairs=pairs,
+        output_dir=output_dir,
+        annotator=annotator,
+        ground_truth={pair_name: gt for pair_name, _s, _m, _r, gt in pairs_in if gt},
+    )
+    campaign._load_state()
+    return campaign
+
+
+def _annotator_folder(annotator: str) -> str:
+    cleaned = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in annotator.strip())
+    return cleaned or "anonymous"
+
+
+def _default_output(folder: Path, annotator: str, data_dir) -> Path:
+    beside = folder / "ursim_annotations" / _annotator_folder(annotator)
+    if _writable(beside):
+        return beside
+    if data_dir is None:
+        from ursim_gui.model.autosave import default_autosave_folder
+
+        data_dir = default_autosave_folder().parent
+    return Path(data_dir) / "campaigns" / folder.name / _annotator_folder(annotator)
+
+
+def _writable(folder: Path) -> bool:
+    probe = folder
+    while not probe.exists():
+        if probe.parent == probe:
+            return False
+        probe = probe.parent
+    return probe.is_dir() and os.access(probe, os.W_OK | os.X_OK)
+
+
+def _read_manifest(path: Path) -> dict:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise FormatError(f"cannot read the campaign manifest: {error}", path=path) from error
+    if (
+        not isinstance(data, dict)
+        or not isinstance(data.get("metric"), str)
+        or not isinstance(data.get("sketches"), list)
+    ):
+        raise FormatError('a campaign manifest needs "metric" (a path) and "sketches" (a list of paths)', path=path)
+    return data
+
+
+def _manifest_pairs(path: Path, manifest: dict):
+    folder = path.parent
+    metric = (folder / manifest["metric"]).absolute()
+    references = manifest.get("references") or {}
+    pairs, seen = [], set()
+    for entry in manifest["sketches"]:
+        if not isinstance(entry, str):
+            raise FormatError('every entry of "sketches" must be a path', path=path, field="sketches")
+        sketch = (folder / entry).absolute()
+        name = _unique(sketch.stem, seen)
+        ref = references.get(sketch.stem) if isinstance(references, dict) else None
+        pairs.append((name, sketch, metric, (folder / ref).absolute() if isinstance(ref, str) else None, {}))
+    return pairs
+
+
+def _folder_pairs(folder: Path):
+    from ursim_core.evaluation.layouts import discover
+
+    try:
+        experiments = discover(folder)
+    except UrsimError:
+        experiments = None
+    if experiments:
+        pairs, seen = [], set()
+        for experiment in experiments:
+            name = _unique(experiment.name, seen)
+            pairs.append((name, experiment.sketch, experiment.metric, None, dict(experiment.ground_truth)))
+        return pairs
+    files = sorted(
+        p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in _IMAGE_SUFFIXES | {".yaml", ".yml"}
+    )
+    metrics = [p for p in files if p.stem.lower() == "metric"] or [
+        p for p in files if p.suffix.lower() in (".yaml", ".yml")
+    ]
+    if len(metrics) != 1:
+        raise FormatError(
+            "not a dataset layout, and not a plain campaign folder: it needs exactly one metric map "
+            f"(named metric.* or one ROS .yaml), found {len(metrics)}",
+            path=folder,
+        )
+    metric = metrics[0]
+    image_of_yaml = (
+        {metric.with_suffix(suffix) for suffix in _IMAGE_SUFFIXES}
+        if metric.suffix.lower() in (".yaml", ".yml")
+        else set()
+    )
+    seen: set[str] = set()
+    return [
+        (_unique(p.stem, seen), p, metric, None, {})
+        for p in files
+        if p != metric and p not in image_of_yaml and p.suffix.lower() in _IMAGE_SUFFIXES
+    ]
+
+
+def _unique(name: str, seen: set[str]) -> str:
+    candidate, index = name, 2
+    while candidate in seen:
+        candidate, index = f"{name}_{index}", index + 1
+    seen.add(candidate)
+    return candidate
