@@ -10,7 +10,7 @@ import pytest
 from conftest import scaled
 from PySide6.QtCore import Qt
 
-from ursim_core.correspondences.codec import Clique, Correspondences, load_correspondences, save_correspondences
+from ursim_core.correspondences import Clique, Correspondences, load_correspondences, save_correspondences
 from ursim_gui.model.agreement import agreement_csv, pair_agreement, pooled
 from ursim_gui.views import file_dialogs
 from ursim_gui.window.main_window import MainWindow

@@ -10,7 +10,7 @@ import pytest
 from conftest import region_point, scaled
 from PySide6.QtCore import Qt
 
-from ursim_core.correspondences.codec import load_correspondences
+from ursim_core.correspondences import load_correspondences
 from ursim_core.errors import FormatError
 from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 from ursim_gui.model.campaign import open_campaign, pair_summary

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from ursim_core.correspondences.codec import Clique, Correspondences, save_correspondences, save_dat
+from ursim_core.correspondences import Clique, Correspondences, save_correspondences, save_dat
 from ursim_gui.views import file_dialogs
 
 

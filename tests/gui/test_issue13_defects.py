@@ -13,7 +13,7 @@ import pytest
 from conftest import region_point
 from PySide6.QtCore import Qt
 
-from ursim_core.correspondences.codec import Clique, Correspondences, load_dat, save_correspondences
+from ursim_core.correspondences import Clique, Correspondences, load_dat, save_correspondences
 from ursim_gui.views import file_dialogs
 from ursim_gui.window import dialogs
 

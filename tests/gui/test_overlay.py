@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from conftest import three_room_labels
 
-from ursim_core.correspondences.codec import Clique, Correspondences
+from ursim_core.correspondences import Clique, Correspondences
 from ursim_core.segmentation.graph import region_graph
 from ursim_gui.model.region_style import (
     NEUTRAL_REGION,

@@ -11,7 +11,7 @@ from conftest import error_boxes, simulate_crash
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QApplication, QMessageBox
 
-from ursim_core.correspondences.codec import load_correspondences, load_dat
+from ursim_core.correspondences import load_correspondences, load_dat
 from ursim_gui.views import file_dialogs
 from ursim_gui.window import dialogs
 from ursim_gui.window.main_window import MainWindow

@@ -186,8 +186,9 @@ def segment_canonical(
 
     Same parameters and result as :func:`~ursim_core.segmentation.segment` (labels in the
     map's own pixel frame), plus ``min_angle``: the smallest wall-direction offset, in degrees,
-    for which the map is turned before segmenting. ``Segmentation.params`` records the pose
-    under the key ``"_pose"``.
+    for which the map is turned before segmenting. ``Segmentation.params`` holds the resolved
+    parameters and ``"canonical": True``, so ``segment(map, params=seg.params)`` gives the same
+    segmentation again.
 
     Examples
     --------
@@ -220,15 +221,10 @@ def segment_canonical(
         ).astype(np.int32)
         labels[~free] = 0
         labels = _renumber(labels)
-    pose = {
-        "degrees": round(-angle, 6) if matrix is not None else 0.0,
-        "quarter_turns": quarter_turns,
-        "mirrored": mirrored,
-    }
     return Segmentation(
         labels=labels,
         graph=region_graph(labels),
         method=inner.method,
-        params={**inner.params, "_pose": pose},
+        params={**inner.params, "canonical": True},
         source=inner.source,
     )

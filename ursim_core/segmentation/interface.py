@@ -103,9 +103,22 @@ def resolve_params(
     --------
     >>> resolve_params("maoris", "robot", {"doors": 60})["doors"]
     60
+
+    ``canonical`` (True: segment in the map's canonical pose, see
+    :mod:`ursim_core.segmentation.canonical`) is a parameter of every method; it is kept in the
+    result only when True, so earlier parameter dicts stay as they were.
     """
     from ursim_core.errors import ParameterError
 
+    params = dict(params or {})
+    canonical = params.pop("canonical", False)
+    if canonical not in (True, False):
+        raise ParameterError(f"must be true or false, not {canonical!r}", field="canonical")
+    resolved = _resolve_method_params(method, preset, params, ParameterError)
+    return {**resolved, "canonical": True} if canonical else resolved
+
+
+def _resolve_method_params(method, preset, params, ParameterError) -> dict[str, Any]:
     if method not in SEGMENTERS:
         raise ParameterError(f"unknown segmentation method '{method}' (known: {', '.join(sorted(SEGMENTERS))})")
     if method == "watershed":
@@ -159,6 +172,10 @@ def segment(
 
     free = getattr(map_or_free, "free", map_or_free)
     resolved = resolve_params(method, preset, params)
+    if resolved.pop("canonical", False):
+        from ursim_core.segmentation.canonical import segment_canonical
+
+        return segment_canonical(map_or_free, method=method, preset=None, params=resolved)
     labels = np.asarray(SEGMENTERS[method](np.asarray(free, dtype=bool), **resolved), dtype=np.int32)
     return Segmentation(labels=labels, graph=region_graph(labels), method=method, params=resolved)
 

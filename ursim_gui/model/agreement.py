@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from itertools import product
 from pathlib import Path
 
-from ursim_core.correspondences.codec import Correspondences, load_correspondences, load_dat, regions_at_points
+from ursim_core.correspondences import Correspondences, load_correspondences, load_dat, regions_at_points
 from ursim_core.io.atomic import atomic_write_bytes
 
 __all__ = [

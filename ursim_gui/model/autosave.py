@@ -32,7 +32,7 @@ import uuid
 from collections.abc import Callable
 from pathlib import Path
 
-from ursim_core.correspondences.codec import Correspondences, load_correspondences, save_correspondences
+from ursim_core.correspondences import Correspondences, load_correspondences, save_correspondences
 from ursim_core.io.atomic import atomic_write_bytes
 from ursim_gui.model.session import AUTOSAVE_ORIGIN_KEY, AnnotationSession
 

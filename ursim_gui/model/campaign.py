@@ -37,7 +37,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ursim_core.correspondences.codec import Correspondences, load_correspondences
+from ursim_core.correspondences import Correspondences, load_correspondences
 from ursim_core.errors import FormatError, UrsimError
 from ursim_core.io.atomic import atomic_write_bytes
 

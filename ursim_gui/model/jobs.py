@@ -79,7 +79,10 @@ class SegmentJob:
         A key of ``ursim_core.segmentation.SEGMENTERS``.
     side : str, optional
         'sketch' or 'metric': carried along so the code receiving the result knows
-        where it belongs (the job itself does not use it).
+        where it belongs; a sketch is segmented in its canonical pose (below).
+    canonical : bool, optional
+        For ``side='sketch'``: segment in the canonical pose, as ``ursim match`` does (the
+        matcher does not assume the sketch's orientation). Default True.
 
     Examples
     --------
@@ -99,12 +102,14 @@ class SegmentJob:
         *,
         method: str = "maoris",
         side: str | None = None,
+        canonical: bool = True,
     ) -> None:
         self.map = map
         self.preset = preset
         self.params = dict(params or {})
         self.method = method
         self.side = side
+        self.canonical = canonical
 
     @property
     def description(self) -> str:
@@ -130,7 +135,12 @@ class SegmentJob:
         resolve_params(self.method, self.preset, self.params)
         _check(cancelled, "segmentation")
         progress(0.05, "segmenting")
-        segmentation = segment(self.map, method=self.method, preset=self.preset, params=self.params)
+        params = dict(self.params or {})
+        if self.side == "sketch" and self.canonical:
+            # As the CLI: a sketch whose orientation the matcher does not assume is segmented in
+            # its canonical pose (ursim_core.segmentation.canonical), recorded in its parameters.
+            params.setdefault("canonical", True)
+        segmentation = segment(self.map, method=self.method, preset=self.preset, params=params)
         _check(cancelled, "segmentation")
         progress(1.0, f"{segmentation.n_regions} regions")
         return segmentation

@@ -6,7 +6,7 @@ directly.
 
 Design
 ------
-- The correspondences are one immutable :class:`~ursim_core.correspondences.codec.Correspondences`
+- The correspondences are one immutable :class:`~ursim_core.correspondences.Correspondences`
   value. Every edit builds a new value and records ``(description, before, after)`` in a
   :class:`~ursim_gui.model.history.History`, so undo/redo restore exact values.
 - ``dirty`` is not a flag that edits set: it is ``correspondences != saved value``, so
@@ -26,7 +26,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from ursim_core.correspondences.codec import Clique, Correspondences, MapRef, utc_timestamp
+from ursim_core.correspondences import Clique, Correspondences, MapRef, utc_timestamp
 from ursim_core.errors import SegmentationError
 from ursim_gui.model.history import History
 from ursim_gui.model.session_documents import DocumentOperations

@@ -11,7 +11,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from ursim_core.correspondences.codec import (
+from ursim_core.correspondences import (
     Correspondences,
     MapRef,
     load_correspondences,

@@ -10,7 +10,7 @@ import dataclasses
 from collections.abc import Iterable
 from itertools import product
 
-from ursim_core.correspondences.codec import STATUSES, Clique, from_pairs, regions_at_points
+from ursim_core.correspondences import STATUSES, Clique, from_pairs, regions_at_points
 from ursim_gui.model.session_values import REFERENCE_TOLERANCE, SIDES, _check_side, _regions_text
 
 __all__ = ["EditOperations"]

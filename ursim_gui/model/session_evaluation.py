@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from itertools import product
 
-from ursim_core.correspondences.codec import load_correspondences, load_dat, regions_at_points
+from ursim_core.correspondences import load_correspondences, load_dat, regions_at_points
 from ursim_gui.model.session_values import REFERENCE_TOLERANCE, SIDES, _absolute
 
 __all__ = ["EvaluationOperations"]

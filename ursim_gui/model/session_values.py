@@ -8,7 +8,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from ursim_core.correspondences.codec import Correspondences, regions_at_points
+from ursim_core.correspondences import Correspondences, regions_at_points
 from ursim_core.matching import MATCH_PRESETS
 
 __all__ = [
@@ -73,7 +73,7 @@ def _regions_text(regions: Iterable[int]) -> str:
 def _with_side_regions(corr: Correspondences, side: str, labels) -> Correspondences:
     """Re-derive one side's region ids of every clique from its points.
 
-    Same rule as :func:`ursim_core.correspondences.codec.assign_regions` (ids under the points,
+    Same rule as :func:`ursim_core.correspondences.assign_regions` (ids under the points,
     tolerance 10, duplicates and dropped points left out, point order), for one side only,
     because the other side may not be segmented yet.
     """

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import simulate_crash
 
-from ursim_core.correspondences.codec import load_correspondences
+from ursim_core.correspondences import load_correspondences
 from ursim_core.segmentation import Segmentation, load_label_image, save_label_image
 from ursim_core.segmentation.graph import region_graph
 from ursim_gui.model.autosave import (

@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ursim_core.correspondences.codec import (
+from ursim_core.correspondences import (
     Clique,
     Correspondences,
     MapRef,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ursim_core.correspondences.codec import load_correspondences
+from ursim_core.correspondences import load_correspondences
 from ursim_core.io.maps import map_from_array
 from ursim_core.segmentation import Segmentation
 from ursim_core.segmentation.graph import region_graph
