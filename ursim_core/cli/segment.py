@@ -118,8 +118,7 @@ def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: 
     ``canonical``: in the map's canonical pose (:mod:`ursim_core.segmentation.canonical`), for a
     sketch whose orientation the matcher does not assume.
     """
-    from ursim_core.segmentation import segment
-    from ursim_core.segmentation.canonical import segment_canonical
+    from ursim_core.segmentation import segment, segment_canonical
 
     announce_kernel_compilation()
     segmenter = segment_canonical if canonical else segment

@@ -96,7 +96,7 @@ def segment_job(job: SegmentationJob):
 
         the_map = transform_map(the_map, job.orientation)
     if job.canonical:
-        from ursim_core.segmentation.canonical import segment_canonical
+        from ursim_core.segmentation import segment_canonical
 
         return segment_canonical(the_map, preset=job.preset)
     return segment(the_map, preset=job.preset)

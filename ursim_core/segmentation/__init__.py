@@ -27,6 +27,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "interface": [
             "Segmentation",
             "SEGMENTERS",
+            "segment_canonical",
             "DEFAULT_SEGMENTERS",
             "segment",
             "resolve_params",

@@ -3,7 +3,9 @@
 MAORIS walks the image in raster order, so the same sketch turned by 90 degrees or mirrored can
 come out with another number of regions, and region ids always follow the raster order. A sketch
 can be drawn in any orientation, and the user expects the same regions whichever way it lies.
-:func:`segment_canonical` therefore
+
+:func:`canonical_labels` (and :func:`ursim_core.segmentation.segment_canonical`, the same with a
+registered segmenter, or ``segment(..., params={"canonical": True})``)
 
 1. turns the map so that its dominant wall direction is along the image axes (only when it is
    off by more than ``min_angle`` degrees: resampling costs detail),
@@ -20,11 +22,10 @@ Points clicked on the map keep their meaning: the returned labels are in the ori
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
-__all__ = ["wall_angle", "canonical_pose", "segment_canonical", "dihedral"]
+__all__ = ["wall_angle", "canonical_pose", "canonical_labels", "dihedral"]
 
 # Contours are simplified to polygons with this tolerance (pixels) before their edge directions are
 # taken: pixel staircases of a straight wall would otherwise vote for 0 and 90 degrees.
@@ -174,42 +175,33 @@ def _turned(free: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
     return image >= 128, matrix
 
 
-def segment_canonical(
-    map_or_free,
-    *,
-    method: str = "maoris",
-    preset: str | None = "sketch",
-    params: dict[str, Any] | None = None,
-    min_angle: float = _MIN_ANGLE,
-):
-    """:func:`ursim_core.segmentation.segment` made independent of the map's orientation.
+def canonical_labels(free: np.ndarray, labels_of, *, min_angle: float = _MIN_ANGLE) -> np.ndarray:
+    """Label ``free`` in its canonical pose with ``labels_of`` and bring the labels back.
 
-    Same parameters and result as :func:`~ursim_core.segmentation.segment` (labels in the
-    map's own pixel frame), plus ``min_angle``: the smallest wall-direction offset, in degrees,
-    for which the map is turned before segmenting. ``Segmentation.params`` holds the resolved
-    parameters and ``"canonical": True``, so ``segment(map, params=seg.params)`` gives the same
-    segmentation again.
+    ``labels_of(free) -> labels`` is any segmenter on a free-space mask. The result is in
+    ``free``'s own pixel frame, ids 1..N in the raster order of the canonical image, so every
+    quarter turn or mirror image of a map gets the same regions with the same ids.
+    ``min_angle``: the smallest wall-direction offset, in degrees, for which the map is turned
+    before it is labelled. :func:`ursim_core.segmentation.segment_canonical` is this with a
+    registered segmenter.
 
     Examples
     --------
     >>> free = np.zeros((100, 170), bool)  # a large and a small room joined by a corridor
     >>> free[10:90, 10:70] = free[30:70, 100:150] = free[45:55, 70:100] = True
-    >>> a = segment_canonical(free, preset="default")
-    >>> b = segment_canonical(np.rot90(free), preset="default")
-    >>> np.array_equal(np.rot90(a.labels), b.labels)
+    >>> first_column = lambda f: (np.cumsum(f, axis=1) == 1).astype(np.int32)  # any labelling
+    >>> a = canonical_labels(free, first_column)
+    >>> np.array_equal(np.rot90(a), canonical_labels(np.rot90(free), first_column))
     True
     """
     import cv2
 
-    from ursim_core.segmentation.graph import region_graph
-    from ursim_core.segmentation.interface import Segmentation, segment
-
-    free = np.asarray(getattr(map_or_free, "free", map_or_free)) != 0
+    free = np.asarray(free) != 0
     angle = wall_angle(free)
     work, matrix = (free, None) if abs(angle) < min_angle else _turned(free, -angle)
     quarter_turns, mirrored = canonical_pose(work)
-    inner = segment(dihedral(work, quarter_turns, mirrored), method=method, preset=preset, params=params)
-    labels = _undo_dihedral(inner.labels, quarter_turns, mirrored)
+    inner = np.asarray(labels_of(dihedral(work, quarter_turns, mirrored)), dtype=np.int32)
+    labels = _undo_dihedral(inner, quarter_turns, mirrored)
     if matrix is not None:
         inverse = cv2.invertAffineTransform(matrix)
         labels = cv2.warpAffine(
@@ -221,10 +213,4 @@ def segment_canonical(
         ).astype(np.int32)
         labels[~free] = 0
         labels = _renumber(labels)
-    return Segmentation(
-        labels=labels,
-        graph=region_graph(labels),
-        method=inner.method,
-        params={**inner.params, "canonical": True},
-        source=inner.source,
-    )
+    return labels

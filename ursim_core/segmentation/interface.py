@@ -22,6 +22,7 @@ __all__ = [
     "SEGMENTERS",
     "DEFAULT_SEGMENTERS",
     "segment",
+    "segment_canonical",
     "resolve_params",
     "read_label_array",
     "load_label_image",
@@ -170,14 +171,42 @@ def segment(
     """
     from ursim_core.segmentation.graph import region_graph
 
-    free = getattr(map_or_free, "free", map_or_free)
+    free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
     resolved = resolve_params(method, preset, params)
-    if resolved.pop("canonical", False):
-        from ursim_core.segmentation.canonical import segment_canonical
+    settings = {name: value for name, value in resolved.items() if name != "canonical"}
+    if resolved.get("canonical"):
+        from ursim_core.segmentation.canonical import canonical_labels
 
-        return segment_canonical(map_or_free, method=method, preset=None, params=resolved)
-    labels = np.asarray(SEGMENTERS[method](np.asarray(free, dtype=bool), **resolved), dtype=np.int32)
+        labels = canonical_labels(free, lambda pose: SEGMENTERS[method](pose, **settings))
+    else:
+        labels = np.asarray(SEGMENTERS[method](free, **settings), dtype=np.int32)
     return Segmentation(labels=labels, graph=region_graph(labels), method=method, params=resolved)
+
+
+def segment_canonical(
+    map_or_free: Any,
+    *,
+    method: str = "maoris",
+    preset: str | None = "sketch",
+    params: dict[str, Any] | None = None,
+) -> Segmentation:
+    """:func:`segment` in the map's canonical pose: the same regions however the map is turned.
+
+    For sketches, whose orientation the matcher does not assume; see
+    :mod:`ursim_core.segmentation.canonical`. Labels are in the map's own pixel frame;
+    ``params`` of the result hold ``"canonical": True`` so that ``segment`` with them gives the
+    same segmentation again.
+
+    Examples
+    --------
+    >>> free = np.zeros((100, 170), bool)  # a large and a small room joined by a corridor
+    >>> free[10:90, 10:70] = free[30:70, 100:150] = free[45:55, 70:100] = True
+    >>> a = segment_canonical(free, preset="default")
+    >>> b = segment_canonical(np.rot90(free), preset="default")
+    >>> np.array_equal(np.rot90(a.labels), b.labels), a.params["canonical"]
+    (True, True)
+    """
+    return segment(map_or_free, method=method, preset=preset, params={**(params or {}), "canonical": True})
 
 
 def read_label_array(path: str | Path) -> np.ndarray:

@@ -29,8 +29,8 @@ from ursim_core.evaluation.kth_protocol import f1_table, kth_pairs, summarise
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.io import load_map
 from ursim_core.matching import M_GRID, MatchConfig, match
-from ursim_core.segmentation import segment
-from ursim_core.segmentation.canonical import dihedral, segment_canonical
+from ursim_core.segmentation import segment, segment_canonical
+from ursim_core.segmentation.canonical import dihedral
 
 pytestmark = [pytest.mark.dataset, pytest.mark.slow]
 ORIENTATIONS = [(k, m) for m in (False, True) for k in range(4)]

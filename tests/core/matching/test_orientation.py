@@ -13,7 +13,8 @@ from ursim_core.errors import ParameterError
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match, prepare
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph, transform_points
-from ursim_core.segmentation.canonical import _turned, canonical_pose, dihedral, segment_canonical, wall_angle
+from ursim_core.segmentation import segment_canonical
+from ursim_core.segmentation.canonical import _turned, canonical_pose, dihedral, wall_angle
 from ursim_core.synth import ground_truth_correspondences, make_pair
 
 
