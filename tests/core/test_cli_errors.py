@@ -168,10 +168,10 @@ def test_match_reference_prints_pair_scores_and_place_accuracy(files, capsys):
 
 def test_first_run_says_the_kernels_are_compiling(tmp_path, monkeypatch, capsys):
     import ursim_core.cli.common as common
-    from ursim_core.segmentation import maoris
+    from ursim_core.segmentation.maoris import kernel_cache
 
     monkeypatch.setattr(common, "_announced", False)
-    monkeypatch.setattr(maoris, "kernels_cached", lambda: False, raising=False)
+    monkeypatch.setattr(kernel_cache, "kernels_cached", lambda: False)
     rooms = two_rooms(tmp_path / "rooms.png")
     assert main(["segment", str(rooms), str(rooms), "--preset", "default", "-o", str(tmp_path / "out")]) == 0
     err = capsys.readouterr().err

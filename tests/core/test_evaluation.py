@@ -349,17 +349,18 @@ def test_progress_counts_every_step_and_caches_are_used(synthetic_dataset, tmp_p
     first = run_evaluation(
         synthetic_dataset, progress=lambda done, total, text: calls.append((done, total, text)), **options
     )
-    # distinct maps (+ the model's place-accuracy reference) + (experiment x variant) tasks + human vs human
-    total = 3 + 2 * 2 + 1
+    # distinct maps (the sketch with the model's bytes is segmented in its canonical pose, the model as
+    # it is; + the model's place-accuracy reference) + (experiment x variant) tasks + human vs human
+    total = 4 + 2 * 2 + 1
     assert [c[0] for c in calls] == list(range(1, total + 1)) and {c[1] for c in calls} == {total}
     assert any(text.startswith("segment") for _, _, text in calls) and calls[-1][2] == "human vs human"
-    assert first.timings["maps_from_cache"] == 0 and len(cache) == 3
-    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 3
+    assert first.timings["maps_from_cache"] == 0 and len(cache) == 4
+    assert len(list((tmp_path / "segcache").glob("*.npz"))) == 4
 
     in_memory = run_evaluation(synthetic_dataset, **options)
-    assert in_memory.timings["maps_from_cache"] == 3
+    assert in_memory.timings["maps_from_cache"] == 4
     on_disk = run_evaluation(synthetic_dataset, **{**options, "segmentation_cache": None})
-    assert on_disk.timings["maps_from_cache"] == 3
+    assert on_disk.timings["maps_from_cache"] == 4
     assert [r.f1 for r in on_disk.rows] == [r.f1 for r in first.rows]
 
 
@@ -491,7 +492,7 @@ def test_disk_cache_misses_when_a_map_changes(synthetic_dataset, tmp_path):
     run_evaluation(dataset, **options)
     Image.fromarray(_plan(1.2)).save(dataset / "sketches" / "small.png")
     again = run_evaluation(dataset, **options)
-    assert again.timings["maps"] == 3 and again.timings["maps_from_cache"] == 2
+    assert again.timings["maps"] == 4 and again.timings["maps_from_cache"] == 3
 
 
 def test_an_exception_in_progress_stops_the_worker_pool(synthetic_dataset):
