@@ -17,7 +17,6 @@ from ursim_core.correspondences import (
     Correspondences,
     MapRef,
     assign_regions,
-    assignment,
     correspondences_schema,
     from_pairs,
     json_codec,
@@ -640,14 +639,16 @@ def test_regions_at_points_edge_inputs():
 
 
 def test_many_points_give_a_nearest_region_like_brute_force(monkeypatch):
+    from scipy import ndimage
+
     transforms = []
-    real_transform = assignment.ndimage.distance_transform_edt
+    real_transform = ndimage.distance_transform_edt
 
     def counting_transform(*args, **kwargs):
         transforms.append(1)
         return real_transform(*args, **kwargs)
 
-    monkeypatch.setattr(assignment.ndimage, "distance_transform_edt", counting_transform)
+    monkeypatch.setattr(ndimage, "distance_transform_edt", counting_transform)
     generator = np.random.default_rng(7)
     labels = np.zeros((60, 80), dtype=np.int32)
     for region in range(1, 9):

@@ -14,7 +14,6 @@ import warnings
 from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
-from scipy import ndimage
 
 from ursim_core.correspondences.values import Clique, Correspondences
 from ursim_core.errors import RegionsRecomputedWarning, SegmentationError
@@ -82,6 +81,8 @@ def regions_at_points(labels: np.ndarray, points: Iterable, *, tolerance: float 
     if len(misses) * (window_area + 4000) > 15 * labels.size:
         # Many misses or a large tolerance: one distance transform answers all
         # points inside the image at once.
+        from scipy import ndimage  # 0.4 s to import: only when a point is off every region
+
         distance, (nearest_row, nearest_col) = ndimage.distance_transform_edt(labels == 0, return_indices=True)
         inside_misses = misses[inside[misses]]
         miss_rows, miss_cols = coordinates[inside_misses, 0], coordinates[inside_misses, 1]

@@ -98,7 +98,17 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
         base if index == 0 else _reoriented(base, sketch_graph, candidate) for index, candidate in enumerate(candidates)
     ]
     finalists = range(len(candidates))
-    if config.m == "auto" and len(candidates) > _FINALISTS and len(config.m_grid) > 2 * _COARSE_STEP:
+    if max(base.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
+        # Large graphs: one planar sweep costs seconds, so the orientation is chosen by how well
+        # every region finds a close partner (mean of the row and column minima of c: all
+        # regions vote, and positions dominate c there). O(n1 n2), no matching.
+        def partner_cost(prepared: Prepared) -> float:
+            c_matrix = prepared.c_matrix
+            return float(c_matrix.min(axis=1).mean() + c_matrix.min(axis=0).mean())
+
+        costs = [(partner_cost(prepared), index) for index, prepared in enumerate(prepared_candidates)]
+        finalists = [min(costs)[1]]
+    elif config.m == "auto" and len(candidates) > _FINALISTS and len(config.m_grid) > 2 * _COARSE_STEP:
         # Screen every orientation on a coarse m grid first; only the best few get the full sweep.
         coarse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: _COARSE_STEP]))
         screened = [
@@ -124,6 +134,8 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
 #: the same F1 as the full sweep of all 8 orientations (0.651) in about half the matcher calls.
 _COARSE_STEP = 2
 _FINALISTS = 3
+#: Above this many regions in either map, orientations are screened by assignment cost instead.
+_SCREEN_BY_ASSIGNMENT = 60
 
 
 def _share_of(progress, index: int, count: int):
