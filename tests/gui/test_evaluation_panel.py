@@ -34,6 +34,8 @@ def test_reference_scores_live_and_marks_cliques(window, tmp_path, monkeypatch, 
     assert panel.values["precision"].text() == "0.500"
     assert panel.values["recall"].text() == "0.333"
     assert panel.values["counts"].text() == "1 / 1 / 2"
+    # Place accuracy: room 1's point is sent to room 1; room 2's to room 3 (wrong); room 3 unmatched.
+    assert panel.values["place"].text() == "0.333 (1 / 3 points)"
     model = window.table.model
     assert model.data(model.index(model.row_of(good), 6)) == "TP"
     assert model.data(model.index(model.row_of(bad), 6)) == "FP"
@@ -45,6 +47,7 @@ def test_reference_scores_live_and_marks_cliques(window, tmp_path, monkeypatch, 
     session.link([2], [2])
     session.link([3], [3])
     assert panel.values["f1"].text() == "1.000" and panel.missed.count() == 0
+    assert panel.values["place"].text() == "1.000 (3 / 3 points)"
 
     panel.clear_button.click()
     assert session.reference is None and panel.values["f1"].text() == "–"

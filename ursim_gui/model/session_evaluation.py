@@ -78,11 +78,12 @@ class EvaluationOperations:
         self._reference = sets
 
     def _evaluate(self) -> None:
+        self._place = None
         if self._reference is None:
             self._evaluation = None
             self._clique_marks = {}
             return
-        from ursim_core.evaluation.scoring import score_matches
+        from ursim_core.evaluation.scoring import place_accuracy, score_matches
 
         pairs, owners = [], []
         for clique in self._corr.cliques:
@@ -100,3 +101,14 @@ class EvaluationOperations:
                 marks.setdefault(owner, "tp")
         self._evaluation = score
         self._clique_marks = marks
+        sketch, metric = self._segmentations["sketch"], self._segmentations["metric"]
+        if sketch is not None and metric is not None and self._reference_corr is not None:
+            # Places are read in the session's own metric segmentation (the GUI segments metric
+            # maps with MAORIS 'default', the reference segmentation of the definition).
+            kept = [c for c in self._reference_corr.cliques if c.effective_status != "rejected"]
+            self._place = place_accuracy(pairs, kept, sketch.labels, metric.labels, metric.labels, metric.graph)
+
+    @property
+    def place(self):
+        """``ursim_core.evaluation.scoring.PlaceScore`` of the non-rejected cliques, or None."""
+        return getattr(self, "_place", None)

@@ -50,7 +50,7 @@ class EvaluationPanel(QWidget):
         buttons.addWidget(self.clear_button)
         self.source = QLabel("no reference loaded")
         self.source.setWordWrap(True)
-        self.values = {name: QLabel("–") for name in ("precision", "recall", "f1", "counts")}
+        self.values = {name: QLabel("–") for name in ("precision", "recall", "f1", "counts", "place")}
         for name, label in self.values.items():
             label.setObjectName(f"eval_{name}")
         form = QFormLayout()
@@ -58,6 +58,12 @@ class EvaluationPanel(QWidget):
         form.addRow("Recall", self.values["recall"])
         form.addRow("F1", self.values["f1"])
         form.addRow("TP / FP / FN", self.values["counts"])
+        place_label = QLabel("Place accuracy")
+        place_label.setToolTip(
+            "Would a robot sent to each sketched reference point reach the annotated place? "
+            "(interior point of the largest matched metric region; mean over a clique's points, then cliques)"
+        )
+        form.addRow(place_label, self.values["place"])
         self.missed = QListWidget()
         self.missed.setObjectName("eval_missed")
         inner = QVBoxLayout(box)
@@ -94,6 +100,11 @@ class EvaluationPanel(QWidget):
         self.values["recall"].setText(f"{score.recall:.3f}" if findable else "– (nothing to find)")
         self.values["f1"].setText(f"{score.f1:.3f}" if predicted and findable else "–")
         self.values["counts"].setText(f"{score.tp} / {score.fp} / {score.fn}")
+        place = self._session.place
+        if place is None or place.accuracy != place.accuracy:  # None or NaN: no clique could be scored
+            self.values["place"].setText("– (no clique with points on both maps)")
+        else:
+            self.values["place"].setText(f"{place.accuracy:.3f} ({place.successes} / {place.n_points} points)")
         self.missed.clear()
         for index in self._session.missed_reference():
             sketch, metric = reference[index]
