@@ -142,3 +142,23 @@ def test_real_recovery_dialog_offers_recover(qtbot, tmp_path):
     from importlib import reload
 
     assert reload(dialogs).ask_recover(None, [copy]) == copy
+
+
+def test_saving_over_a_file_changed_on_disk_asks_first(window, tmp_path, monkeypatch):
+    """Issue 12 item 3 through the window: the changed-on-disk question, Cancel keeps the other file."""
+    import dataclasses
+
+    from ursim_core.correspondences import load_correspondences, save_correspondences
+    from ursim_gui.window import dialogs
+
+    path = tmp_path / "shared.json"
+    window.session.save(path)
+    # Another session (or program) writes the file: here, a new annotator name.
+    save_correspondences(dataclasses.replace(load_correspondences(path), annotator="someone else"), path)
+    written = path.read_bytes()
+    asked = []
+    monkeypatch.setattr(dialogs, "ask_overwrite_changed", lambda parent, p: asked.append(p) or False)
+    assert window.documents.save() is False
+    assert asked == [path] and path.read_bytes() == written
+    monkeypatch.setattr(dialogs, "ask_overwrite_changed", lambda parent, p: True)
+    assert window.documents.save() is True and path.read_bytes() != written

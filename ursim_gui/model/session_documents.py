@@ -123,16 +123,21 @@ class DocumentOperations:
                 saved = None  # the original is unreadable: everything recovered is unsaved
         self._install_document(corr, path=path, saved=saved)
 
-    def save(self, path: str | os.PathLike | None = None) -> None:
+    def save(self, path: str | os.PathLike | None = None, *, overwrite_changed: bool = False) -> None:
         """Write the correspondences to ``path`` (default: the current file), atomically.
 
         ``created`` (when empty) and ``modified`` are stamped. On success the document is
-        clean and ``path`` becomes the current file.
+        clean and ``path`` becomes the current file. Saving to the current file checks that it
+        is still what this session read or last wrote (SHA-256); ``overwrite_changed`` skips
+        that check (the user chose to overwrite).
 
         Raises
         ------
         ValueError
             No ``path`` and the document has never been saved.
+        ursim_core.errors.FileChangedError
+            The current file changed on disk since this session read or wrote it (another
+            session saved it): nothing is written.
         OSError, UrsimError
             Writing failed. The file on disk is unchanged, and so is the session: it
             stays dirty, with the same path.
@@ -148,7 +153,9 @@ class DocumentOperations:
         stamped = dataclasses.replace(self._corr, created=created, modified=moment)
         # An edited segmentation is saved beside the file and referenced in it.
         stamped = self._write_edited_labels(stamped, target)
-        save_correspondences(stamped, target, now=moment)
+        same_file = self._path is not None and target == self._path
+        expected = getattr(self, "_disk_sha256", None) if same_file and not overwrite_changed else None
+        self._disk_sha256 = save_correspondences(stamped, target, now=moment, expected_sha256=expected)
 
         was_dirty = self.dirty
         # The timestamps describe the document, not one edit: every history value gets
@@ -202,6 +209,8 @@ class DocumentOperations:
         self._corr = current
         self._saved = saved
         self._path = path
+        # What this session last read from or wrote to ``path``: a save checks the file is unchanged.
+        self._disk_sha256 = getattr(saved, "loaded_sha256", None)
         self._history.clear()
         self._selection = {side: frozenset() for side in SIDES}
         self._selected_clique = None

@@ -11,7 +11,7 @@ from PySide6.QtWidgets import QMessageBox, QWidget
 
 from ursim_gui.views.messages import show_error
 
-__all__ = ["show_error", "ask_unsaved_changes", "ask_recover"]
+__all__ = ["show_error", "ask_unsaved_changes", "ask_recover", "ask_overwrite_changed"]
 
 
 def ask_unsaved_changes(parent: QWidget | None, what: str) -> str:
@@ -29,6 +29,22 @@ def ask_unsaved_changes(parent: QWidget | None, what: str) -> str:
     return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
         QMessageBox.StandardButton(answer), "cancel"
     )
+
+
+def ask_overwrite_changed(parent: QWidget | None, path: Path) -> bool:
+    """The file changed on disk since it was opened (another session?): True to overwrite it."""
+    box = QMessageBox(parent)
+    box.setObjectName("changed_on_disk_box")
+    box.setIcon(QMessageBox.Icon.Warning)
+    box.setWindowTitle("File changed on disk")
+    box.setText(
+        f"{path} was changed by someone else since it was opened or last saved here "
+        "(another window or another program). Overwrite it with this document, losing those changes?"
+    )
+    box.setStandardButtons(QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Cancel)
+    box.button(QMessageBox.StandardButton.Save).setText("Overwrite")
+    box.setDefaultButton(QMessageBox.StandardButton.Cancel)
+    return QMessageBox.StandardButton(box.exec()) == QMessageBox.StandardButton.Save
 
 
 def ask_recover(parent: QWidget | None, paths: list[Path]) -> Path | None:

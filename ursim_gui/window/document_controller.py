@@ -137,7 +137,18 @@ class DocumentController(QObject):
         return self._save_to(path)
 
     def _save_to(self, path: Path | None) -> bool:
-        if not self._try("Save failed", self.session.save, path):
+        from ursim_core.errors import FileChangedError
+
+        try:
+            self.session.save(path)
+        except FileChangedError:
+            # Someone else wrote the file since we read it: ask before overwriting their work.
+            if not dialogs.ask_overwrite_changed(self.window, self.session.path):
+                return False
+            if not self._try("Save failed", lambda: self.session.save(path, overwrite_changed=True)):
+                return False
+        except _FAILURES as error:
+            dialogs.show_error(self.window, "Save failed", str(error))
             return False
         self.autosaver.discard()
         self._remember(self.session.path)

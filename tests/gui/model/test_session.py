@@ -771,3 +771,30 @@ def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(sess
             lambda *a: None, cancel_during_the_sweep
         )
     assert len(polls) == 6
+
+
+def test_a_second_session_on_the_same_file_does_not_silently_drop_the_first_ones_work(tmp_path):
+    """Issue 12 item 3: the second session's save raises FileChangedError instead of overwriting."""
+    import dataclasses
+
+    from ursim_core.correspondences import load_correspondences, save_correspondences
+    from ursim_core.errors import FileChangedError
+    from ursim_gui.model.session import AnnotationSession
+
+    path = tmp_path / "shared.json"
+    AnnotationSession().save(path)
+    second = AnnotationSession()
+    second.open(path)
+    # Another session (or program) writes the file: here, a new annotator name.
+    changed = dataclasses.replace(load_correspondences(path), annotator="someone else")
+    save_correspondences(changed, path)
+    written = path.read_bytes()
+    with pytest.raises(FileChangedError):
+        second.save()
+    assert path.read_bytes() == written and second.path == path
+    second.save(overwrite_changed=True)  # the user chose to overwrite
+    assert load_correspondences(path).modified is not None
+    second.save()  # its digest is the one it wrote: no question now
+    reopened = AnnotationSession()
+    reopened.open(path)
+    reopened.save()
