@@ -157,3 +157,18 @@ def staged_folder(out: Path) -> Iterator[Path]:
             os.replace(item, out / item.name)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def add_subcommand(subparsers, name: str, module) -> argparse.ArgumentParser:
+    """Add the subcommand ``name`` of ``module`` (``HELP``, ``EXAMPLES``, ``configure``, ``run``) to
+    ``subparsers`` on its own, outside the ``ursim`` parser (for embedding and tests); ``handler`` runs it."""
+    parser = subparsers.add_parser(
+        name,
+        help=module.HELP,
+        description=module.HELP,
+        epilog=module.EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    module.configure(parser)
+    parser.set_defaults(handler=module.run)
+    return parser

@@ -112,12 +112,11 @@ def run(args: argparse.Namespace) -> int:
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add ``goal`` to a set of sub-commands (``subparsers`` from ``add_subparsers``), on its own."""
-    parser = subparsers.add_parser(
-        "goal", help=HELP, description=HELP, epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    configure(parser)
-    parser.set_defaults(handler=cmd_goal)
-    return parser
+    import sys
+
+    from ursim_core.cli.common import add_subcommand
+
+    return add_subcommand(subparsers, "goal", sys.modules[__name__])
 
 
 def prepare_navigation(args: argparse.Namespace) -> Navigation:

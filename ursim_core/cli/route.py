@@ -44,12 +44,11 @@ def run(args: argparse.Namespace) -> int:
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add ``route`` to a set of sub-commands (``subparsers`` from ``add_subparsers``), on its own."""
-    parser = subparsers.add_parser(
-        "route", help=HELP, description=HELP, epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    configure(parser)
-    parser.set_defaults(handler=cmd_route)
-    return parser
+    import sys
+
+    from ursim_core.cli.common import add_subcommand
+
+    return add_subcommand(subparsers, "route", sys.modules[__name__])
 
 
 def read_points(path: str | Path) -> list[tuple[float, float]]:

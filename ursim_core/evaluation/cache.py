@@ -183,8 +183,11 @@ def store_segmentation(job: SegmentationJob, segmentation, memory_cache, cache_d
         _write_disk_cache(_disk_cache_path(Path(cache_dir), job), segmentation)
 
 
-def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir):
-    """Segmentations by job key, from the caches or computed biggest map first."""
+def split_cached(jobs, reporter: Progress, memory_cache, cache_dir):
+    """The cached segmentations by job key, and the jobs still to run, biggest map first.
+
+    Biggest first so that the workers (local processes or a Dask cluster) finish together.
+    """
     segmentations: dict[str, Any] = {}
     to_run = []
     for job in jobs:
@@ -194,12 +197,22 @@ def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir)
         else:
             segmentations[job.key] = found
             reporter.step(f"segment {job.path.name} (cached)")
-    cached = len(jobs) - len(to_run)
-    # Biggest maps first so the workers finish together.
     to_run.sort(key=lambda job: -pixel_count(job.path))
+    return segmentations, to_run
+
+
+def record_segmentation(job, segmentation, segmentations: dict, reporter: Progress, memory_cache, cache_dir):
+    """Keep a computed segmentation: in the result, in the caches, and say so."""
+    segmentations[job.key] = segmentation
+    store_segmentation(job, segmentation, memory_cache, cache_dir)
+    turned = f" {job.augment}" if job.augment else ""
+    reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
+
+
+def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir):
+    """Segmentations by job key, from the caches or computed biggest map first."""
+    segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir)
+    cached = len(jobs) - len(to_run)
     for job, segmentation in completed(segment_job, to_run, workers=workers):
-        segmentations[job.key] = segmentation
-        store_segmentation(job, segmentation, memory_cache, cache_dir)
-        turned = f" {job.augment}" if job.augment else ""
-        reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
+        record_segmentation(job, segmentation, segmentations, reporter, memory_cache, cache_dir)
     return segmentations, cached

@@ -16,8 +16,8 @@ from __future__ import annotations
 from typing import Any
 
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation.cache import read_cached, segment_job, store_segmentation
-from ursim_core.evaluation.pool import Progress, pixel_count
+from ursim_core.evaluation.cache import record_segmentation, segment_job, split_cached
+from ursim_core.evaluation.pool import Progress
 from ursim_core.evaluation.results import RunRow
 from ursim_core.evaluation.tasks import MatchTask, run_task, sorted_rows
 
@@ -48,29 +48,14 @@ def segment_all_dask(client, jobs, reporter: Progress, memory_cache, cache_dir):
     """Segmentations by job key and their futures on the cluster (cached ones are scattered)."""
     from distributed import as_completed
 
-    segmentations: dict[str, Any] = {}
-    futures: dict[str, Any] = {}
-    to_run = []
-    for job in jobs:
-        found = read_cached(job, memory_cache, cache_dir)
-        if found is None:
-            to_run.append(job)
-        else:
-            segmentations[job.key] = found
-            futures[job.key] = client.scatter(found)
-            reporter.step(f"segment {job.path.name} (cached)")
+    segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir)
+    futures: dict[str, Any] = {key: client.scatter(found) for key, found in segmentations.items()}
     cached = len(jobs) - len(to_run)
-    # Biggest maps first, as the local pool does, so the workers finish together.
-    to_run.sort(key=lambda job: -pixel_count(job.path))
     pending = {client.submit(segment_job, job, key=f"segment-{job.key}", pure=False): job for job in to_run}
     for future in as_completed(pending):
         job = pending[future]
-        segmentation = future.result()
-        segmentations[job.key] = segmentation
         futures[job.key] = future
-        store_segmentation(job, segmentation, memory_cache, cache_dir)
-        turned = f" {job.augment}" if job.augment else ""
-        reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
+        record_segmentation(job, future.result(), segmentations, reporter, memory_cache, cache_dir)
     return segmentations, futures, cached
 
 
