@@ -91,3 +91,26 @@ def test_an_edited_segmentation_is_saved_beside_the_file_and_reopened_exactly(wi
     reopened.open(document)
     assert np.array_equal(reopened.segmentation("sketch").labels, edited)
     assert reopened.correspondences.cliques == session.correspondences.cliques and not reopened.dirty
+
+
+def test_an_edited_segmentation_survives_a_crash_through_the_autosave_copy(window, tmp_path):
+    """The autosave copy carries the edited label image, so recovering it restores the edit."""
+    from ursim_gui.model.autosave import Autosaver, discard, recover
+
+    session = window.session
+    session.link([1], [1])
+    session.merge_regions("sketch", 2, 3)
+    edited = session.segmentation("sketch").labels.copy()
+    saver = Autosaver(session, tmp_path / "autosave")
+    saver.flush()
+    copy = saver.path
+    labels_copy = copy.with_name(f"{copy.stem}.sketch.labels.png")
+    assert copy.is_file() and labels_copy.is_file()
+    assert session.path is None or session.path.parent != copy.parent  # the document is untouched
+
+    recovered = AnnotationSession()
+    recovered.restore(recover(copy))
+    assert np.array_equal(recovered.segmentation("sketch").labels, edited)
+    discard(copy)
+    assert not copy.exists() and not labels_copy.exists()
+    saver.close()

@@ -34,7 +34,7 @@ from pathlib import Path
 
 from ursim_core.correspondences import Correspondences, load_correspondences, save_correspondences
 from ursim_core.io.atomic import atomic_write_bytes
-from ursim_gui.model.session import AUTOSAVE_ORIGIN_KEY, AnnotationSession
+from ursim_gui.model.session import AUTOSAVE_ORIGIN_KEY, SIDES, AnnotationSession
 
 __all__ = [
     "AUTOSAVE_SUFFIX",
@@ -157,8 +157,13 @@ def recover_with_origin(path: str | os.PathLike) -> tuple[Correspondences, Path 
 
 
 def discard(path: str | os.PathLike) -> None:
-    """Delete an autosave file (no error when it is already gone)."""
-    Path(path).unlink(missing_ok=True)
+    """Delete an autosave file and its edited label images (no error when they are already gone)."""
+    from ursim_gui.model.session_label_edits import labels_path_for
+
+    path = Path(path)
+    path.unlink(missing_ok=True)
+    for side in SIDES:
+        labels_path_for(path, side).unlink(missing_ok=True)
 
 
 class Autosaver:
@@ -279,7 +284,9 @@ class Autosaver:
             self._take_lock()
         # ``now`` keeps the document's own timestamps: the copy must be the value in the
         # session, not a re-stamped one.
-        save_correspondences(dataclasses.replace(corr, extra=extra), target, now=corr.modified)
+        # Edited segmentations go along as label images beside the copy, or a crash would lose them.
+        copy = self.session.edited_labels_beside(dataclasses.replace(corr, extra=extra), target)
+        save_correspondences(copy, target, now=corr.modified)
         if self._written is not None and self._written != target:
             discard(self._written)
         self._written = target

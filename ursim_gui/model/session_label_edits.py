@@ -110,6 +110,23 @@ class LabelEditOperations:
                 self._recompute_reference()
                 self.segmentation_changed.emit(side)
 
+    def edited_labels_beside(self, corr, target):
+        """``corr`` referencing copies of the edited sides' label images, written beside ``target``.
+
+        For the autosave copy: the session and its history are not changed (a save does that,
+        :meth:`_write_edited_labels`), so recovering the copy restores the edits too.
+        """
+        from ursim_core.segmentation import save_label_image
+
+        for side in SIDES:
+            ref = getattr(corr, side)
+            if ref.segmentation_method != EDITED_METHOD or self._segmentations[side] is None:
+                continue
+            path = labels_path_for(target, side)
+            save_label_image(self._segmentations[side], path)
+            corr = dataclasses.replace(corr, **{side: dataclasses.replace(ref, labels_path=path)})
+        return corr
+
     def _write_edited_labels(self, corr, target):
         """Save edited sides' label images beside ``target``; returns ``corr`` referencing them."""
         from ursim_core.segmentation import save_label_image
