@@ -116,3 +116,21 @@ def test_multi_file_run_keeps_going_after_a_bad_file(tmp_path):
     assert result.returncode == 1
     assert (tmp_path / "out" / "good.labels.png").is_file()
     assert "missing.png" in result.stderr
+
+
+def test_convert_exports_by_name_and_by_format(tmp_path, capsys):
+    from ursim_core.synth import make_pair, save_example
+
+    plan, sketch = make_pair(seed=1)
+    save_example(plan, sketch, tmp_path, now="2026-12-01T00:00:00Z")
+    source = tmp_path / "ground_truth.json"
+    assert main(["convert", str(source), str(tmp_path / "regions.geojson")]) == 0
+    geojson = json.loads((tmp_path / "regions.geojson").read_text())
+    assert geojson["type"] == "FeatureCollection" and geojson["features"]
+    assert main(["convert", str(source), str(tmp_path / "s.labelme.json"), "--side", "sketch"]) == 0
+    assert json.loads((tmp_path / "s.labelme.json").read_text())["shapes"]
+    assert main(["convert", str(source), str(tmp_path / "gcp.points")]) == 0
+    assert (tmp_path / "gcp.points").read_text().splitlines()[1].startswith("mapX,mapY,sourceX,sourceY")
+    assert main(["convert", str(source), str(tmp_path / "plain.txt"), "--format", "geojson"]) == 0
+    assert "(geojson)" in capsys.readouterr().out
+    assert main(["convert", str(source), str(tmp_path / "again.dat")]) == 0  # the two formats still convert

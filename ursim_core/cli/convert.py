@@ -1,4 +1,5 @@
-"""``ursim convert``: correspondences between the original annotators' ``.dat`` files and JSON."""
+"""``ursim convert``: correspondences between the original annotators' ``.dat`` files and JSON,
+and exports to GeoJSON, labelme JSON and QGIS georeferencer ``.points``."""
 
 from __future__ import annotations
 
@@ -11,10 +12,15 @@ from ursim_core.errors import ParameterError
 
 __all__ = ["convert_correspondences"]
 
-HELP = "Convert correspondences between the original .dat files and JSON."
+HELP = "Convert correspondences between .dat and JSON, or export them (GeoJSON, labelme, QGIS .points)."
 EXAMPLES = """examples:
   ursim convert gt_00_model_simple.dat gt_00.json --sketch 00.png --metric model_simple.png
-  ursim convert gt_00.json gt_00.dat"""
+  ursim convert gt_00.json gt_00.dat
+  ursim convert out/correspondences.json regions.geojson            # metric side; world metres for a YAML map
+  ursim convert out/correspondences.json sketch.labelme.json --side sketch
+  ursim convert out/correspondences.json clicks.points               # QGIS georeferencer control points
+
+Exports are chosen by the output name (.geojson, .labelme.json, .points) or --format."""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -22,6 +28,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("output", metavar="OUT", help=".json or .dat")
     parser.add_argument("--sketch", help="sketch map (for .dat -> JSON: stored in the JSON, regions assigned)")
     parser.add_argument("--metric", help="metric map (for .dat -> JSON)")
+    parser.add_argument(
+        "--format", choices=["geojson", "labelme", "qgis-points"], help="export format (default: from OUT's name)"
+    )
+    parser.add_argument(
+        "--side", choices=["sketch", "metric"], default="metric", help="map side of a GeoJSON / labelme export"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -32,9 +44,20 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("is a folder; give the file to write", path=target)
     if not target.parent.is_dir():
         raise ParameterError(f"no folder {target.parent} to write into", path=target)
+    if args.format is not None or _is_export(target):
+        from ursim_core.correspondences.exporters import export_file
+
+        kind = export_file(Path(args.input), target, format=args.format, side=args.side)
+        print(f"wrote {args.output} ({kind})")
+        return 0
     convert_correspondences(Path(args.input), target, sketch=args.sketch, metric=args.metric)
     print(f"wrote {args.output}")
     return 0
+
+
+def _is_export(target: Path) -> bool:
+    name = target.name.lower()
+    return name.endswith((".geojson", ".points", ".labelme.json"))
 
 
 _KINDS = {".dat": "dat", ".json": "json"}
