@@ -107,12 +107,41 @@ def _undo_dihedral(image: np.ndarray, quarter_turns: int, mirrored: bool) -> np.
 
 
 def _moments(free: np.ndarray) -> tuple[float, float, float, float]:
-    rows, cols = np.nonzero(free)
-    if rows.size == 0:
-        return 0.0, 0.0, 0.0, 0.0
-    r = rows - rows.mean()
-    c = cols - cols.mean()
-    return float((r * r).mean()), float((c * c).mean()), float((r**3).mean()), float((c**3).mean())
+    """Variance and third central moment of the free pixels' rows and columns.
+
+    From the row and column counts (two sums over the image, then 1-D sums), not from the
+    pixel coordinates: a few milliseconds on a 2-million-pixel sketch instead of about 50.
+    """
+    values = []
+    for axis in (1, 0):
+        counts = free.sum(axis=axis, dtype=np.float64)
+        total = counts.sum()
+        if total == 0:
+            return 0.0, 0.0, 0.0, 0.0
+        position = np.arange(counts.size, dtype=np.float64)
+        centred = position - (position * counts).sum() / total
+        values.append((float((centred**2 * counts).sum() / total), float((centred**3 * counts).sum() / total)))
+    (var_r, skew_r), (var_c, skew_c) = values
+    return var_r, var_c, skew_r, skew_c
+
+
+def _turned_moments(var_r, var_c, skew_r, skew_c, quarter_turns: int, mirrored: bool):
+    """The second and third central moments of ``dihedral(free, quarter_turns, mirrored)``.
+
+    Examples
+    --------
+    >>> free = np.zeros((30, 40), bool); free[2:10, 2:38] = True; free[10:28, 2:8] = True
+    >>> all(
+    ...     np.allclose(_turned_moments(*_moments(free), k, m), _moments(dihedral(free, k, m)))
+    ...     for k in range(4) for m in (False, True)
+    ... )
+    True
+    """
+    for _ in range(quarter_turns % 4):
+        var_r, var_c, skew_r, skew_c = var_c, var_r, -skew_c, skew_r
+    if mirrored:
+        skew_c = -skew_c
+    return var_r, var_c, skew_r, skew_c
 
 
 def canonical_pose(free: np.ndarray) -> tuple[int, bool]:
@@ -134,10 +163,13 @@ def canonical_pose(free: np.ndarray) -> tuple[int, bool]:
     True
     """
     free = np.asarray(free) != 0
+    # The central moments of every pose follow from the map's own: a quarter turn maps the
+    # centred (r, c) to (-c, r), a mirror c to -c. One pass over the pixels instead of eight.
+    var_r0, var_c0, skew_r0, skew_c0 = _moments(free)
     best_key, best = None, (0, False)
     for mirrored in (False, True):
         for quarter_turns in range(4):
-            var_r, var_c, skew_r, skew_c = _moments(dihedral(free, quarter_turns, mirrored))
+            var_r, var_c, skew_r, skew_c = _turned_moments(var_r0, var_c0, skew_r0, skew_c0, quarter_turns, mirrored)
             # Round so that the same moments computed from a turned copy compare equal.
             key = (
                 var_c >= var_r - 1e-9 * max(var_c, var_r, 1.0),
