@@ -57,3 +57,18 @@ def test_a_result_for_a_replaced_map_is_dropped(window, qtbot, map_files):
     qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
     assert window.session.segmentation("sketch") is None  # the stale result was not applied
     assert before is not None and "dropped" in window.status.currentMessage()
+
+
+def test_a_document_reopened_from_its_file_says_its_automatic_cliques_are_there(window, tmp_path):
+    """Reopened pairs said 'not matched yet' although the file held the matcher's cliques."""
+    from types import SimpleNamespace
+
+    session = window.session
+    session.apply_match(SimpleNamespace(pairs=[(1, 1), (2, 2)], anchors=[(1, 1)], m=0.1, cost=0.0, reason=""))
+    automatic = sum(1 for clique in session.correspondences.cliques if clique.source == "auto")
+    assert automatic == 2 and window.matching_panel.summary.text().startswith("2 pairs")
+    path = tmp_path / "doc.json"
+    session.save(path)
+    session.open(path)
+    assert session.last_match is None
+    assert window.matching_panel.summary.text().startswith(f"{automatic} automatic cliques from the file")

@@ -39,9 +39,20 @@ VARIANTS = (
 MATCHERS = (("planar", "planar expansion"), ("hungarian", "Hungarian"), ("vf2", "VF2"))
 
 
-def describe_result(result) -> str:
-    """One-paragraph summary of a ``MatchResult`` for the panel."""
+def describe_result(result, *, automatic_cliques: int = 0) -> str:
+    """One-paragraph summary of a ``MatchResult`` for the panel.
+
+    Without a result in memory (a document reopened from its file), ``automatic_cliques`` says
+    whether the file already holds the matcher's answer.
+
+    Examples
+    --------
+    >>> describe_result(None), describe_result(None, automatic_cliques=6)
+    ('not matched yet', '6 automatic cliques from the file (press Match to run the matcher again)')
+    """
     if result is None:
+        if automatic_cliques:
+            return f"{automatic_cliques} automatic cliques from the file (press Match to run the matcher again)"
         return "not matched yet"
     text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
     if math.isfinite(result.cost):
@@ -166,8 +177,8 @@ class MatchingPanel(QWidget):
         """Enable Match only when both maps are segmented and no job runs."""
         self.match_button.setEnabled(ready)
 
-    def show_result(self, result) -> None:
-        self.summary.setText(describe_result(result))
+    def show_result(self, result, *, automatic_cliques: int = 0) -> None:
+        self.summary.setText(describe_result(result, automatic_cliques=automatic_cliques))
 
 
 def _combo(name: str, items) -> QComboBox:

@@ -252,11 +252,10 @@ class MainWindow(QMainWindow):
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
         self.session.segmentation_changed.connect(self._show_summary)
         self.session.map_changed.connect(self._show_map_title)
-        self.session.correspondences_changed.connect(
-            lambda *_: self.matching_panel.show_result(self.session.last_match)
-        )
+        self.session.correspondences_changed.connect(lambda *_: self._show_match_summary())
         self.tools = WindowTools(self)
         self._update_ready()
+        self._show_match_summary()
 
     def _fill_recent_menu(self) -> None:
         """Recent campaigns and correspondence files (from the preferences), newest first."""
@@ -334,6 +333,10 @@ class MainWindow(QMainWindow):
         self.matching_panel.set_ready(segmented and not self.jobs.busy)
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
+
+    def _show_match_summary(self) -> None:
+        automatic = sum(1 for clique in self.session.correspondences.cliques if clique.source == "auto")
+        self.matching_panel.show_result(self.session.last_match, automatic_cliques=automatic)
 
     def _show_summary(self, side: str) -> None:
         segmentation = self.session.segmentation(side)
