@@ -33,6 +33,8 @@ def test_pair_agreement_counts_f1_and_disagreeing_cliques(labels3):
     result = pair_agreement("p", a, b, labels3, scaled(labels3, 2))
     a_vs_b = result.comparisons["A vs B"]
     assert (a_vs_b.tp, a_vs_b.fp, a_vs_b.fn, a_vs_b.f1) == (1, 1, 1, 0.5)
+    # Place accuracy: B's room 1 is reached through A's (1, 1); B's room 2 is sent to room 3 by A.
+    assert a_vs_b.place == 0.5
     assert result.disagreeing == (2,)  # the rejected clique 3 is no claim
     assert result.comparisons["matcher vs A"].f1 == 1.0  # A kept both automatic cliques
     whole = pooled([result, result])
