@@ -1,7 +1,8 @@
 """Regression on the 18 KTH sketches in all 8 orientations (needs ../shared/datasets).
 
 Protocol: each sketch image is turned by 0/90/180/270 degrees, mirrored or not, and its
-ground-truth points are moved with it (exactly: quarter turns and mirrors permute pixels). The
+ground-truth points are moved with it by ``ursim_core.evaluation.augment`` (exactly: quarter turns and
+mirrors permute pixels). The
 sketch is segmented with :func:`ursim_core.segmentation.canonical.segment_canonical`, the metric
 model with ``segment`` (its own frame; canonicalising it too gave 0.616 upright), both with the
 MAORIS ``default`` preset (the one the annotators clicked on), and matched with the default
@@ -25,12 +26,12 @@ import pytest
 
 from ursim_core.correspondences import load_dat, regions_at_points
 from ursim_core.evaluation import datasets
+from ursim_core.evaluation.augment import Orientation, transform_image, transform_points
 from ursim_core.evaluation.kth_protocol import f1_table, kth_pairs, summarise
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.io import load_map
 from ursim_core.matching import M_GRID, MatchConfig, match
 from ursim_core.segmentation import segment, segment_canonical
-from ursim_core.segmentation.canonical import dihedral
 
 pytestmark = [pytest.mark.dataset, pytest.mark.slow]
 ORIENTATIONS = [(k, m) for m in (False, True) for k in range(4)]
@@ -44,24 +45,6 @@ def root():
     return found
 
 
-def _moved_points(shape, quarter_turns, mirrored):
-    rows, cols = shape
-    index = dihedral(np.arange(rows * cols).reshape(rows, cols), quarter_turns, mirrored)
-    where = np.empty(rows * cols, np.int64)
-    where[index.ravel()] = np.arange(rows * cols)
-    new_cols = index.shape[1]
-
-    def move(points):
-        out = []
-        for r, c in points:
-            r, c = min(max(int(r), 0), rows - 1), min(max(int(c), 0), cols - 1)
-            flat = where[r * cols + c]
-            out.append((int(flat // new_cols), int(flat % new_cols)))
-        return out
-
-    return move
-
-
 @functools.lru_cache(maxsize=1)
 def _f1_by_orientation(folder) -> dict:
     model = segment(load_map(folder / "model" / "model_simple.png"), preset="default")
@@ -73,9 +56,13 @@ def _f1_by_orientation(folder) -> dict:
             for annotator in ("malcolm", "vasiliki")
         ]
         for orientation in ORIENTATIONS:
-            seg = segment_canonical(dihedral(sketch.free, *orientation), preset="default")
+            turn = Orientation(90.0 * orientation[0], mirrored=orientation[1])
+            seg = segment_canonical(transform_image(sketch.free, turn), preset="default")
             pairs = match(seg, model).pairs
-            move = _moved_points(sketch.free.shape, *orientation)
+
+            def move(points, turn=turn, shape=sketch.free.shape):
+                return transform_points(points, shape, turn)
+
             for cliques in truths:
                 reference = [
                     (

@@ -10,6 +10,7 @@ import pytest
 
 from ursim_core.correspondences import regions_at_points
 from ursim_core.errors import ParameterError
+from ursim_core.evaluation import augment
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match, prepare
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph, transform_points
@@ -106,14 +107,8 @@ def test_canonical_segmentation_turns_with_the_map():
 def _moved(free: np.ndarray, points: list, kind: str):
     rows, cols = free.shape
     if kind.startswith("dihedral"):
-        quarter_turns, mirrored = int(kind[-2]), kind[-1] == "m"
-        index = dihedral(np.arange(rows * cols).reshape(rows, cols), quarter_turns, mirrored)
-        where = np.empty(rows * cols, np.int64)
-        where[index.ravel()] = np.arange(rows * cols)
-        new_cols = index.shape[1]
-        return dihedral(free, quarter_turns, mirrored), [
-            (int(where[r * cols + c] // new_cols), int(where[r * cols + c] % new_cols)) for r, c in points
-        ]
+        turn = augment.Orientation(90.0 * int(kind[-2]), mirrored=kind[-1] == "m")
+        return augment.transform_image(free, turn), augment.transform_points(points, free.shape, turn)
     if kind.startswith("angle"):
         image, matrix = _turned(free, float(kind[5:]))
         xy = np.array([(c, r, 1.0) for r, c in points]) @ matrix.T
