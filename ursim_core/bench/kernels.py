@@ -1,8 +1,11 @@
-"""Compilation of the segmentation kernels on an empty cache, as a fresh install pays it.
+"""First-run preparation of the segmentation kernels, as a fresh install pays it.
 
-``bench_compile()`` runs :func:`ursim_core.segmentation.maoris.compile_kernels` in a new
-process whose numba cache (``NUMBA_CACHE_DIR``) is an empty temporary folder, and prints
-the seconds: wall clock (what the user waits) and CPU (less sensitive to a busy machine).
+``bench_compile()`` prepares the MAORIS kernels in a new process on empty caches, both ways
+:mod:`ursim_core.segmentation.maoris.compiled` knows: the ahead-of-time build (the default,
+into an empty temporary folder) and numba's JIT (``URSIM_KERNELS=jit``, into an empty
+``NUMBA_CACHE_DIR``). It prints the seconds: wall clock (what the user waits) and CPU (less
+sensitive to a busy machine), and the kernels' load time in a later process (what every
+later command pays before its first segmentation).
 """
 
 from __future__ import annotations
@@ -15,45 +18,74 @@ import tempfile
 
 __all__ = ["bench_compile"]
 
-_CHILD = """
+_BUILD = """
 import json, resource, time
 start = time.perf_counter()
-from ursim_core.segmentation.maoris import compile_kernels, kernels_cached
-seconds = compile_kernels({processes})
+from ursim_core.segmentation.maoris.compiled import build_ahead
+build_ahead({folder!r})
+own = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({{"process_s": time.perf_counter() - start, "cpu_s": own.ru_utime + own.ru_stime}}))
+"""
+_JIT = """
+import json, resource, time
+start = time.perf_counter()
+from ursim_core.segmentation.maoris import compile_kernels
+compile_kernels(jit=True, processes={processes})
 own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-print(json.dumps({{"compile_s": seconds, "process_s": time.perf_counter() - start,
-    "cpu_s": own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime, "cached": kernels_cached()}}))
+print(json.dumps({{"process_s": time.perf_counter() - start,
+    "cpu_s": own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime}}))
+"""
+# A later process: load the kernels and run one small segmentation (what a command pays).
+_LOAD = """
+import json, time
+start = time.perf_counter()
+import numpy as np
+from ursim_core.segmentation.maoris import maoris_labels
+from ursim_core.segmentation.maoris.compiled import kernels
+free = np.zeros((40, 40), bool); free[2:38, 2:38] = True
+maoris_labels(free)
+print(json.dumps({"load_s": time.perf_counter() - start, "source": kernels().source}))
 """
 
 
-def bench_compile(*, processes: int | None = None, repeats: int = 1) -> list[dict[str, float]]:
-    """Compile the kernels into an empty cache in a subprocess; print and return the figures.
+def _child(code: str, env: dict[str, str]) -> dict:
+    result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def bench_compile(*, processes: int = 1, repeats: int = 1) -> list[dict]:
+    """Prepare the kernels on empty caches in subprocesses, both ways; print and return the figures.
 
     Parameters
     ----------
-    processes : int, optional
-        Passed to ``compile_kernels`` (default: its default, one process).
+    processes : int
+        Processes of the JIT compile (``compile_kernels(processes=...)``).
     repeats : int
-        Runs, each on a new empty cache.
+        Runs of each way, each on new empty caches.
 
     Returns
     -------
     list of dict
-        Per run: ``compile_s`` (inside compile_kernels), ``process_s`` (the whole process
-        less the interpreter's start), ``cpu_s`` (user + system, with the helper processes)
-        and ``cached`` (``kernels_cached()`` afterwards).
+        Per run: ``way`` ("ahead" or "jit"), ``process_s`` (the preparing process less the
+        interpreter's start), ``cpu_s`` (user + system, with its helper processes) and
+        ``load_s`` (a later process: import, load the kernels, segment a 40 x 40 map).
     """
     rows = []
     for _ in range(repeats):
-        with tempfile.TemporaryDirectory(prefix="ursim-numba-cache-") as cache:
-            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-            code = _CHILD.format(processes="" if processes is None else f"processes={int(processes)}")
-            result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-            row = json.loads(result.stdout.strip().splitlines()[-1])
-        rows.append(row)
+        with tempfile.TemporaryDirectory(prefix="ursim-kernels-bench-") as scratch:
+            folder, numba_cache, xdg = (os.path.join(scratch, name) for name in ("ahead", "numba", "xdg"))
+            base = {**os.environ, "NUMBA_CACHE_DIR": numba_cache, "XDG_CACHE_HOME": xdg}
+            row = {"way": "ahead", **_child(_BUILD.format(folder=folder), base)}
+            # A later process loads the install's own build (the same machine code as this one).
+            row["load_s"] = _child(_LOAD, {**os.environ, "URSIM_KERNELS": "ahead"})["load_s"]
+            rows.append(row)
+            jit = {"way": "jit", **_child(_JIT.format(processes=int(processes)), {**base, "URSIM_KERNELS": "jit"})}
+            jit["load_s"] = _child(_LOAD, {**base, "URSIM_KERNELS": "jit"})["load_s"]
+            rows.append(jit)
+    for row in rows:
+        load = f"{row['load_s']:.2f} s"
         print(
-            f"kernel compilation on an empty cache: {row['compile_s']:.1f} s "
-            f"(process {row['process_s']:.1f} s, CPU {row['cpu_s']:.1f} s, "
-            f"processes={1 if processes is None else processes}, cached after: {row['cached']})"
+            f"kernels {row['way']:>5} on empty caches: {row['process_s']:.1f} s (CPU {row['cpu_s']:.1f} s); "
+            f"a later process loads them and segments a small map in {load}"
         )
     return rows

@@ -23,6 +23,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "config",
         "descriptors",
         "edit_distance",
+        "lsap",
         "orientation",
         "pipeline",
         "planar",
@@ -47,5 +48,6 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "descriptors": ["DEFAULT_TIMES", "SIZE_WEIGHT_FLOOR", "VARIANTS", "PairDescriptors", "pair_descriptors"],
         "baselines": ["hungarian_match", "vf2_match"],
         "planar": ["PlanarGraph", "planar_graph", "planar_match"],
+        "lsap": ["linear_sum_assignment"],
     },
 )

@@ -47,7 +47,7 @@ def hungarian_match(c_matrix: np.ndarray, m: float) -> list[tuple[int, int]]:
     c_matrix = np.asarray(c_matrix, dtype=np.float64)
     if c_matrix.size == 0:
         return []
-    from scipy.optimize import linear_sum_assignment
+    from ursim_core.matching.lsap import linear_sum_assignment
 
     rows, cols = linear_sum_assignment(c_matrix)
     return [(int(r), int(k)) for r, k in zip(rows, cols) if c_matrix[r, k] <= m]

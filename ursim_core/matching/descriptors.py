@@ -262,7 +262,7 @@ def anchor_pairs(cost: np.ndarray) -> list[tuple[int, int]]:
     cost = np.asarray(cost, dtype=np.float64)
     if cost.size == 0:
         return []
-    from scipy.optimize import linear_sum_assignment
+    from ursim_core.matching.lsap import linear_sum_assignment
 
     rows, cols = linear_sum_assignment(cost)
     return [(int(r), int(c)) for r, c in zip(rows, cols)]

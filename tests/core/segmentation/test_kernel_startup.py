@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 
 def _run(code: str, **env: str) -> str:
@@ -51,24 +52,100 @@ def test_public_names_stay_importable():
     )
 
 
-def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch):
-    from ursim_core.segmentation.maoris import ZoneGraph, flat_zones, maoris_labels, quantize
-    from ursim_core.segmentation.maoris.kernels import contacts, signatures
+@pytest.fixture
+def jit_kernels(monkeypatch):
+    """The steps use numba's JIT dispatchers (``URSIM_KERNELS=jit``) for this test."""
+    from ursim_core.segmentation.maoris import compiled
+
+    monkeypatch.setenv("URSIM_KERNELS", "jit")
+    compiled.forget()
+    yield compiled.kernels()
+    compiled.forget()
+
+
+def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit_kernels):
+    from ursim_core.segmentation.maoris import ZoneGraph, contact_tracking, flat_zones, maoris_labels, quantize
+    from ursim_core.segmentation.maoris.kernels import signatures
     from ursim_core.synth import make_large_building
 
+    assert jit_kernels.source == "jit"
     free = make_large_building(300, seed=3).free
     maoris_labels(free)
-    monkeypatch.setattr(contacts, "_BAND_PIXELS", 0)  # also the banded count (join_counts)
+    monkeypatch.setattr(contact_tracking, "_BAND_PIXELS", 0)  # also the banded count (join_counts)
     maoris_labels(free)
     values = quantize(np.where(free, 100, 0).astype(np.uint8))
     ZoneGraph(flat_zones(values), values).contact_percent(1, 2)  # contact_table
+    flat_zones(np.array([[5, 5, 0], [0, 5, 7]]))  # another dtype goes through the one signature too
     for key, types in signatures.SIGNATURES.items():
         compiled = signatures.kernel(key).signatures
         assert compiled == [types], (key, compiled)
 
 
+def test_ahead_of_time_kernels_give_the_jit_labels(monkeypatch):
+    """The built module and the JIT: the same labels on maps of every step (banded contacts too)."""
+    from ursim_core.segmentation.maoris import PRESETS, compile_kernels, compiled, contact_tracking, maoris_labels
+    from ursim_core.synth import make_large_building
+
+    compile_kernels()
+    assert compiled.ahead_module_path() is not None
+    maps = [make_large_building(size, seed=seed).free for size, seed in ((300, 1), (500, 4))]
+    labels = {}
+    for way in ("ahead", "jit"):
+        monkeypatch.setenv("URSIM_KERNELS", way)
+        compiled.forget()
+        assert compiled.kernels().source == way
+        labels[way] = [maoris_labels(free, PRESETS[preset]) for free in maps for preset in ("default", "sketch")]
+        with monkeypatch.context() as banded:
+            banded.setattr(contact_tracking, "_BAND_PIXELS", 0)
+            banded.setattr(contact_tracking, "_usable_cpus", lambda: 3)
+            labels[way].append(maoris_labels(maps[1], PRESETS["robot"]))
+    compiled.forget()
+    assert max(int(image.max()) for image in labels["jit"]) > 5
+    for ahead, jit in zip(labels["ahead"], labels["jit"]):
+        np.testing.assert_array_equal(ahead, jit)
+
+
+def test_stale_or_missing_build_is_not_used(tmp_path, monkeypatch):
+    from ursim_core.segmentation.maoris import compiled
+
+    path = compiled.ahead_module_path()
+    if path is None:
+        pytest.skip("no ahead-of-time build in this install (make builds it)")
+    digest = path.parent / compiled.DIGEST_NAME
+    original = digest.read_text(encoding="ascii")
+    monkeypatch.setattr(compiled, "build_directories", lambda: [path.parent])
+    monkeypatch.setattr(compiled, "sources_digest", lambda: "0" * 64)  # as if a kernel was edited
+    assert compiled.ahead_module_path() is None
+    monkeypatch.setattr(compiled, "build_directories", lambda: [tmp_path])
+    assert compiled.ahead_module_path() is None
+    assert digest.read_text(encoding="ascii") == original
+    monkeypatch.setenv("URSIM_KERNELS", "ahead")
+    compiled.forget()
+    with pytest.raises(compiled.SegmentationError, match="URSIM_KERNELS=ahead"):
+        compiled.kernels()
+    monkeypatch.setenv("URSIM_KERNELS", "fast")
+    compiled.forget()
+    with pytest.raises(compiled.SegmentationError, match="auto, jit or ahead"):
+        compiled.kernels()
+    compiled.forget()
+
+
+def test_importing_the_kernels_for_a_segmentation_loads_no_numba():
+    from ursim_core.segmentation.maoris import compile_kernels
+
+    compile_kernels()
+    code = (
+        "import sys, numpy as np\n"
+        "from ursim_core.segmentation.maoris import maoris_labels\n"
+        "free = np.zeros((30, 30), bool); free[3:27, 3:27] = True\n"
+        "maoris_labels(free)\n"
+        "print(sorted(m for m in ('numba', 'llvmlite') if m in sys.modules))"
+    )
+    assert _run(code) == "[]"
+
+
 def test_kernel_cache_lists_the_declared_kernels():
-    from ursim_core.segmentation.maoris.kernel_cache import ENTRY_KERNELS
+    from ursim_core.segmentation.maoris.compiled import ENTRY_KERNELS
     from ursim_core.segmentation.maoris.kernels import signatures
 
     listed = {(module, name) for module, names in ENTRY_KERNELS.items() for name in names}
@@ -81,11 +158,14 @@ def test_kernels_cached_is_true_after_compiling_and_false_on_an_empty_cache(tmp_
 
     compile_kernels(processes=1)
     assert kernels_cached() and compile_notice() is None
+    compile_kernels(jit=True)
     code = (
         "from ursim_core.segmentation.maoris.kernel_cache import compile_notice, kernels_cached\n"
         "print(kernels_cached(), compile_notice())"
     )
-    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path)).startswith("False Compiling the segmentation kernels (first run")
+    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path / "numba")).startswith("True None")
+    jit = _run(code, NUMBA_CACHE_DIR=str(tmp_path / "numba"), URSIM_KERNELS="jit")
+    assert jit.startswith("False Compiling the segmentation kernels (first run")
 
 
 def test_region_graph_boxes_are_those_of_scipy_find_objects():
@@ -108,5 +188,5 @@ def test_kernel_groups_compile_in_processes_and_cover_every_kernel():
     from ursim_core.segmentation.maoris.pipeline import _compile_in_processes, compile_kernels
 
     assert sorted(key for group in signatures.GROUPS for key in group) == sorted(signatures.SIGNATURES)
-    compile_kernels()
+    compile_kernels(jit=True)
     _compile_in_processes(len(signatures.GROUPS), 2)  # cached: each process loads its group

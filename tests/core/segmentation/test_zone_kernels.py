@@ -230,7 +230,7 @@ def _tracked_contacts(tracking) -> tuple[dict[tuple[int, int], int], list[list[i
 
 @pytest.mark.parametrize("bands", [2, 3, 7])
 def test_contacts_counted_in_bands_of_rows_equal_one_pass(bands):
-    from ursim_core.segmentation.maoris.kernels import contacts as _contacts
+    from ursim_core.segmentation.maoris import contact_tracking as _contacts
     from ursim_core.synth import make_large_building
 
     values = quantize(inscribed_circle_image(make_large_building(400, seed=bands).free), quantum=5)
@@ -248,8 +248,8 @@ def test_contacts_counted_in_bands_of_rows_equal_one_pass(bands):
 
 
 def test_segmentation_is_the_same_with_contacts_counted_in_bands(monkeypatch):
+    from ursim_core.segmentation.maoris import contact_tracking as _contacts
     from ursim_core.segmentation.maoris import maoris_labels
-    from ursim_core.segmentation.maoris.kernels import contacts as _contacts
     from ursim_core.synth import make_large_building
 
     free = make_large_building(600, seed=2).free

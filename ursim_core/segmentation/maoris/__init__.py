@@ -24,7 +24,9 @@ tested on its own:
 * :mod:`.zone_graph`: step 3, :func:`flat_zones` and :class:`ZoneGraph`;
 * :mod:`.steps`: steps 4-7, the graph operations;
 * :mod:`.pipeline`: :func:`maoris_labels`, :func:`compile_kernels`, :func:`kernels_cached`;
-* :mod:`.kernels`: the compiled (numba) loops, one module per family.
+* :mod:`.kernels`: the compiled (numba) loops, one module per family;
+* :mod:`.compiled`: the kernels as the steps call them (built ahead of time, or the JIT);
+* :mod:`.contact_tracking`: counting contacts in bands of rows on threads.
 
 Importing this package imports none of them (nor numba): each name loads its module on
 first use.
@@ -34,10 +36,12 @@ one by one in an order that decides ties, so the graph steps cannot be
 vectorised; steps 3, 4 and 6 run as compiled code (numba, :mod:`.kernels`)
 on an array form of the zone graph, and step 1 paints its discs with compiled
 code too (:mod:`.kernels.discs`). The contacts of large maps are counted in bands
-of rows on one thread per CPU. The kernels compile once, about 27 s of CPU
-(:func:`compile_kernels` spreads it over two processes; ``ursim bench compile``
-measures it), and numba caches them beside the module (or in ``NUMBA_CACHE_DIR``);
-:func:`kernels_cached` tells, without importing numba, whether that is done.
+of rows on one thread per CPU. :func:`compile_kernels` builds the kernels once ahead of
+time into an extension module (numba's ``pycc``, about 25 s of CPU; ``make`` runs it, and
+the first segmentation does if nothing did), which later processes load in milliseconds
+without importing numba; ``URSIM_KERNELS=jit`` uses numba's JIT and its cache instead
+(``ursim bench compile`` measures both). :func:`kernels_cached` tells, without importing
+numba, whether that is done.
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
 
@@ -106,7 +110,17 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["params", "inscribed_circle", "zone_graph", "steps", "pipeline", "kernel_cache", "kernels"],
+    submodules=[
+        "params",
+        "inscribed_circle",
+        "zone_graph",
+        "steps",
+        "pipeline",
+        "kernel_cache",
+        "kernels",
+        "compiled",
+        "contact_tracking",
+    ],
     submod_attrs={
         "params": ["MaorisParams", "PRESETS"],
         "inscribed_circle": ["inscribed_circle_radii", "inscribed_circle_image", "quantize"],

@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 
 from ursim_core.errors import ParameterError, SegmentationError
-from ursim_core.segmentation.maoris.kernels import discs as _disc_kernels
+from ursim_core.segmentation.maoris.compiled import kernels
 
 __all__ = ["inscribed_circle_radii", "inscribed_circle_image", "quantize"]
 
@@ -90,9 +90,9 @@ def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:
     # image border is kept where the box touches it).
     dist = cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
     # Radii are int32 (as the output); a larger cap only matters without any obstacle.
-    shapes = _disc_kernels.centre_rectangles(dist, min(max_radius, np.iinfo(np.int32).max))
+    shapes = kernels().centre_rectangles(dist, min(max_radius, np.iinfo(np.int32).max))
     out = np.zeros(free.shape, np.int32)
-    _disc_kernels.paint_discs(dist, shapes, out)
+    kernels().paint_discs(dist, shapes, out)
     return out
 
 

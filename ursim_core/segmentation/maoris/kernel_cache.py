@@ -15,20 +15,11 @@ import os
 import sys
 from pathlib import Path
 
+from ursim_core.segmentation.maoris.compiled import ENTRY_KERNELS, ahead_module_path
+
 __all__ = ["kernels_cached", "compile_notice", "ENTRY_KERNELS", "COMPILE_CPU_SECONDS"]
 
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
-
-#: The kernels called from Python, by module of :mod:`ursim_core.segmentation.maoris.kernels`
-#: (the helpers they call are compiled into them). A test checks this against the modules.
-ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
-    "discs": ("centre_rectangles", "paint_discs"),
-    "flat_zones": ("label_flat_zones", "zone_values_and_sizes", "first_pixels", "resolve_parents", "relabel"),
-    "adjacency": ("build_adjacency", "adjacency_entries", "_link_entries", "remove_small_zones"),
-    "contacts": ("_compact_labels", "count_contacts", "join_counts", "contact_table"),
-    "fusion": ("merge_ripples", "remove_doors"),
-}
-
 
 #: Seconds of CPU that compiling every kernel on an empty cache took on the 2-CPU machine
 #: of the project (``ursim bench compile``: 27-34 s); the wait :func:`compile_notice` gives.
@@ -60,16 +51,25 @@ def _cache_dirs(source: Path) -> list[Path]:
 
 
 def kernels_cached() -> bool:
-    """True when every MAORIS kernel of this install is compiled in numba's cache.
+    """True when the MAORIS kernels of this install are compiled: built ahead of time
+    (:mod:`ursim_core.segmentation.maoris.compiled`) or, with ``URSIM_KERNELS=jit``, every
+    one in numba's cache.
 
-    Cheap (a few directory listings; imports neither numba nor the kernels). A cache
-    older than its source, as numba would reject, counts as missing.
+    Cheap (a few directory listings and reading the kernel sources; imports neither numba
+    nor the kernels). A cache older than its source, as numba would reject, counts as missing.
 
     Examples
     --------
     >>> isinstance(kernels_cached(), bool)
     True
     """
+    if os.environ.get("URSIM_KERNELS", "auto").strip().lower() != "jit":
+        return ahead_module_path() is not None
+    return jit_kernels_cached()
+
+
+def jit_kernels_cached() -> bool:
+    """True when every MAORIS kernel is compiled in numba's cache (``URSIM_KERNELS=jit``)."""
     tag = f".py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}.nbi"
     for module, names in ENTRY_KERNELS.items():
         source = _KERNELS_DIR / f"{module}.py"

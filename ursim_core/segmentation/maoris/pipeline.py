@@ -77,23 +77,32 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     return labels
 
 
-def compile_kernels(*, processes: int = 1) -> float:
-    """Compile (or load from numba's cache) the MAORIS kernels; return the seconds it took.
+def compile_kernels(*, processes: int = 1, jit: bool = False) -> float:
+    """Make the MAORIS kernels ready for use; return the seconds it took.
 
-    The first segmentation in a new environment otherwise pays this; benchmarks call it
-    so that their timings exclude it. Prints nothing (callers say what is happening:
+    By default this builds the kernels ahead of time into one extension module
+    (:func:`ursim_core.segmentation.maoris.compiled.build_ahead`, about 25 s of CPU,
+    once per install and kernel source) unless a fresh one exists, and loads it: later
+    processes then start without numba (:mod:`ursim_core.segmentation.maoris.compiled`).
+    When that build fails (pycc needs a C compiler) or ``jit`` is true, numba's JIT
+    compiles the kernels into its cache instead. The first segmentation in a new
+    environment otherwise pays this; benchmarks call it so that their timings exclude it.
+    Prints nothing (callers say what is happening:
     :func:`~ursim_core.segmentation.maoris.kernel_cache.kernels_cached` tells whether it
     will take long).
 
     Parameters
     ----------
     processes : int, keyword-only
-        When more than 1 and the kernels are not all cached, compile their groups
+        JIT only: when more than 1 and the kernels are not all cached, compile their groups
         (:data:`~ursim_core.segmentation.maoris.kernels.signatures.GROUPS`) in this many
         processes at once into numba's cache, then load them here. Default 1: on the
         shared 2-CPU machine it was measured on (load 7-8), two processes took longer
         (66 s wall, 42 s CPU) than one (53 s, 34 s); on idle CPUs they may be faster
         (not measured).
+    jit : bool, keyword-only
+        Compile numba's JIT cache (what ``URSIM_KERNELS=jit`` uses) rather than the
+        ahead-of-time module.
 
     Examples
     --------
@@ -102,14 +111,25 @@ def compile_kernels(*, processes: int = 1) -> float:
     """
     import time
 
-    from ursim_core.segmentation.maoris.kernel_cache import kernels_cached
-    from ursim_core.segmentation.maoris.kernels import signatures
+    from ursim_core.segmentation.maoris import compiled
 
     start = time.perf_counter()
-    if processes > 1 and not kernels_cached():
+    if not jit:
+        if compiled.ahead_module_path() is None:
+            compiled.build_or_warn()
+        if compiled.ahead_module_path() is not None:
+            return time.perf_counter() - start
+    _compile_jit(processes)
+    return time.perf_counter() - start
+
+
+def _compile_jit(processes: int) -> None:
+    from ursim_core.segmentation.maoris.kernel_cache import jit_kernels_cached
+    from ursim_core.segmentation.maoris.kernels import signatures
+
+    if processes > 1 and not jit_kernels_cached():
         _compile_in_processes(len(signatures.GROUPS), processes)
     signatures.compile_group()
-    return time.perf_counter() - start
 
 
 def _compile_in_processes(groups: int, processes: int) -> None:

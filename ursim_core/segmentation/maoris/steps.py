@@ -10,10 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ursim_core.segmentation.maoris.kernels import adjacency as _adjacency
-from ursim_core.segmentation.maoris.kernels import contacts as _contacts
-from ursim_core.segmentation.maoris.kernels import flat_zones as _flat_zones
-from ursim_core.segmentation.maoris.kernels import fusion as _fusion
+from ursim_core.segmentation.maoris.compiled import kernels
+from ursim_core.segmentation.maoris.contact_tracking import start_tracking
 from ursim_core.segmentation.maoris.zone_graph import ZoneGraph
 
 __all__ = [
@@ -43,9 +41,9 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     """
     compact = graph._run_compiled()
     parent = np.where(graph._alive, np.arange(len(graph._value), dtype=np.int32), 0).astype(np.int32)
-    _adjacency.remove_small_zones(int(min_size), graph._size, graph._alive, parent, compact)
-    _flat_zones.resolve_parents(parent, graph._alive)
-    _flat_zones.relabel(graph._labels.ravel(), parent)
+    kernels().remove_small_zones(int(min_size), graph._size, graph._alive, parent, compact)
+    kernels().resolve_parents(parent, graph._alive)
+    kernels().relabel(graph._labels.ravel(), parent)
     return graph
 
 
@@ -70,8 +68,8 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
     zones = np.flatnonzero(graph._alive)
     order = zones[np.lexsort((graph._size[zones], -graph._value_array[zones]))].astype(np.int32)
     labels, width = graph._labels.ravel(), graph._labels.shape[1]
-    tracking = _contacts.start_tracking(labels, width, graph._alive)
-    _fusion.merge_ripples(order, float(ripples), labels, width, graph._size, graph._alive, compact, tracking)
+    tracking = start_tracking(labels, width, graph._alive)
+    kernels().merge_ripples(order, float(ripples), labels, width, graph._size, graph._alive, compact, tracking)
     return graph
 
 
@@ -201,8 +199,8 @@ def remove_doors(graph: ZoneGraph, *, doors: float = 40) -> ZoneGraph:
     """
     compact = graph._run_compiled()
     labels, width = graph._labels.ravel(), graph._labels.shape[1]
-    tracking = _contacts.start_tracking(labels, width, graph._alive)
-    _fusion.remove_doors(float(doors), labels, width, graph._size, graph._alive, compact, tracking)
+    tracking = start_tracking(labels, width, graph._alive)
+    kernels().remove_doors(float(doors), labels, width, graph._size, graph._alive, compact, tracking)
     return graph
 
 

@@ -12,9 +12,8 @@ from collections.abc import Callable
 import numpy as np
 
 from ursim_core.errors import SegmentationError
-from ursim_core.segmentation.maoris.kernels import adjacency as _adjacency
-from ursim_core.segmentation.maoris.kernels import contacts as _contacts
-from ursim_core.segmentation.maoris.kernels import flat_zones as _flat_zones
+from ursim_core.segmentation.maoris.compiled import kernels
+from ursim_core.segmentation.maoris.kernels.constants import NO_MINIMUM
 
 __all__ = ["flat_zones", "ZoneGraph", "ZoneEdge"]
 
@@ -32,7 +31,23 @@ def flat_zones(values: np.ndarray) -> np.ndarray:
     values = np.asarray(values)
     if values.ndim != 2:
         raise SegmentationError(f"value image must be 2-D, got shape {values.shape}")
-    return _flat_zones.label_flat_zones(values)
+    return kernels().label_flat_zones(_as_value_bytes(values))
+
+
+def _as_value_bytes(values: np.ndarray) -> np.ndarray:
+    """The value image as C-ordered uint8 (the kernel's one signature), zones unchanged: other
+    dtypes are ranked (0 stays 0), which keeps equal values equal and distinct ones distinct."""
+    if values.dtype == np.uint8:
+        return np.ascontiguousarray(values)
+    distinct, rank = np.unique(values, return_inverse=True)
+    nonzero = distinct != 0
+    if int(nonzero.sum()) > 255:
+        raise SegmentationError(
+            f"value image has {int(nonzero.sum())} distinct non-zero values; at most 255 are supported"
+        )
+    codes = np.zeros(len(distinct), np.uint8)
+    codes[nonzero] = np.arange(1, int(nonzero.sum()) + 1)
+    return codes[rank.reshape(values.shape)]
 
 
 class ZoneEdge:
@@ -96,14 +111,14 @@ class ZoneGraph:
         zones = zones.astype(np.int32, copy=False)
         self._labels = np.pad(zones, _PAD)
         count = int(zones.max(initial=0))
-        value, self._size = _flat_zones.zone_values_and_sizes(zones, values, count + 1)
+        value, self._size = kernels().zone_values_and_sizes(zones, values, count + 1)
         self._value_array = value
         self._value: list[int] = value.tolist()
         # The adjacency lives either in compact arrays (the compiled steps'
         # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
         self._alive = self._size > 0
         self._alive[0] = False
-        self._compact: tuple | None = _adjacency.build_adjacency(zones, value)
+        self._compact: tuple | None = kernels().build_adjacency(zones, value)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         # Contact counts, computed for the whole image when first queried and
         # dropped by the next fusion (the compiled steps track their own).
@@ -126,9 +141,9 @@ class ZoneGraph:
     def _adjacency_dicts(self) -> dict[int, dict[int, ZoneEdge | None]]:
         adj: dict[int, dict[int, ZoneEdge | None]] = {zone: {} for zone in np.flatnonzero(self._alive).tolist()}
         edges: dict[int, ZoneEdge | None] = {}  # node -> the edge object both directions share
-        for zone, other, node, twin, low, unbreakable in _adjacency.adjacency_entries(
-            self._alive, self._compact
-        ).tolist():
+        for zone, other, node, twin, low, unbreakable in (
+            kernels().adjacency_entries(self._alive, self._compact).tolist()
+        ):
             edge = edges.pop(twin, _MISSING)
             if edge is _MISSING:
                 edge = None if low < 0 and not unbreakable else ZoneEdge(None if low < 0 else low, bool(unbreakable))
@@ -140,7 +155,7 @@ class ZoneGraph:
         """The adjacency as compact arrays (converted from `_adj` if needed)."""
         if self._compact is None:
             entries = [
-                (a, b, _adjacency.NO_MINIMUM if edge is None or edge.minimum is None else edge.minimum,
+                (a, b, NO_MINIMUM if edge is None or edge.minimum is None else edge.minimum,
                  edge is not None and edge.unbreakable)
                 for a, neighbours in self._adj.items()
                 for b, edge in neighbours.items()
@@ -148,7 +163,7 @@ class ZoneGraph:
             columns = list(zip(*entries)) or [()] * 4
             zone, other, minimum = (np.array(column, np.int32) for column in columns[:3])
             unbreakable = np.array(columns[3], bool)
-            self._compact = _adjacency.adjacency_from_entries(zone, other, minimum, unbreakable, self._value_array)
+            self._compact = _adjacency_from_entries(zone, other, minimum, unbreakable, self._value_array)
             self._alive = np.zeros(len(self._value), bool)
             self._alive[list(self._adj)] = True
             self._adj = None
@@ -229,7 +244,7 @@ class ZoneGraph:
         self._flush()
         zones = np.array(self.vertices(), np.int64)
         # The padding adds no labels, so raster order in it is raster order in the map.
-        first = _flat_zones.first_pixels(self._labels, len(self._value))[zones]
+        first = kernels().first_pixels(self._labels, len(self._value))[zones]
         lookup = np.zeros(len(self._value), np.int32)
         lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
         return lookup[self.labels]
@@ -264,7 +279,7 @@ class ZoneGraph:
             self._flush()
             alive = np.zeros(len(self._value), bool)
             alive[self.vertices()] = True
-            table = _contacts.contact_table(self._labels.ravel(), self._labels.shape[1], alive)
+            table = kernels().contact_table(self._labels.ravel(), self._labels.shape[1], alive)
             codes = table[:, 0] * len(self._value) + table[:, 1]
             self._contacts = dict(zip(codes.tolist(), table[:, 2].tolist()))
         return self._contacts
@@ -320,3 +335,18 @@ class ZoneGraph:
         self._contacts = None
         for neighbour in self.adj.pop(zone):
             del self.adj[neighbour][zone]
+
+
+def _adjacency_from_entries(zone, other, minimum, unbreakable, value):
+    """Zone graph from (zone, neighbour, minimum, unbreakable) entries, each
+    zone's in list order: the inverse of the kernel ``adjacency_entries``. Every edge
+    must appear in both directions, with the same attributes."""
+    # Entry i of an edge (low -> high) owns the node pair 2i, 2i + 1; the
+    # reversed entry finds it by key. The keys are distinct, so any sort gives the
+    # same owners; numpy's sort here spares compiling numba's (about 5 s).
+    count = len(value)
+    keys = zone.astype(np.int64) * count + other
+    order = np.argsort(keys)
+    low, high = np.minimum(zone, other).astype(np.int64), np.maximum(zone, other)
+    owner = order[np.searchsorted(keys[order], low * count + high)]
+    return kernels()._link_entries(zone, other, owner, minimum, unbreakable, value)

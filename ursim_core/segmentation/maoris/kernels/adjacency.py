@@ -34,10 +34,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ursim_core.segmentation.maoris.kernels.constants import NO_MINIMUM
 from ursim_core.segmentation.maoris.kernels.helpers import inner_kernel, loop_helper
-
-NO_MINIMUM = -1
-
 
 # Columns of the zone records (one row of 16 bytes per zone).
 HEAD, TAIL, DEGREE, VALUE = 0, 1, 2, 3
@@ -134,21 +132,6 @@ def _link_pair(records, nodes, node, a, b, minimum, unbreakable):
     _append(records, nodes, b, node + 1, a)
     nodes[node, ATTRIBUTE] = minimum
     nodes[node + 1, ATTRIBUTE] = unbreakable
-
-
-def adjacency_from_entries(zone, other, minimum, unbreakable, value):
-    """Zone graph from (zone, neighbour, minimum, unbreakable) entries, each
-    zone's in list order: the inverse of :func:`adjacency_entries`. Every edge
-    must appear in both directions, with the same attributes."""
-    # Entry i of an edge (low -> high) owns the node pair 2i, 2i + 1; the
-    # reversed entry finds it by key. The keys are distinct, so any sort gives the
-    # same owners; numpy's sort here spares compiling numba's (about 5 s).
-    count = len(value)
-    keys = zone.astype(np.int64) * count + other
-    order = np.argsort(keys)
-    low, high = np.minimum(zone, other).astype(np.int64), np.maximum(zone, other)
-    owner = order[np.searchsorted(keys[order], low * count + high)]
-    return _link_entries(zone, other, owner, minimum, unbreakable, value)
 
 
 @njit(cache=True)

@@ -1,15 +1,12 @@
 """Counting the contacts of a MAORIS label image (numba).
 
-:func:`start_tracking` compacts the labels and counts every contact, in bands
-of rows on threads for large images; :func:`contact_table` gives all counts
+:func:`count_contacts` counts every contact of a range of pixels (the bands of
+:func:`ursim_core.segmentation.maoris.contact_tracking.start_tracking`); :func:`contact_table` gives all counts
 as rows. The pixel-level rules (contour pixel, partners, the changes a fusion
 makes) are the helpers here; :mod:`.fusion` applies them while fusing.
 """
 
 from __future__ import annotations
-
-import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from numba import njit
@@ -319,43 +316,6 @@ def join_counts(first, second):
         if keys_b[slot] != _EMPTY and counts_b[slot] != 0:
             _contact_add(slots, keys, counts, meta, base, keys_b[slot] // base, keys_b[slot] % base, counts_b[slot])
     return pixels, following, head, tail, used + used_b, keys, counts, meta, slots, total
-
-
-def start_tracking(labels, width, alive, *, bands=None):
-    """Compact the labels of a padded, flattened label image in place
-    (:func:`_compact_labels`) and count their contacts: ``(original,
-    compact_of, state)`` for the compiled steps that track contacts.
-
-    The state is ``(parent, pixels, following, head, tail, keys, counts,
-    meta, slots, total)``: union-find parents of the labels, then the arrays
-    of :func:`count_contacts`. Large images are counted in ``bands`` of rows
-    at the same time (default: one per CPU, at most 4), each on a thread.
-    """
-    original, compact_of, n = _compact_labels(labels, alive)
-    if bands is None:
-        bands = min(_usable_cpus(), 4) if labels.size >= _BAND_PIXELS else 1
-    rows = labels.size // width
-    edges = [row * width for row in np.linspace(0, rows, bands + 1).astype(int)]
-    if bands == 1:
-        counted = [count_contacts(labels, width, n, 0, labels.size)]
-    else:
-        with ThreadPoolExecutor(bands) as pool:
-            counted = list(pool.map(lambda k: count_contacts(labels, width, n, edges[k], edges[k + 1]), range(bands)))
-    joined = counted[0]
-    for band in counted[1:]:
-        joined = join_counts(joined, band)
-    pixels, following, head, tail, _, keys, counts, meta, slots, total = joined
-    parent = np.arange(n, dtype=np.int32)
-    return original, compact_of, (parent, pixels, following, head, tail, keys, counts, meta, slots, total)
-
-
-# Smaller images are counted on one thread: starting threads costs more.
-_BAND_PIXELS = 1 << 20
-
-
-def _usable_cpus() -> int:
-    """CPUs this process may run on (a container or taskset may allow fewer than the machine has)."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 @njit(cache=True)

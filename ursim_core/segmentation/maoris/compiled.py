@@ -1,0 +1,255 @@
+"""The MAORIS kernels as the steps call them: built ahead of time when fresh, else numba's JIT.
+
+:func:`kernels` gives one namespace with every kernel called from Python (the names of
+:data:`ENTRY_KERNELS`). It is the extension module that
+:func:`build_ahead` wrote (``make`` builds it)
+when that module was built from the kernel sources of this install, which takes milliseconds
+and no numba. When there is none, the first call builds it (about 25 s of CPU, once, as long as
+the JIT's own first compile); when that fails (pycc needs a C compiler), numba's JIT
+dispatchers of :mod:`.kernels`, which import numba and load (or compile) their cache. Both run the same compiled Python source for the same
+signatures; a test checks that their label images agree.
+
+``URSIM_KERNELS`` chooses: ``auto`` (default), ``jit`` (always the JIT) or ``ahead`` (the
+built module, or a :class:`~ursim_core.errors.SegmentationError` saying how to build it).
+This module imports neither numba nor the kernels, but to build.
+
+The build: numba's JIT costs every new process about a second before the first segmentation,
+importing numba and its typing registries (0.4-0.6 s) and loading the cached machine code of
+each kernel (0.3-0.7 s). The same kernels, compiled once with :mod:`numba.pycc` for the one
+signature each has (:data:`.kernels.signatures.SIGNATURES`), form an ordinary extension module
+that imports in milliseconds and needs neither numba nor llvmlite at run time. Every exported
+kernel releases the GIL, as the JIT's ``count_contacts`` does (``nogil=True``): the contacts of
+large maps are counted in bands on threads. The kernels touch only the arrays they are given,
+never a Python object, so releasing it is safe for all of them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import os
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+from types import SimpleNamespace
+
+from ursim_core.errors import SegmentationError
+
+__all__ = [
+    "ENTRY_KERNELS",
+    "MODULE_NAME",
+    "DIGEST_NAME",
+    "kernels",
+    "ahead_module_path",
+    "build_directories",
+    "sources_digest",
+    "build_ahead",
+    "build_or_warn",
+    "forget",
+]
+
+#: The kernels called from Python, by module of :mod:`.kernels` (the helpers they call are
+#: compiled into them). A test checks this against :data:`.kernels.signatures.SIGNATURES`.
+ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
+    "discs": ("centre_rectangles", "paint_discs"),
+    "flat_zones": ("label_flat_zones", "zone_values_and_sizes", "first_pixels", "resolve_parents", "relabel"),
+    "adjacency": ("build_adjacency", "adjacency_entries", "_link_entries", "remove_small_zones"),
+    "contacts": ("_compact_labels", "count_contacts", "join_counts", "contact_table"),
+    "fusion": ("merge_ripples", "remove_doors"),
+}
+
+MODULE_NAME = "_maoris_kernels"
+"""Name of the extension module built ahead of time."""
+DIGEST_NAME = MODULE_NAME + ".digest"
+"""The file beside it that names the sources it was built from (:func:`sources_digest`)."""
+
+_KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
+_loaded: SimpleNamespace | None = None
+
+
+def sources_digest() -> str:
+    """SHA-256 of the kernel sources (every ``.py`` of :mod:`.kernels`) and the Python ABI.
+
+    The built module is used only while this matches the digest it was built with: an
+    edited kernel falls back to the JIT until the module is built again.
+    """
+    digest = hashlib.sha256(importlib.machinery.EXTENSION_SUFFIXES[0].encode())
+    for source in sorted(_KERNELS_DIR.glob("*.py")):
+        digest.update(source.name.encode() + b"\0" + source.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def build_directories() -> list[Path]:
+    """Where the built module may live, in the order looked at: beside the kernels (a
+    checkout or a writable install), then the user's cache (``$XDG_CACHE_HOME/ursim``)."""
+    xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    folder = hashlib.sha1(str(_KERNELS_DIR).encode()).hexdigest()[:16]
+    own = _KERNELS_DIR / "__pycache__"
+    user = Path(xdg) / "ursim" / f"kernels-{folder}"
+    return [own, user] if os.access(_KERNELS_DIR, os.W_OK) else [user, own]
+
+
+def ahead_module_path() -> Path | None:
+    """The built module of these kernel sources, or None when there is none (or it is stale)."""
+    wanted = None
+    for folder in build_directories():
+        try:
+            recorded = (folder / DIGEST_NAME).read_text(encoding="ascii").strip()
+        except OSError:
+            continue
+        wanted = wanted or sources_digest()
+        candidate = folder / (MODULE_NAME + importlib.machinery.EXTENSION_SUFFIXES[0])
+        if recorded == wanted and candidate.is_file():
+            return candidate
+    return None
+
+
+def _load_ahead(path: Path) -> SimpleNamespace:
+    spec = importlib.util.spec_from_file_location(MODULE_NAME, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    names = [name for group in ENTRY_KERNELS.values() for name in group]
+    return SimpleNamespace(source="ahead", path=path, **{name: getattr(module, name) for name in names})
+
+
+def _load_jit() -> SimpleNamespace:
+    import importlib
+
+    found = {}
+    for module_name, names in ENTRY_KERNELS.items():
+        module = importlib.import_module(f"ursim_core.segmentation.maoris.kernels.{module_name}")
+        found.update({name: getattr(module, name) for name in names})
+    return SimpleNamespace(source="jit", path=None, **found)
+
+
+def kernels() -> SimpleNamespace:
+    """Every kernel called from Python, and ``source`` ("ahead" or "jit"); loaded once.
+
+    Examples
+    --------
+    >>> kernels().source in ("ahead", "jit")
+    True
+    """
+    global _loaded
+    if _loaded is None:
+        choice = os.environ.get("URSIM_KERNELS", "auto").strip().lower() or "auto"
+        if choice not in ("auto", "jit", "ahead"):
+            raise SegmentationError(f"URSIM_KERNELS must be auto, jit or ahead, not {choice!r}")
+        path = None if choice == "jit" else ahead_module_path()
+        if choice == "auto" and path is None:
+            path = build_or_warn()  # once per install: as long as the JIT's first compile
+        if choice == "ahead" and path is None:
+            raise SegmentationError(
+                "URSIM_KERNELS=ahead but the kernels are not built for these sources: run "
+                f"`{Path(sys.executable).name} -m ursim_core.segmentation.maoris.compiled`"
+            )
+        _loaded = _load_ahead(path) if path is not None else _load_jit()
+    return _loaded
+
+
+def build_or_warn() -> Path | None:
+    """Build the kernels ahead of time; on failure warn, and return None (the JIT is used)."""
+    try:
+        return build_ahead()
+    except Exception as error:
+        warnings.warn(
+            f"could not build the segmentation kernels ahead of time ({type(error).__name__}: {error}); "
+            "using numba's JIT, which starts about a second slower",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        return None
+
+
+def forget() -> None:
+    """Load again on the next :func:`kernels` (after a build, or to switch ``URSIM_KERNELS``)."""
+    global _loaded
+    _loaded = None
+
+
+def build_ahead(directory: str | Path | None = None) -> Path:
+    """Compile every kernel into the extension module loaded here; return its path.
+
+    The module and its digest file are written to ``directory`` (default: the first writable
+    of :func:`build_directories`), the module first,
+    each by a rename, so a reader never sees a digest without its module. Takes about 20 s of
+    CPU (``ursim bench kernels`` measures it).
+    """
+    from numba.core.compiler import Flags
+    from numba.pycc import CC
+    from numba.pycc import compiler as pycc_compiler
+
+    from ursim_core.segmentation.maoris.kernels import signatures
+
+    target = Path(directory) if directory is not None else build_directories()[0]
+    target.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="ursim-kernels-", dir=target) as scratch:
+        cc = CC(MODULE_NAME)
+        cc.output_dir = scratch
+        cc.verbose = False
+        for key, args in signatures.SIGNATURES.items():
+            py_func = signatures.kernel(key).py_func
+            cc.export(key[1], _typed_signature(py_func, args))(py_func)
+        original_flags = pycc_compiler.Flags
+        pycc_compiler.Flags = _GilReleasingFlags.make(Flags)
+        try:
+            cc.compile()
+        finally:
+            pycc_compiler.Flags = original_flags
+        (built,) = Path(scratch).glob(MODULE_NAME + ".*")
+        module_path = target / built.name
+        os.replace(built, module_path)
+        digest_path = Path(scratch) / "digest"
+        digest_path.write_text(sources_digest() + "\n", encoding="ascii")
+        os.replace(digest_path, target / DIGEST_NAME)
+    forget()
+    return module_path
+
+
+def _typed_signature(py_func, args):
+    """The full signature (with its return type) that numba's typing gives ``py_func(*args)``.
+
+    pycc wants the return type too; typing alone, without machine code, gives it (a JIT
+    compile of the entry kernel would cost seconds more on an empty cache).
+    """
+    from numba.core import compiler
+    from numba.core.registry import cpu_target
+
+    # As a dispatcher does before compiling: load the typing and lowering registries.
+    cpu_target.typing_context.refresh()
+    cpu_target.target_context.refresh()
+    flags = compiler.Flags()
+    flags.no_compile = True
+    flags.nrt = True
+    flags.no_cpython_wrapper = True
+    flags.no_cfunc_wrapper = True
+    result = compiler.compile_extra(
+        cpu_target.typing_context, cpu_target.target_context, py_func, args, None, flags, locals={}
+    )
+    return result.signature
+
+
+class _GilReleasingFlags:
+    """pycc builds its own ``Flags()`` for the exports, with no way to ask for ``nogil``."""
+
+    @staticmethod
+    def make(base):
+        class Flags(base):
+            def __init__(self, *args, **kwargs):
+                super().__init__(*args, **kwargs)
+                self.release_gil = True
+
+        return Flags
+
+
+def _main() -> None:  # ``python -m ursim_core.segmentation.maoris.compiled``
+    started = time.process_time()
+    path = build_ahead()
+    print(f"{path} ({time.process_time() - started:.1f} s CPU)")
+
+
+if __name__ == "__main__":
+    _main()
