@@ -130,6 +130,27 @@ def test_stale_or_missing_build_is_not_used(tmp_path, monkeypatch):
     compiled.forget()
 
 
+def test_a_broken_build_is_reported_and_left_for_the_jit(tmp_path, monkeypatch):
+    from ursim_core.segmentation.maoris import compiled
+
+    module = tmp_path / (compiled.MODULE_NAME + compiled.importlib.machinery.EXTENSION_SUFFIXES[0])
+    module.write_bytes(b"\x7fELF truncated")
+    (tmp_path / compiled.DIGEST_NAME).write_text(compiled.sources_digest() + "\n", encoding="ascii")
+    monkeypatch.setattr(compiled, "build_directories", lambda: [tmp_path])
+    rebuilds = []
+    monkeypatch.setattr(compiled, "build_or_warn", lambda: rebuilds.append(1))  # no 25 s build here
+    monkeypatch.setenv("URSIM_KERNELS", "auto")
+    compiled.forget()
+    with pytest.warns(RuntimeWarning, match="cannot be loaded.*building them again"):
+        assert compiled.kernels().source == "jit"
+    assert rebuilds == [1]
+    monkeypatch.setenv("URSIM_KERNELS", "ahead")
+    compiled.forget()
+    with pytest.raises(compiled.SegmentationError, match=str(module.name)):
+        compiled.kernels()
+    compiled.forget()
+
+
 def test_importing_the_kernels_for_a_segmentation_loads_no_numba():
     from ursim_core.segmentation.maoris import compile_kernels
 

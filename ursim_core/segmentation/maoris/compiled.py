@@ -146,8 +146,29 @@ def kernels() -> SimpleNamespace:
                 "URSIM_KERNELS=ahead but the kernels are not built for these sources: run "
                 f"`{Path(sys.executable).name} -m ursim_core.segmentation.maoris.compiled`"
             )
-        _loaded = _load_ahead(path) if path is not None else _load_jit()
+        _loaded = _load_ahead_or_warn(path, choice) if path is not None else None
+        if _loaded is None:
+            _loaded = _load_jit()
     return _loaded
+
+
+def _load_ahead_or_warn(path: Path, choice: str) -> SimpleNamespace | None:
+    """The built module at ``path``; a broken one (truncated, foreign, missing a kernel) is
+    reported, and then built again (``auto``), refused (``ahead``) or left for the JIT."""
+    try:
+        return _load_ahead(path)
+    except (ImportError, OSError, AttributeError) as error:
+        problem = f"the segmentation kernels built at {path} cannot be loaded ({type(error).__name__}: {error})"
+    if choice == "ahead":
+        raise SegmentationError(problem)
+    warnings.warn(f"{problem}; building them again", RuntimeWarning, stacklevel=3)
+    rebuilt = build_or_warn()
+    if rebuilt is None:
+        return None
+    try:
+        return _load_ahead(rebuilt)
+    except (ImportError, OSError, AttributeError):
+        return None
 
 
 def build_or_warn() -> Path | None:
