@@ -112,15 +112,16 @@ def match_at(prepared: Prepared, m: float) -> MatchResult:
             if not seeds:
                 reasons.append(f"no seeds: no pair of regions has c <= m = {m:g}")
             else:
-                same = (c_matrix <= m).tolist()
+                # Arrays, not nested lists: converting an n1 x n2 matrix costs seconds for
+                # thousands of regions, and the planar matcher reads only a few of its cells.
                 outcome = planar_match(
                     prepared.sketch_planar,
                     prepared.metric_planar,
-                    same,
+                    np.asarray(c_matrix) <= m,
                     seeds=seeds,
                     rotation_search=config.rotation_search,
                     reflections=config.reflections,
-                    pair_costs=None if pair_costs is None else pair_costs.tolist(),
+                    pair_costs=pair_costs,
                     pair_cost_weight=config.score_weight,
                 )
                 index_pairs = outcome.pairs
