@@ -30,9 +30,22 @@ def seed_pairs(c_matrix: np.ndarray, m: float, *, max_seeds: int | None = None) 
     c_matrix = np.asarray(c_matrix)
     rows, cols = np.nonzero(c_matrix <= m)
     if max_seeds is not None and rows.size > max_seeds:
-        keep = np.sort(np.argsort(c_matrix[rows, cols], kind="stable")[:max_seeds])
+        keep = _lowest_in_order(c_matrix[rows, cols], max_seeds)
         rows, cols = rows[keep], cols[keep]
     return list(zip(rows.tolist(), cols.tolist()))
+
+
+def _lowest_in_order(values: np.ndarray, count: int) -> np.ndarray:
+    """Positions of the ``count`` lowest values, ties by position, in ascending position order.
+
+    The same as ``np.sort(np.argsort(values, kind="stable")[:count])`` in O(n) instead of
+    O(n log n): with millions of candidate seeds (thousands of regions, a large m) the sort
+    cost seconds per m.
+    """
+    kth = np.partition(values, count - 1)[count - 1]
+    below = np.flatnonzero(values < kth)
+    tied = np.flatnonzero(values == kth)[: count - below.size]
+    return np.sort(np.concatenate([below, tied]))
 
 
 def seed_cap(max_seeds, n_sketch: int, n_metric: int) -> int | None:

@@ -16,9 +16,20 @@ import numpy as np
 from ursim_core.errors import UrsimError
 from ursim_core.io.atomic import atomic_write_bytes
 
-__all__ = ["distinct_colors", "label_colors", "overlay_segmentation", "side_by_side_matches", "save_png"]
+__all__ = [
+    "FIGURE_MAX_SIDE",
+    "distinct_colors",
+    "label_colors",
+    "overlay_segmentation",
+    "side_by_side_matches",
+    "save_png",
+]
 
 _GOLDEN = 0.618033988749895
+
+#: Longest side, in pixels, at which :func:`side_by_side_matches` draws a map (larger ones are
+#: scaled down): every KTH sketch and robot map is smaller, a 8000 x 8000 building is halved.
+FIGURE_MAX_SIDE = 4000
 
 
 def distinct_colors(n: int, *, saturation: float = 0.65, value: float = 0.95) -> np.ndarray:
@@ -145,12 +156,18 @@ def side_by_side_matches(
     *,
     anchors: Sequence[tuple[int, int]] = (),
     gap: int = 24,
+    max_side: int | None = FIGURE_MAX_SIDE,
 ) -> np.ndarray:
     """Both maps side by side, matched regions sharing a colour, connector lines, anchors ringed.
 
     ``sketch`` and ``metric`` are ``(labels, graph, grey_image_or_None)``. The metric map is
-    scaled to the sketch's height so both read at a similar size.
+    scaled to the sketch's height so both read at a similar size. A map whose longer side
+    exceeds ``max_side`` pixels is drawn scaled down to it (None: never): a building-sized
+    map would otherwise give a figure of hundreds of megabytes that takes longer to draw
+    than to match.
     """
+    sketch = _shrunk(*sketch, max_side)
+    metric = _shrunk(*metric, max_side)
     pair_colors = distinct_colors(max(len(pairs), 1))
     grey = np.array((205, 205, 205), np.uint8)
     sketch_colors = {r: grey for r in sketch[1].nodes}
@@ -190,6 +207,29 @@ def side_by_side_matches(
         color = tuple(int(v) for v in pair_colors[index])
         cv2.line(canvas, (int(cs), int(rs)), (int(offset + cm * scale), int(rm * scale)), color, 2, cv2.LINE_AA)
     return canvas
+
+
+def _shrunk(labels: np.ndarray, graph: nx.Graph, image: np.ndarray | None, max_side: int | None):
+    """``(labels, graph, image)`` scaled so that the longer side is at most ``max_side``.
+
+    Labels are resized by nearest neighbour, the grey image by area averaging, and the graph
+    is replaced by one with the same nodes and their scaled ``interior`` points (no edges:
+    the figure does not draw them).
+    """
+    labels = np.asarray(labels)
+    longest = max(labels.shape) if labels.size else 0
+    if max_side is None or longest <= max_side:
+        return labels, graph, image
+    factor = max_side / longest
+    size = (max(1, round(labels.shape[1] * factor)), max(1, round(labels.shape[0] * factor)))
+    small_labels = cv2.resize(labels.astype(np.int32, copy=False), size, interpolation=cv2.INTER_NEAREST)
+    small_image = None
+    if image is not None:
+        small_image = cv2.resize(np.asarray(image, np.uint8), size, interpolation=cv2.INTER_AREA)
+    small_graph = nx.Graph()
+    for region, (row, col) in graph.nodes(data="interior"):
+        small_graph.add_node(region, interior=(row * factor, col * factor))
+    return small_labels, small_graph, small_image
 
 
 def save_png(path: str | Path, rgb: np.ndarray) -> None:
