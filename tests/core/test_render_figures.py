@@ -31,3 +31,17 @@ def test_a_map_above_the_limit_is_drawn_scaled_down():
     assert figure.shape[1] == 75 + 24 + round(80 * 100 / 120)
     # Matched regions keep their shared colours: both halves show non-grey colour.
     assert (figure[:, :75].std(axis=2) > 20).any() and (figure[:, 99:].std(axis=2) > 20).any()
+
+
+def test_the_table_blend_gives_the_pixels_of_the_float_blend():
+    from ursim_core.render.figures import _base_image, _blended, label_colors
+
+    rng = np.random.default_rng(0)
+    labels = rng.integers(0, 30, (40, 50)).astype(np.int32)
+    base = _base_image(rng.integers(0, 256, (40, 50)).astype(np.uint8), None, labels.shape)
+    table = label_colors(labels)
+    inside = labels > 0
+    for opacity in (0.0, 0.3, 0.55, 0.7, 1.0):
+        expected = base.astype(np.float32)
+        expected[inside] = (1 - opacity) * expected[inside] + opacity * table.astype(np.float32)[labels[inside]]
+        assert np.array_equal(_blended(base, labels, inside, table, opacity), expected.astype(np.uint8))
