@@ -32,3 +32,12 @@ def test_startup_table_states_each_target(capsys):
     )
     out = capsys.readouterr().out
     assert "meets target" in out and "2.0x over target" in out
+
+
+def test_scale_prints_both_tables_with_the_whole_process_match(capsys):
+    # Tiny buildings: the figures are printed, never asserted; the rows and columns are.
+    assert runner.run_bench("scale", sizes=(200, 400)) == 0
+    out = capsys.readouterr().out
+    assert "segmentation scale" in out and "whole-process `ursim match`" in out
+    match_table = out.split("whole-process `ursim match`")[1]
+    assert "maxrss_mb" in match_table and "time_ratio" in match_table and "error" not in match_table

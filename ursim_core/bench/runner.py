@@ -6,7 +6,10 @@ from pathlib import Path
 
 from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 
-__all__ = ["run_bench"]
+__all__ = ["run_bench", "SCALE_SIZES"]
+
+#: Sides in pixels of the generated buildings of ``ursim bench scale`` (issue 14 targets at 8000).
+SCALE_SIZES = (1000, 2000, 4000, 8000)
 
 
 #: Benchmarks that other modules of this package provide (module, function), run on request.
@@ -16,12 +19,15 @@ _OPTIONAL = {
 }
 
 
-def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats: int = 5) -> int:
+def run_bench(
+    what: str = "all", *, datasets: str | Path | None = None, repeats: int = 5, sizes: tuple[int, ...] | None = None
+) -> int:
     """Run the benchmarks named by ``what`` and print figures.
 
     ``what``: 'segment', 'scale', 'match' or 'all' (those three), 'startup' (whole-process
     times, :mod:`ursim_core.bench.startup`), 'compile' (first-run kernel compilation) or 'files'
-    (correspondence files). Returns the exit code: 1 when the benchmark is not available.
+    (correspondence files). ``sizes``: the building sides of 'scale' (default :data:`SCALE_SIZES`).
+    Returns the exit code: 1 when the benchmark is not available.
     """
     root = dataset_root(datasets)
     if what == "startup":
@@ -61,10 +67,14 @@ def run_bench(what: str = "all", *, datasets: str | Path | None = None, repeats:
             print("== segmentation of the largest maps (median of repeats)")
             print_table(bench_segmentation(root, repeats=repeats))
     if what in ("scale", "all"):
+        from ursim_core.bench.scale import bench_match_process
         from ursim_core.bench.segmentation import bench_scale, print_table
 
-        print("== segmentation scale (generated buildings)")
-        print_table(bench_scale())
+        print("== segmentation scale (generated buildings; targets at 8000 px: 5 s, 1.5 GB)")
+        print_table(bench_scale(sizes or SCALE_SIZES))
+        print("== whole-process `ursim match` of each building against itself (targets at 8000 px: 30 s, 3 GB)")
+        print_table(bench_match_process(sizes or SCALE_SIZES))
+        print("time_ratio: wall time over the previous size's (each step is 4x the pixels; target <= 4.5)")
     if what in ("match", "all"):
         from ursim_core.bench.matching import main as bench_matching
 

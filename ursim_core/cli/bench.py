@@ -8,6 +8,7 @@ HELP = "Print speed and memory figures."
 EXAMPLES = """examples:
   ursim bench segment
   ursim bench startup --repeats 7
+  ursim bench scale --sizes 1000 2000 4000
   ursim bench all --datasets ../shared/datasets"""
 
 #: Benchmarks by name; "all" runs segment, scale and match (the others on request).
@@ -25,9 +26,16 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--datasets", help="datasets folder (default: $URSIM_DATASETS or ../shared/datasets)")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument(
+        "--sizes",
+        type=int,
+        nargs="+",
+        metavar="PX",
+        help="scale: building sides in pixels (default 1000 2000 4000 8000)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     from ursim_core.bench.runner import run_bench
 
-    return run_bench(args.what, datasets=args.datasets, repeats=args.repeats)
+    return run_bench(args.what, datasets=args.datasets, repeats=args.repeats, sizes=args.sizes)

@@ -70,10 +70,14 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
     >>> [r.m for r in sweep(prepare(g, g.copy()), [0.0, 0.1])]
     [0.0, 0.1]
     """
-    from ursim_core.matching.single import match_at
+    from ursim_core.matching.single import SeedSelector, match_at, seed_cap
 
     grid = prepared.config.m_grid if grid is None else grid
     c_matrix = prepared.c_matrix
+    selector = None
+    cap = seed_cap(prepared.config.max_seeds, *c_matrix.shape)
+    if prepared.config.matcher == "planar" and prepared.descriptors is not None and cap is not None and len(grid) > 1:
+        selector = SeedSelector(c_matrix, cap)
     results = []
     previous_mask = None
     for index, m in enumerate(grid, start=1):
@@ -81,7 +85,7 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
         if previous_mask is not None and np.array_equal(mask, previous_mask) and results:
             results.append(replace(results[-1], m=float(m)))
         else:
-            results.append(match_at(prepared, float(m)))
+            results.append(match_at(prepared, float(m), seed_selector=selector))
             previous_mask = mask
         if progress is not None:
             progress(index / len(grid), f"matching at m = {float(m):.3f}")

@@ -86,7 +86,8 @@ def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
         (``first``) and columns (``second``).
     same : callable or 2-D array-like of bool
         ``same(a, b)`` or ``same[a][b]``: True when element ``a`` of ``first`` and
-        element ``b`` of ``second`` are equal (substitution cost 0).
+        element ``b`` of ``second`` are equal (substitution cost 0). With a NumPy bool
+        array, alignments of :data:`COMPILED_CELLS` cells or more run compiled (same result).
 
     Returns
     -------
@@ -102,15 +103,20 @@ def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
     (1, 'dn')
     """
     rows, cols = len(first), len(second)
+    if isinstance(same, np.ndarray):
+        equal_array = _equal_array(first, second, same)
+        if rows * cols >= COMPILED_CELLS:
+            return _compiled_levenshtein(equal_array)
+        equal = equal_array.tolist()
+    elif callable(same):
+        equal = [[bool(same(a, b)) for b in second] for a in first]
+    else:  # a matrix: read its rows once instead of one call per cell (the matcher's hot loop)
+        equal = [[same[a][b] for b in second] for a in first]
     table = [[0] * (cols + 1) for _ in range(rows + 1)]
     for i in range(rows + 1):
         table[i][0] = i
     for j in range(cols + 1):
         table[0][j] = j
-    if callable(same):
-        equal = [[bool(same(a, b)) for b in second] for a in first]
-    else:  # a matrix: read its rows once instead of one call per cell (the matcher's hot loop)
-        equal = [[same[a][b] for b in second] for a in first]
     for i in range(1, rows + 1):
         equal_row = equal[i - 1]
         above, here = table[i - 1], table[i]
@@ -141,6 +147,41 @@ def levenshtein(first: Sequence, second: Sequence, same) -> tuple[int, str]:
                 operations.append("d")
                 i -= 1
     return table[rows][cols], "".join(reversed(operations))
+
+
+#: Alignments of at least this many cells (``len(first) * len(second)``) with a NumPy "same"
+#: matrix run in the compiled kernel (:mod:`ursim_core.matching.edit_kernel`); smaller ones stay in
+#: Python, so small maps never import numba. Both give the same operations.
+COMPILED_CELLS = 400
+
+_LETTERS = np.frombuffer(b"nsdi", dtype=np.uint8)
+
+
+def _equal_array(first: Sequence[int], second: Sequence[int], same: np.ndarray) -> np.ndarray:
+    """``same`` restricted to the rows ``first`` and the columns ``second``, in their order."""
+    rows = np.asarray(first, dtype=np.intp)
+    cols = np.asarray(second, dtype=np.intp)
+    return np.ascontiguousarray(same[rows[:, None], cols[None, :]], dtype=np.bool_)
+
+
+def _compiled_levenshtein(equal: np.ndarray) -> tuple[int, str]:
+    from ursim_core.matching.edit_kernel import levenshtein_codes
+
+    distance, codes = levenshtein_codes(equal)
+    return int(distance), _LETTERS[codes].tobytes().decode("ascii")
+
+
+def _compiled_aligned(first: Sequence[int], second: Sequence[int], equal: np.ndarray) -> list[tuple[int, int]]:
+    """Aligned pairs from the compiled backtrace: the ``n`` and ``s`` steps."""
+    from ursim_core.matching.edit_kernel import levenshtein_codes
+
+    _, codes = levenshtein_codes(equal)
+    first_positions = np.cumsum(codes != 3) - 1  # every step but an insertion advances in first
+    second_positions = np.cumsum(codes != 2) - 1  # every step but a deletion advances in second
+    aligned = codes <= 1
+    first_items = np.asarray(first)[first_positions[aligned]].tolist()
+    second_items = np.asarray(second)[second_positions[aligned]].tolist()
+    return list(zip(first_items, second_items))
 
 
 def normalised_distance(distance: int, first_length: int, second_length: int) -> float:
@@ -274,13 +315,16 @@ def aligned_pairs(alignment: Alignment) -> list[tuple]:
 
 
 def aligned_index_pairs(
-    first: Sequence[int], second: Sequence[int], same: Sequence[Sequence[bool]]
+    first: Sequence[int], second: Sequence[int], same: Sequence[Sequence[bool]] | np.ndarray
 ) -> list[tuple[int, int]]:
     """Pairs aligned by :func:`levenshtein` for integer sequences and a "same" matrix.
 
     Same result as ``aligned_pairs(align(first, second, same))`` (same costs, same
     backtrace ties), specialised for the matcher's inner loop: no operation string,
-    no callable, and a shortcut for one-element sequences.
+    no callable, and a shortcut for one-element sequences. ``same`` is nested lists or a
+    NumPy bool array; with an array, alignments of :data:`COMPILED_CELLS` cells or more
+    run compiled (the matcher passes an array, so the long neighbour lists of large maps
+    cost microseconds instead of milliseconds).
 
     Examples
     --------
@@ -292,14 +336,21 @@ def aligned_index_pairs(
         return []
     if rows == 1 and cols == 1:
         return [(first[0], second[0])]
+    if isinstance(same, np.ndarray):
+        equal_array = _equal_array(first, second, same)
+        if rows * cols >= COMPILED_CELLS:
+            return _compiled_aligned(first, second, equal_array)
+        equal = equal_array.tolist()
+    else:
+        equal = [[same_row[b] for b in second] for same_row in (same[a] for a in first)]
     table = [list(range(cols + 1))]
     for i in range(1, rows + 1):
-        same_row = same[first[i - 1]]
+        equal_row = equal[i - 1]
         above = table[i - 1]
         here = [i]
         left = i
         for j in range(1, cols + 1):
-            value = above[j - 1] + (0 if same_row[second[j - 1]] else 1)
+            value = above[j - 1] + (0 if equal_row[j - 1] else 1)
             if above[j] + 1 < value:
                 value = above[j] + 1
             if left + 1 < value:

@@ -94,26 +94,42 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0])
     if len(candidates) == 1:
         return base
-    prepared_candidates = [
-        base if index == 0 else _reoriented(base, sketch_graph, candidate) for index, candidate in enumerate(candidates)
-    ]
-    finalists = range(len(candidates))
+
+    def candidate(index: int) -> Prepared:
+        return base if index == 0 else _reoriented(base, sketch_graph, candidates[index])
+
     if max(base.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
         # Large graphs: one planar sweep costs seconds, so the orientation is chosen by how well
         # every region finds a close partner (mean of the row and column minima of c: all
-        # regions vote, and positions dominate c there). O(n1 n2), no matching.
+        # regions vote, and positions dominate c there). O(n1 n2), no matching. The candidates
+        # are made one at a time and only the best is kept (each c is n1 x n2 floats).
         def partner_cost(prepared: Prepared) -> float:
             c_matrix = prepared.c_matrix
             return float(c_matrix.min(axis=1).mean() + c_matrix.min(axis=0).mean())
 
-        costs = [(partner_cost(prepared), index) for index, prepared in enumerate(prepared_candidates)]
-        finalists = [min(costs)[1]]
-    elif config.m == "auto" and len(candidates) > _FINALISTS and len(config.m_grid) > 2 * _COARSE_STEP:
+        best: tuple[float, int, Prepared] | None = None
+        for index in range(len(candidates)):
+            prepared = candidate(index)
+            cost = partner_cost(prepared)
+            if best is None or (cost, index) < best[:2]:
+                best = (cost, index, prepared)
+            del prepared
+        prepared_candidates = {best[1]: best[2]}
+        finalists = [best[1]]
+    else:
+        prepared_candidates = {index: candidate(index) for index in range(len(candidates))}
+        finalists = range(len(candidates))
+    if (
+        len(finalists) > 1
+        and config.m == "auto"
+        and len(candidates) > _FINALISTS
+        and len(config.m_grid) > 2 * _COARSE_STEP
+    ):
         # Screen every orientation on a coarse m grid first; only the best few get the full sweep.
         coarse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: _COARSE_STEP]))
         screened = [
             (match_prepared(dataclasses.replace(prepared, config=coarse)).normalised_cost, index)
-            for index, prepared in enumerate(prepared_candidates)
+            for index, prepared in prepared_candidates.items()
         ]
         finalists = sorted(index for _, index in sorted(screened)[:_FINALISTS])
     trials = []

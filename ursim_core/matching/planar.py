@@ -50,6 +50,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import networkx as nx
+import numpy as np
 
 from ursim_core.matching.edit_distance import aligned_index_pairs, aligned_pairs, cyclic_align
 
@@ -234,7 +235,7 @@ def _expand_locked(first_order, second_order, matched, second_set, same, cache):
 def planar_match(
     first: PlanarGraph,
     second: PlanarGraph,
-    same: Sequence[Sequence[bool]],
+    same: Sequence[Sequence[bool]] | np.ndarray,
     *,
     seeds: Sequence[tuple[int, int]] | None = None,
     rotation_search: str = "min",
@@ -249,9 +250,10 @@ def planar_match(
     ----------
     first, second : PlanarGraph
         Sketch and metric graphs (index form, see :func:`planar_graph`).
-    same : 2-D sequence of bool
+    same : 2-D sequence of bool or NumPy bool array
         ``same[i][j]`` is True when sketch vertex i and metric vertex j compare equal
-        (``c <= m``).
+        (``c <= m``). An array (what :func:`~ursim_core.matching.single.match_at` passes)
+        lets long neighbour lists be aligned by the compiled kernel.
     seeds : sequence of (int, int), optional
         Seed pairs in processing order. Default: every pair with ``same[i][j]``,
         sketch index outer loop, metric index inner loop (as the released code).
@@ -262,7 +264,7 @@ def planar_match(
     keep_alternatives : bool
         Also return every expanded hypothesis (for inspection and for rules that
         re-rank them).
-    pair_costs : 2-D sequence of float, optional
+    pair_costs : 2-D sequence of float or NumPy array, optional
         Cost of matching sketch vertex i to metric vertex j, added to the score with
         weight ``pair_cost_weight`` (see the module docstring).
     pair_cost_weight : float
@@ -279,7 +281,9 @@ def planar_match(
     >>> sorted(result.pairs), result.cost
     ([(0, 0), (1, 1), (2, 2)], 0)
     """
-    if seeds is None:
+    if seeds is None and isinstance(same, np.ndarray):
+        seeds = list(zip(*(axis.tolist() for axis in np.nonzero(same))))
+    elif seeds is None:
         seeds = [(i, j) for i in range(first.n_vertices) for j in range(second.n_vertices) if same[i][j]]
     else:
         seeds = list(seeds)
@@ -289,8 +293,20 @@ def planar_match(
     edges_first, edges_second = len(first.edges), len(second.edges)
     weighted = pair_costs is not None and pair_cost_weight != 0
 
+    if weighted and isinstance(pair_costs, np.ndarray):
+        cost_array = pair_costs
+
+        def pair_costs_of(pairs):
+            # The same values in the same order as the nested-list form: the same float sum.
+            return cost_array[[a for a, _ in pairs], [b for _, b in pairs]].tolist()
+
+    else:
+
+        def pair_costs_of(pairs):
+            return [pair_costs[a][b] for a, b in pairs]
+
     def pair_term(pairs):
-        return pair_cost_weight * sum(pair_costs[a][b] for a, b in pairs) if weighted else 0
+        return pair_cost_weight * sum(pair_costs_of(pairs)) if weighted else 0
 
     # Every one-pair hypothesis has the same structural cost; they come first, so the first seed
     # wins among them (the first of the lowest pair cost when pair costs are used).

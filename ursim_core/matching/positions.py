@@ -72,7 +72,14 @@ def position_distance(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """
     first = np.asarray(first, dtype=np.float64).reshape(-1, 2)
     second = np.asarray(second, dtype=np.float64).reshape(-1, 2)
-    return np.sqrt(np.square(first[:, None, :] - second[None, :, :]).sum(axis=2))
+    # Per axis rather than one (n1, n2, 2) array: half the memory, the same sums.
+    rows = np.subtract.outer(first[:, 0], second[:, 0])
+    rows *= rows
+    cols = np.subtract.outer(first[:, 1], second[:, 1])
+    cols *= cols
+    rows += cols
+    del cols
+    return np.sqrt(rows, out=rows)
 
 
 def blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight):
@@ -82,4 +89,8 @@ def blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_n
     distances = position_distance(
         region_positions(sketch_graph, nodes=sketch_nodes), region_positions(metric_graph, nodes=metric_nodes)
     )
-    return (c_matrix + position_weight * distances) / (1.0 + position_weight)
+    # In place, in the order of ``(c + w * d) / (1 + w)``: the same values without two temporaries.
+    distances *= position_weight
+    distances += c_matrix
+    distances /= 1.0 + position_weight
+    return distances

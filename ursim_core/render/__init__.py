@@ -9,6 +9,13 @@ __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
     submodules=["figures"],
     submod_attrs={
-        "figures": ["distinct_colors", "label_colors", "overlay_segmentation", "side_by_side_matches", "save_png"]
+        "figures": [
+            "FIGURE_MAX_SIDE",
+            "distinct_colors",
+            "label_colors",
+            "overlay_segmentation",
+            "side_by_side_matches",
+            "save_png",
+        ]
     },
 )

@@ -74,23 +74,30 @@ def contour_pca_shape(mask: np.ndarray) -> float:
     return float(np.clip(1.0 - max(float(eigenvalues[0]), 0.0) / largest, 0.0, 1.0))
 
 
-def _bounding_boxes(labels: np.ndarray, count: int) -> np.ndarray:
-    """``(row_start, col_start, row_stop, col_stop)`` of each label 0..count - 1 (stops
-    exclusive; as ``scipy.ndimage.find_objects``, without importing scipy.ndimage).
-
-    Computed on the runs of equal labels along rows, far fewer than the pixels.
-    """
-    rows, cols = labels.shape
+def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Runs of equal non-zero labels along the rows: ``(label, row, col_start, col_stop)``."""
+    cols = labels.shape[1]
     starts = np.ones(labels.shape, bool)
     starts[:, 1:] = labels[:, 1:] != labels[:, :-1]
     run_rows, run_cols = np.nonzero(starts)
+    del starts
     run_labels = labels[run_rows, run_cols]
     # A run stops where the next one starts on the same row, else at the row's end.
     stops = np.full(len(run_cols), cols, np.intp)
     same_row = run_rows[1:] == run_rows[:-1]
     stops[:-1][same_row] = run_cols[1:][same_row]
     keep = run_labels > 0
-    run_labels, run_rows, run_cols, stops = run_labels[keep], run_rows[keep], run_cols[keep], stops[keep]
+    return run_labels[keep], run_rows[keep], run_cols[keep], stops[keep]
+
+
+def _bounding_boxes(labels: np.ndarray, count: int, runs=None) -> np.ndarray:
+    """``(row_start, col_start, row_stop, col_stop)`` of each label 0..count - 1 (stops
+    exclusive; as ``scipy.ndimage.find_objects``, without importing scipy.ndimage).
+
+    Computed on the runs of equal labels along rows, far fewer than the pixels.
+    """
+    rows, cols = labels.shape
+    run_labels, run_rows, run_cols, stops = _runs(labels) if runs is None else runs
     boxes = np.empty((count, 4), np.intp)
     boxes[:, 0], boxes[:, 1], boxes[:, 2], boxes[:, 3] = rows, cols, 0, 0
     np.minimum.at(boxes[:, 0], run_labels, run_rows)
@@ -98,6 +105,20 @@ def _bounding_boxes(labels: np.ndarray, count: int) -> np.ndarray:
     np.maximum.at(boxes[:, 2], run_labels, run_rows + 1)
     np.maximum.at(boxes[:, 3], run_labels, stops)
     return boxes
+
+
+def _coordinate_sums(runs, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sums of the row and of the column indices of each label's pixels, from its runs.
+
+    Integer sums (exact in float64 below 2**53), so the centroids are those of a sum over the
+    pixels, without two int64 index images of the map's size.
+    """
+    run_labels, run_rows, run_cols, stops = runs
+    lengths = (stops - run_cols).astype(np.int64)
+    row_sums = np.bincount(run_labels, weights=run_rows.astype(np.int64) * lengths, minlength=count)
+    # Columns start..stop-1 sum to (start + stop - 1) * length / 2, an integer.
+    col_sums = np.bincount(run_labels, weights=(run_cols + stops - 1).astype(np.int64) * lengths // 2, minlength=count)
+    return row_sums, col_sums
 
 
 def region_graph(labels: np.ndarray) -> nx.Graph:
@@ -135,10 +156,10 @@ def region_graph(labels: np.ndarray) -> nx.Graph:
     n_max = int(labels.max())
     flat = labels.ravel()
     sizes = np.bincount(flat, minlength=n_max + 1)
-    rows, cols = np.indices(labels.shape)
-    row_sums = np.bincount(flat, weights=rows.ravel(), minlength=n_max + 1)
-    col_sums = np.bincount(flat, weights=cols.ravel(), minlength=n_max + 1)
-    boxes = _bounding_boxes(labels, n_max + 1)
+    runs = _runs(labels)
+    row_sums, col_sums = _coordinate_sums(runs, n_max + 1)
+    boxes = _bounding_boxes(labels, n_max + 1, runs)
+    del runs
     for index in range(1, n_max + 1):
         if sizes[index] == 0:
             continue

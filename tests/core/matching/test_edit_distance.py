@@ -88,3 +88,23 @@ def test_reflections_are_tried_only_when_asked():
 def test_unknown_rotation_search_is_rejected():
     with pytest.raises(ValueError):
         cyclic_align("ab", "ab", equal, rotation_search="all")
+
+
+@pytest.mark.parametrize("density", [0.05, 0.5, 0.95])
+def test_compiled_alignment_gives_the_python_operations_and_pairs(density):
+    # A NumPy "same" matrix sends long alignments (COMPILED_CELLS or more) to the numba kernel;
+    # nested lists stay in Python. Dense and sparse relations make many backtrace ties.
+    import numpy as np
+
+    from ursim_core.matching.edit_distance import COMPILED_CELLS, aligned_index_pairs, levenshtein
+
+    rng = np.random.default_rng(int(density * 100))
+    same = rng.random((90, 90)) < density
+    long_ones = 0
+    for _ in range(60):
+        first = rng.integers(0, 90, int(rng.integers(0, 70))).tolist()
+        second = rng.integers(0, 90, int(rng.integers(0, 70))).tolist()
+        long_ones += len(first) * len(second) >= COMPILED_CELLS
+        assert levenshtein(first, second, same) == levenshtein(first, second, same.tolist())
+        assert aligned_index_pairs(first, second, same) == aligned_index_pairs(first, second, same.tolist())
+    assert long_ones > 10

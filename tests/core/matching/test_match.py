@@ -166,3 +166,29 @@ def test_large_graphs_use_the_seed_cap():
     assert result.seeds_count <= max(64, 100_000 // 400)
     correct = sum(1 for a, b in result.pairs if mapping[a] == b)
     assert correct >= 0.95 * 400
+
+
+def test_capped_seeds_are_the_lowest_c_with_ties_in_loop_order():
+    import numpy as np
+
+    from ursim_core.matching.single import seed_pairs
+
+    rng = np.random.default_rng(3)
+    c_matrix = rng.integers(0, 6, (40, 50)) / 10.0  # many ties
+    rows, cols = np.nonzero(c_matrix <= 0.3)
+    keep = np.sort(np.argsort(c_matrix[rows, cols], kind="stable")[:100])
+    expected = list(zip(rows[keep].tolist(), cols[keep].tolist()))
+    assert seed_pairs(c_matrix, 0.3, max_seeds=100) == expected
+
+
+def test_seed_selector_gives_the_capped_seeds_of_every_m():
+    import numpy as np
+
+    from ursim_core.matching.single import SeedSelector, seed_pairs
+
+    rng = np.random.default_rng(4)
+    c_matrix = rng.integers(0, 12, (30, 45)) / 20.0  # many ties
+    for cap in (1, 7, 64, 5000):
+        selector = SeedSelector(c_matrix, cap)
+        for m in np.arange(0.0, 0.7, 0.025):
+            assert selector.at(float(m)) == seed_pairs(c_matrix, float(m), max_seeds=cap)

@@ -64,11 +64,14 @@ def inscribed_circle_radii(free: np.ndarray, *, max_radius: int = 500) -> np.nda
     free = _as_free_mask(free)
     if int(max_radius) < 1:
         raise ParameterError(f"must be >= 1, got {max_radius!r}", field="max_radius")
-    out = np.zeros(free.shape, np.int32)
     window = _free_bbox(free, margin=1)
     if window is None:
-        return out
-    out[window] = _inscribed_radii_in_window(free[window], int(max_radius))
+        return np.zeros(free.shape, np.int32)
+    inner = _inscribed_radii_in_window(free[window], int(max_radius))
+    if inner.shape == free.shape:  # the window is the whole image (maoris_labels crops to it first)
+        return inner
+    out = np.zeros(free.shape, np.int32)
+    out[window] = inner
     return out
 
 
@@ -93,6 +96,7 @@ def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:
     shapes = kernels().centre_rectangles(dist, min(max_radius, np.iinfo(np.int32).max))
     out = np.zeros(free.shape, np.int32)
     kernels().paint_discs(dist, shapes, out)
+    del dist, shapes
     return out
 
 

@@ -58,14 +58,17 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if not isinstance(params, MaorisParams):
         raise ParameterError(f"expected MaorisParams, got {type(params).__name__}", field="params")
     free = _as_free_mask(free)
-    labels = np.zeros(free.shape, np.int32)
+    shape = free.shape
     # Everything outside the free pixels' bounding box is obstacle: work on the box.
     window = _free_bbox(free, margin=1)
     if window is None:
-        return labels
+        return np.zeros(shape, np.int32)
     free = free[window]
     values = quantize(inscribed_circle_image(free, max_radius=params.max_radius), quantum=params.quantum)
     graph = ZoneGraph(flat_zones(values), values)
+    # Large temporaries go as soon as they are read: the zone graph keeps what it needs, and the
+    # output is allocated last (at 8000 x 8000 each full-size image is 64-256 MB).
+    del values, free
     remove_small_zones(graph, min_size=params.small_before)
     merge_ripples(graph, ripples=params.ripples)
     mark_unbreakable_edges(graph, threshold=params.threshold)
@@ -73,7 +76,12 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     remove_doors(graph, doors=params.doors)
     remove_small_zones(graph, min_size=params.small_after)
     remove_isolated_zones(graph)
-    labels[window] = graph.label_image()
+    inner = graph.label_image()
+    del graph
+    if inner.shape == shape:
+        return inner
+    labels = np.zeros(shape, np.int32)
+    labels[window] = inner
     return labels
 
 

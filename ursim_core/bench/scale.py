@@ -1,0 +1,86 @@
+"""Whole-process ``ursim match`` of generated buildings of growing size (``ursim bench scale``).
+
+Each size is written as a PNG and matched against itself by a fresh ``python -m ursim_core.cli
+match`` process, as a user runs it: loading, both segmentations, the region graphs, the
+orientation search, the automatic m, the figure and the files. Wall time, CPU time (user +
+system) and peak resident memory are those of that one child process (``os.wait4`` in a small intermediate process).
+
+Issue 14 targets: two 8000 x 8000 maps in 30 s and 3 GB; time growth per doubling of the side
+(4x the pixels) at most 4.5x.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from ursim_core.synth import make_large_building
+
+__all__ = ["bench_match_process"]
+
+
+# Run by a fresh interpreter between the benchmark and the measured process: on Linux a child's
+# peak RSS starts at its parent's resident size at fork time, and the benchmark's own process
+# is large after the in-process segmentations; this small one is not.
+_MEASURE = """
+import json, os, subprocess, sys, time
+started = time.perf_counter()
+child = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL)
+_, status, usage = os.wait4(child.pid, 0)
+print(json.dumps({"wall": time.perf_counter() - started, "cpu": usage.ru_utime + usage.ru_stime,
+                  "rss_kb": usage.ru_maxrss, "code": os.waitstatus_to_exitcode(status)}))
+"""
+
+
+def _run(command: list[str]) -> tuple[float, float, float, int]:
+    """Wall s, CPU s (user + system), peak RSS MB and exit code of one child process."""
+    done = subprocess.run([sys.executable, "-c", _MEASURE, *command], capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.stderr.write(done.stderr)
+        return 0.0, 0.0, 0.0, done.returncode
+    figures = json.loads(done.stdout.strip().splitlines()[-1])
+    if figures["code"] != 0:
+        sys.stderr.write(done.stderr)
+    return figures["wall"], figures["cpu"], figures["rss_kb"] / 1024, figures["code"]
+
+
+def bench_match_process(sizes: Iterable[int] = (1000, 2000, 4000, 8000)) -> list[dict]:
+    """Time and peak memory of ``ursim match`` of a generated building against itself.
+
+    Returns
+    -------
+    list of dict
+        ``size``, ``wall_s``, ``cpu_s``, ``maxrss_mb`` (the child's peak resident size) and,
+        from the second size on, ``time_ratio`` (wall time over the previous size's) and
+        ``pixel_ratio``. A failed run has ``error`` (its exit code) instead of figures.
+    """
+    import cv2
+
+    rows: list[dict] = []
+    previous: tuple[int, float] | None = None
+    with tempfile.TemporaryDirectory(prefix="ursim-bench-scale-") as folder:
+        for size in sizes:
+            size = int(size)
+            image = Path(folder) / f"building-{size}.png"
+            cv2.imwrite(str(image), make_large_building(size).free.astype(np.uint8) * 255)
+            out = Path(folder) / f"match-{size}"
+            command = [sys.executable, "-m", "ursim_core.cli", "match", str(image), str(image), "-o", str(out)]
+            wall, cpu, rss, code = _run(command)
+            row: dict = {"size": size, "pixels": size * size}
+            if code != 0:
+                row["error"] = f"exit {code}"
+                rows.append(row)
+                continue
+            row.update(wall_s=round(wall, 2), cpu_s=round(cpu, 2), maxrss_mb=round(rss, 1))
+            if previous is not None:
+                row["pixel_ratio"] = round(row["pixels"] / previous[0], 2)
+                row["time_ratio"] = round(wall / previous[1], 2) if previous[1] > 0 else None
+            previous = (row["pixels"], wall)
+            rows.append(row)
+    return rows
