@@ -59,7 +59,7 @@ def candidate_pieces(
     free: np.ndarray,
     *,
     maoris_preset: str = "sketch",
-    door_ratio: float = 1.0,
+    door_ratio: float = 0.95,
     watershed_min_size: int = 100,
     min_piece: int = 30,
 ) -> CandidatePieces:

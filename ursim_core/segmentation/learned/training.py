@@ -27,7 +27,7 @@ import numpy as np
 __all__ = ["oracle_pairs", "map_pairs", "train_merge_model", "TRAINING_DEFAULTS"]
 
 #: Boosting settings of the shipped model and of the cross-validation.
-TRAINING_DEFAULTS = {"trees": 150, "learning_rate": 0.1, "bins": 32, "reg": 1.0, "min_samples": 10}
+TRAINING_DEFAULTS = {"trees": 150, "learning_rate": 0.1, "bins": 32, "reg": 1.0, "min_samples": 40}
 
 
 def _owner(histogram: np.ndarray) -> int:
