@@ -35,15 +35,17 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", metavar="OUT", help="output folder")
     parser.add_argument(
         "--method",
-        choices=["maoris", "watershed"],
+        choices=["maoris", "watershed", "learned"],
         default="maoris",
         help="segmenter: maoris (default; sketches and robot maps) or watershed (clearance watershed with "
-        "saddle-ratio doors, for robot occupancy maps: presets default, robot)",
+        "saddle-ratio doors, for robot occupancy maps: presets default, robot) or learned (MAORIS and watershed "
+        "pieces merged by a classifier trained on sketches: presets default, sketch)",
     )
     parser.add_argument(
         "--preset",
         default="sketch",
-        help="parameter preset: maoris: sketch, robot, default, icra, ursim-released; watershed: default, robot",
+        help="parameter preset: maoris: sketch, robot, default, icra, ursim-released; watershed: default, robot; "
+        "learned: default, sketch",
     )
     parser.add_argument("--param", action="append", metavar="NAME=VALUE", help="override one parameter (repeatable)")
     parser.add_argument(

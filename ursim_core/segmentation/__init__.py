@@ -3,7 +3,8 @@
 Owns: :class:`Segmentation` (label image + region adjacency graph), :func:`segment` and the
 ``SEGMENTERS`` registry, label-image files, the region graph (:func:`region_graph`), MAORIS
 (:mod:`ursim_core.segmentation.maoris`), the clearance watershed
-(:mod:`ursim_core.segmentation.watershed`), leave-one-map-out figures of the presets
+(:mod:`ursim_core.segmentation.watershed`), learned merging of candidate pieces
+(:mod:`ursim_core.segmentation.learned`, its figures :mod:`ursim_core.segmentation.learned_cv`), leave-one-map-out figures of the presets
 (:mod:`ursim_core.segmentation.presets_cv`) and the scoring of a segmentation against ground truth
 (:mod:`ursim_core.segmentation.scoring`).
 
@@ -22,7 +23,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["interface", "graph", "scoring", "maoris", "watershed", "presets_cv"],
+    submodules=["interface", "graph", "scoring", "maoris", "watershed", "presets_cv", "learned", "learned_cv"],
     submod_attrs={
         "interface": [
             "Segmentation",
@@ -38,5 +39,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "graph": ["region_graph", "adjacent_pairs", "contour_pca_shape"],
         "watershed": ["watershed_labels"],
         "presets_cv": ["cross_validate"],
+        "learned": ["learned_labels"],
+        "learned_cv": ["cross_validate_learned"],
     },
 )

@@ -79,8 +79,14 @@ def _watershed(free: np.ndarray, **params: Any) -> np.ndarray:
     return watershed_labels(free, **params)
 
 
+def _learned(free: np.ndarray, **params: Any) -> np.ndarray:
+    from ursim_core.segmentation.learned.merging import learned_labels
+
+    return learned_labels(free, **params)
+
+
 #: Segmenters by name: ``callable(free, **params) -> int32 label image``.
-SEGMENTERS: dict[str, Any] = {"maoris": _maoris, "watershed": _watershed}
+SEGMENTERS: dict[str, Any] = {"maoris": _maoris, "watershed": _watershed, "learned": _learned}
 
 #: The segmenter and preset to use by kind of map, ``(method, preset)``: the best
 #: cross-validated on ``maoris_segmentation`` (:mod:`ursim_core.segmentation.presets_cv`):
@@ -90,6 +96,9 @@ DEFAULT_SEGMENTERS: dict[str, tuple[str, str]] = {"sketch": ("maoris", "sketch")
 #: Preset names of the segmenters other than MAORIS (whose presets are
 #: :data:`ursim_core.segmentation.maoris.PRESETS`).
 WATERSHED_PRESETS = ("default", "robot")
+#: Preset names of learned merging (:mod:`ursim_core.segmentation.learned`): its defaults
+#: are made for sketches.
+LEARNED_PRESETS = ("default", "sketch")
 
 
 def resolve_params(
@@ -129,6 +138,12 @@ def _resolve_method_params(method, preset, params, ParameterError) -> dict[str, 
         if preset not in (None, "sketch", *WATERSHED_PRESETS):
             raise ParameterError(f"unknown preset '{preset}' of the watershed (known: {', '.join(WATERSHED_PRESETS)})")
         return resolve_watershed_params(params or {})
+    if method == "learned":
+        from ursim_core.segmentation.learned.merging import resolve_learned_params
+
+        if preset not in (None, *LEARNED_PRESETS):
+            raise ParameterError(f"unknown preset '{preset}' of learned merging (known: {', '.join(LEARNED_PRESETS)})")
+        return resolve_learned_params(params or {})
     if method != "maoris":
         return dict(params or {})
     from ursim_core.segmentation.maoris import PRESETS
@@ -157,7 +172,8 @@ def segment(
         A key of :data:`SEGMENTERS`.
     preset : str, optional
         Named parameter set of the method (MAORIS: 'sketch', 'robot', 'default', ...;
-        watershed: 'default' = 'robot', and 'sketch' gives the same defaults).
+        watershed: 'default' = 'robot', and 'sketch' gives the same defaults; learned:
+        'default' = 'sketch').
     params : dict, optional
         Overrides of single parameters.
 

@@ -37,7 +37,13 @@ import numpy as np
 
 from ursim_core.errors import ParameterError, SegmentationError
 
-__all__ = ["watershed_labels", "resolve_watershed_params", "WATERSHED_DEFAULTS"]
+__all__ = [
+    "watershed_labels",
+    "resolve_watershed_params",
+    "merge_small_regions",
+    "in_raster_order",
+    "WATERSHED_DEFAULTS",
+]
 
 #: Default parameters: the best mean F1 of the grid door_ratio 0.7-0.9 x min_size 50-200 on
 #: the 15 robot maps of ``maoris_segmentation``. Chosen without each map in turn and scored
@@ -228,3 +234,15 @@ def _in_raster_order(labels: np.ndarray) -> np.ndarray:
     lookup = np.zeros(count, np.int32)
     lookup[present[np.argsort(first[present], kind="stable")]] = np.arange(1, len(present) + 1, dtype=np.int32)
     return lookup[labels]
+
+
+def merge_small_regions(labels: np.ndarray, clearance: np.ndarray, min_size: int) -> np.ndarray:
+    """Regions under ``min_size`` px joined to the neighbour they share the longest boundary
+    with, smallest first; regions without neighbours become 0 (step 4 of
+    :func:`watershed_labels`, for any label image). Labels are not renumbered."""
+    return _merge_small(np.asarray(labels), clearance, int(min_size))
+
+
+def in_raster_order(labels: np.ndarray) -> np.ndarray:
+    """Labels renumbered 1..N by the raster order of their first pixel (0 stays 0)."""
+    return _in_raster_order(np.asarray(labels))
