@@ -70,3 +70,51 @@ def test_anchors_are_marked_and_listed_after_a_match(window, qtbot):
     assert window.views["metric"].marked_regions("anchors") == {1, 3}
     anchors.itemClicked.emit(anchors.item(1))
     assert window.session.selection == {"sketch": frozenset({3}), "metric": frozenset({3})}
+
+
+def test_the_panel_offers_every_segmenter_of_the_registry():
+    from ursim_core.segmentation import SEGMENTERS, method_presets
+    from ursim_gui.panels.segmentation_panel import SideSegmentationBox
+
+    box = SideSegmentationBox("metric")
+    assert [box.method.itemText(i) for i in range(box.method.count())] == list(SEGMENTERS)
+    assert {"maoris", "watershed", "learned"} <= set(SEGMENTERS)
+    for method in SEGMENTERS:
+        box.method.setCurrentText(method)
+        assert [box.preset.itemText(i) for i in range(box.preset.count())] == list(method_presets(method))
+        assert box.spins and box.overrides() == {}
+    box.method.setCurrentText("watershed")
+    assert set(box.spins) == {"door_ratio", "min_size"}
+    box.method.setCurrentText("maoris")
+    assert set(box.spins) == {"threshold", "margin", "ripples", "doors"}
+
+
+def test_watershed_chosen_in_the_panel_segments_saves_and_reopens_as_watershed(window, qtbot, tmp_path):
+    box = window.segmentation_panel.boxes["metric"]
+    box.method.setCurrentText("watershed")
+    box.preset.setCurrentText("robot")
+    box.spins["door_ratio"].setValue(0.8)
+    assert box.overrides() == {"door_ratio": 0.8}
+    with qtbot.waitSignal(window.session.segmentation_changed, timeout=60_000):
+        qtbot.mouseClick(box.segment_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: not window.jobs.busy)
+    segmentation = window.session.segmentation("metric")
+    assert segmentation.method == "watershed" and segmentation.params["door_ratio"] == 0.8
+    assert box.summary.text() == f"{segmentation.n_regions} regions (watershed)"
+    path = tmp_path / "pair.json"
+    window.session.save(path)
+    window.session.open(path)
+    reopened = window.session.segmentation("metric")
+    assert reopened.method == "watershed" and reopened.params["door_ratio"] == 0.8
+    assert (reopened.labels == segmentation.labels).all()
+
+
+def test_learned_merging_from_the_panel(window, qtbot):
+    box = window.segmentation_panel.boxes["sketch"]
+    box.method.setCurrentText("learned")
+    assert box.preset.currentText() == "default"
+    with qtbot.waitSignal(window.session.segmentation_changed, timeout=120_000):
+        qtbot.mouseClick(box.segment_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=120_000)
+    segmentation = window.session.segmentation("sketch")
+    assert segmentation.method == "learned" and segmentation.n_regions >= 2

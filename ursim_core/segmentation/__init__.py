@@ -32,6 +32,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "DEFAULT_SEGMENTERS",
             "segment",
             "resolve_params",
+            "method_presets",
             "read_label_array",
             "load_label_image",
             "save_label_image",

@@ -101,6 +101,31 @@ WATERSHED_PRESETS = ("default", "robot")
 LEARNED_PRESETS = ("default", "sketch")
 
 
+def method_presets(method: str) -> tuple[str, ...]:
+    """Preset names of a segmenter of :data:`SEGMENTERS`, its default first.
+
+    Raises :class:`~ursim_core.errors.ParameterError` for an unknown method.
+
+    Examples
+    --------
+    >>> method_presets("watershed")
+    ('default', 'robot')
+    >>> "sketch" in method_presets("maoris")
+    True
+    """
+    from ursim_core.errors import ParameterError
+
+    if method == "maoris":
+        from ursim_core.segmentation.maoris import PRESETS
+
+        return tuple(sorted(PRESETS, key=lambda name: name != "default"))
+    if method == "watershed":
+        return WATERSHED_PRESETS
+    if method == "learned":
+        return LEARNED_PRESETS
+    raise ParameterError(f"unknown segmentation method '{method}' (known: {', '.join(sorted(SEGMENTERS))})")
+
+
 def resolve_params(
     method: str = "maoris", preset: str | None = "sketch", params: dict[str, Any] | None = None
 ) -> dict[str, Any]:

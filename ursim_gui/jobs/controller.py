@@ -56,13 +56,13 @@ class JobController(QObject):
         return self.runner.busy or bool(self._queue)
 
     # ---- requests --------------------------------------------------------------------
-    def segment(self, side: str, preset: str, params: dict | None = None) -> None:
-        """Queue the segmentation of one side's map with a preset and overrides."""
+    def segment(self, side: str, preset: str, params: dict | None = None, *, method: str = "maoris") -> None:
+        """Queue the segmentation of one side's map with a segmenter, a preset and overrides."""
         map_ = self._session.map(side)
         if map_ is None:
             show_error(self._parent, "Cannot segment", f"Open a {side} map first.")
             return
-        self._enqueue(SegmentJob(map_, preset, params, side=side))
+        self._enqueue(SegmentJob(map_, preset, params, method=method, side=side))
 
     def match(self, config=None) -> None:
         """Queue a match of the two segmentations (taken when the job starts).

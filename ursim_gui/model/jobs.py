@@ -49,12 +49,12 @@ COMPILING_NOTE = "Compiling the segmentation kernels (first run only)…"
 
 
 def compiling_note(job) -> str | None:
-    """:data:`COMPILING_NOTE` when ``job`` is a MAORIS segmentation that will compile the kernels.
+    """:data:`COMPILING_NOTE` when ``job`` is a segmentation that will compile the MAORIS kernels.
 
     Asks ``ursim_core.segmentation.maoris.kernels_cached()`` (a few directory listings)
     when the core has it; without it, or once the kernels are cached, None.
     """
-    if not isinstance(job, SegmentJob) or job.method != "maoris":
+    if not isinstance(job, SegmentJob) or job.method not in ("maoris", "learned"):  # learned runs MAORIS
         return None
     from ursim_core.segmentation import maoris
 

@@ -241,7 +241,9 @@ class MainWindow(QMainWindow):
             box.preset.currentTextChanged.connect(
                 lambda preset, side=side: self.session.set_segmentation_preset(side, preset)
             )
-            box.segment_requested.connect(lambda s, preset, params: self.jobs.segment(s, preset, params))
+            box.segment_requested.connect(
+                lambda s, method, preset, params: self.jobs.segment(s, preset, params, method=method)
+            )
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
         self.matching_panel.orientation_changed.connect(

@@ -147,13 +147,20 @@ class WindowTools:
         config = self.window.matching_panel.config()
         if not wait:
             for side in ("sketch", "metric"):
-                jobs.segment(side, panel.boxes[side].preset.currentText(), panel.boxes[side].overrides())
+                box = panel.boxes[side]
+                jobs.segment(side, box.preset.currentText(), box.overrides(), method=box.method_name())
             jobs.match(config)
             return True
         for side in ("sketch", "metric"):
             box = panel.boxes[side]
             if not jobs.run_now(
-                SegmentJob(self.session.map(side), box.preset.currentText(), box.overrides(), side=side)
+                SegmentJob(
+                    self.session.map(side),
+                    box.preset.currentText(),
+                    box.overrides(),
+                    method=box.method_name(),
+                    side=side,
+                )
             ):
                 return False
         self.session.match_config = config
