@@ -20,13 +20,20 @@ _OPTIONAL = {
 
 
 def run_bench(
-    what: str = "all", *, datasets: str | Path | None = None, repeats: int = 5, sizes: tuple[int, ...] | None = None
+    what: str = "all",
+    *,
+    datasets: str | Path | None = None,
+    repeats: int = 5,
+    sizes: tuple[int, ...] | None = None,
+    csv: str | Path | None = None,
 ) -> int:
     """Run the benchmarks named by ``what`` and print figures.
 
     ``what``: 'segment', 'scale', 'match' or 'all' (those three), 'startup' (whole-process
-    times, :mod:`ursim_core.bench.startup`), 'compile' (first-run kernel compilation) or 'files'
-    (correspondence files). ``sizes``: the building sides of 'scale' (default :data:`SCALE_SIZES`).
+    times, :mod:`ursim_core.bench.startup`), 'compile' (first-run kernel compilation), 'files'
+    (correspondence files) or 'quality' (segmentation F1, in-sample and leave-one-map-out, of
+    every preset on maoris_segmentation, :mod:`ursim_core.bench.quality`; ``csv``: also the rows).
+    ``sizes``: the building sides of 'scale' (default :data:`SCALE_SIZES`).
     Returns the exit code: 1 when the benchmark is not available.
     """
     root = dataset_root(datasets)
@@ -38,6 +45,16 @@ def run_bench(
             print(f"startup: KTH cases skipped ({MISSING_REASON})")
         print("== whole-process start-up (issue 10 item 4 targets)")
         print_startup(bench_startup(kth, repeats=repeats))
+        return 0
+    if what == "quality":
+        import sys
+
+        if root is None or not (root / "maoris_segmentation").is_dir():
+            print(f"error: 'ursim bench quality' needs maoris_segmentation ({MISSING_REASON})", file=sys.stderr)
+            return 1
+        from ursim_core.bench.quality import bench_quality
+
+        bench_quality(root, csv_path=csv)
         return 0
     if what in _OPTIONAL:
         import importlib

@@ -12,7 +12,7 @@ EXAMPLES = """examples:
   ursim bench all --datasets ../shared/datasets"""
 
 #: Benchmarks by name; "all" runs segment, scale and match (the others on request).
-BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "all")
+BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "quality", "all")
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -22,10 +22,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         nargs="?",
         default="all",
         help="startup: whole-process times of ursim --help / match / segment; compile: first-run kernel "
-        "compilation; files: correspondence file load/save; all: segment, scale and match",
+        "compilation; files: correspondence file load/save; quality: segmentation F1 of every preset, "
+        "in-sample and leave-one-map-out; all: segment, scale and match",
     )
     parser.add_argument("--datasets", help="datasets folder (default: $URSIM_DATASETS or ../shared/datasets)")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--csv", metavar="FILE", help="quality: also write every row to FILE")
     parser.add_argument(
         "--sizes",
         type=int,
@@ -38,4 +40,4 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from ursim_core.bench.runner import run_bench
 
-    return run_bench(args.what, datasets=args.datasets, repeats=args.repeats, sizes=args.sizes)
+    return run_bench(args.what, datasets=args.datasets, repeats=args.repeats, sizes=args.sizes, csv=args.csv)
