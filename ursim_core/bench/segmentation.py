@@ -101,6 +101,38 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
             }
         )
     rows.extend(_learned_rows(Path(dataset_root), repeats))
+    rows.extend(_watershed_rows(Path(dataset_root), repeats))
+    return rows
+
+
+def _watershed_rows(dataset_root: Path, repeats: int, *, building: int = 4000) -> list[dict]:
+    """The watershed segmenter (:mod:`ursim_core.segmentation.watershed`, the robot-map
+    default) on the robot maps of :data:`_BENCH_MAPS` and a generated building of
+    ``building`` px a side (target: 4000 px <= 5 s); at most 3 runs of the building."""
+    from ursim_core.io.maps import load_map
+    from ursim_core.segmentation.watershed import watershed_labels
+    from ursim_core.synth import make_large_building
+
+    maps = []
+    for relative, _, preset in _BENCH_MAPS:
+        path = dataset_root / relative
+        if preset != "sketch" and path.exists():
+            maps.append((relative, load_map(path).free, repeats))
+    if building:
+        maps.append((f"generated building {building} px", make_large_building(building, seed=1).free, min(repeats, 3)))
+    rows = []
+    for name, free, runs in maps:
+        wall, cpu, labels = _time(lambda: watershed_labels(free), runs)
+        rows.append(
+            {
+                "map": name,
+                "shape": f"{free.shape[0]}x{free.shape[1]}",
+                "preset": "watershed",
+                "regions": int(labels.max()),
+                "wall_s": round(wall, 3),
+                "cpu_s": round(cpu, 3),
+            }
+        )
     return rows
 
 
