@@ -63,6 +63,19 @@ def _time(function: Callable[[], object], repeats: int) -> tuple[float, float, o
     return statistics.median(walls), statistics.median(cpus), result
 
 
+def _timed_row(name: str, free: np.ndarray, preset: str, segmenter: Callable[[], np.ndarray], repeats: int) -> dict:
+    """One row of :func:`bench_segmentation`: the median time of ``segmenter()`` on ``free``."""
+    wall, cpu, labels = _time(segmenter, repeats)
+    return {
+        "map": name,
+        "shape": f"{free.shape[0]}x{free.shape[1]}",
+        "preset": preset,
+        "regions": int(labels.max()),
+        "wall_s": round(wall, 3),
+        "cpu_s": round(cpu, 3),
+    }
+
+
 def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[dict]:
     """Median time to segment the largest sketch and the largest robot map.
 
@@ -89,17 +102,7 @@ def bench_segmentation(dataset_root: Path | None, *, repeats: int = 5) -> list[d
         if not path.exists():
             continue
         free = load_map(path).free
-        wall, cpu, labels = _time(lambda: maoris_labels(free, PRESETS[preset]), repeats)
-        rows.append(
-            {
-                "map": relative,
-                "shape": f"{free.shape[0]}x{free.shape[1]}",
-                "preset": preset,
-                "regions": int(labels.max()),
-                "wall_s": round(wall, 3),
-                "cpu_s": round(cpu, 3),
-            }
-        )
+        rows.append(_timed_row(relative, free, preset, lambda: maoris_labels(free, PRESETS[preset]), repeats))
     rows.extend(_learned_rows(Path(dataset_root), repeats))
     rows.extend(_watershed_rows(Path(dataset_root), repeats))
     return rows
@@ -120,20 +123,7 @@ def _watershed_rows(dataset_root: Path, repeats: int, *, building: int = 4000) -
             maps.append((relative, load_map(path).free, repeats))
     if building:
         maps.append((f"generated building {building} px", make_large_building(building, seed=1).free, min(repeats, 3)))
-    rows = []
-    for name, free, runs in maps:
-        wall, cpu, labels = _time(lambda: watershed_labels(free), runs)
-        rows.append(
-            {
-                "map": name,
-                "shape": f"{free.shape[0]}x{free.shape[1]}",
-                "preset": "watershed",
-                "regions": int(labels.max()),
-                "wall_s": round(wall, 3),
-                "cpu_s": round(cpu, 3),
-            }
-        )
-    return rows
+    return [_timed_row(name, free, "watershed", lambda: watershed_labels(free), runs) for name, free, runs in maps]
 
 
 def _learned_rows(dataset_root: Path, repeats: int) -> list[dict]:
@@ -148,17 +138,7 @@ def _learned_rows(dataset_root: Path, repeats: int) -> list[dict]:
         if preset != "sketch" or not path.exists():
             continue
         free = load_map(path).free
-        wall, cpu, labels = _time(lambda: learned_labels(free), min(repeats, 3))
-        rows.append(
-            {
-                "map": relative,
-                "shape": f"{free.shape[0]}x{free.shape[1]}",
-                "preset": "learned",
-                "regions": int(labels.max()),
-                "wall_s": round(wall, 3),
-                "cpu_s": round(cpu, 3),
-            }
-        )
+        rows.append(_timed_row(relative, free, "learned", lambda: learned_labels(free), min(repeats, 3)))
     return rows
 
 
