@@ -104,6 +104,19 @@ def test_unmatched_tap_names_the_nearest_matched_region(example_window, qtbot):
     message = window.statusBar().currentMessage()
     assert message.startswith("No goal") and "nearest matched region" in message
     assert window.navigation.model.goals == []
+    # Accepting the offer places the goal in the nearest matched region, as the core says.
+    offer = window.navigation.model.offer
+    assert offer is not None
+    window.actions["goal_nearest"].trigger()
+    (goal,) = window.navigation.model.goals
+    expected = locate(
+        session.correspondences,
+        session.segmentation("sketch"),
+        session.segmentation("metric"),
+        session.map("metric"),
+        *offer,
+    )
+    assert goal.ok and goal.pixel == expected.pixel
 
 
 def test_route_tool_drag_gives_waypoints_that_follow_the_cliques(example_window, qtbot, tmp_path):

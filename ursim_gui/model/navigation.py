@@ -40,6 +40,8 @@ class NavigationModel:
         self.changed = Signal("navigation_changed")
         self.message = Signal("navigation_message")
         self._nav: NavigationSession | None = None
+        #: Sketch point (row, col) of the nearest matched region after an unmatched tap, else None.
+        self.offer: tuple[int, int] | None = None
         session.correspondences_changed.connect(self._correspondences_changed)
         session.segmentation_changed.connect(lambda side: self._reset(f"the {side} segmentation changed"))
         session.map_changed.connect(lambda side: self._reset(f"the {side} map changed"))
@@ -82,8 +84,19 @@ class NavigationModel:
             self.message.emit("Segment both maps before placing a goal")
             return None
         goal = nav.tap(row, col)
-        self.message.emit(_goal_text(goal))
+        self.offer = None if goal.ok or goal.nearest is None else tuple(goal.nearest.point)
+        text = _goal_text(goal)
+        if self.offer is not None:
+            text += " (Shift+T places the goal there)"
+        self.message.emit(text)
         return goal
+
+    def accept_offer(self):
+        """Place the goal at the nearest matched region offered after an unmatched tap (None without an offer)."""
+        if self.offer is None:
+            self.message.emit("No nearest region to go to: tap an unmatched region first")
+            return None
+        return self.tap(*self.offer)
 
     def draw_route(self, points) -> object | None:
         """The route tool: plan a route through sketch points (row, col) in drawing order."""

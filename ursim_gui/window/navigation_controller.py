@@ -30,6 +30,7 @@ class NavigationController:
         # The segmentation editor's stroke modes and these tools share the left drag: one at a time.
         segmentation_editor.mode_changed.connect(lambda mode: mode and self.tools.set_mode(""))
         a["clear_selection"].triggered.connect(lambda: self.tools.set_mode(""))
+        a["goal_nearest"].triggered.connect(self.model.accept_offer)
         a["clear_navigation"].triggered.connect(self.model.clear)
         a["export_navigation"].triggered.connect(lambda: self.export_json())
         a["export_nav2"].triggered.connect(lambda: self.export_nav2())

@@ -119,6 +119,13 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Navigate",
         checkable=True,
     ),
+    ActionSpec(
+        "goal_nearest",
+        "Goal at the &nearest matched region",
+        ("Shift+T",),
+        "After a tap on an unmatched region: place the goal in the nearest matched one",
+        "Navigate",
+    ),
     ActionSpec("clear_navigation", "&Clear goals and route", (), "Remove the goals and the route", "Navigate"),
     ActionSpec(
         "export_navigation", "Export goals as &JSON…", (), "Goals and route as PoseStamped-like JSON", "Navigate"
