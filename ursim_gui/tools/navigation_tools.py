@@ -61,6 +61,10 @@ class NavigationTools(QObject):
 
     def refresh(self) -> None:
         """Redraw both overlays from the model."""
+        for side, overlay in self.overlays.items():
+            # Markers in map pixels, sized to the map so they read alike on a 400 px sketch and a 4000 px grid.
+            rect = self.views[side].sceneRect()
+            overlay.marker = max(4.0, 0.012 * max(rect.width(), rect.height()))
         goals, route = self.model.goals, self.model.route
         self.overlays["sketch"].show([g.sketch_point for g in goals], self.model.route_points)
         marks = [g.pixel for g in goals]
