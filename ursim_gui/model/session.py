@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from ursim_core.correspondences import Clique, Correspondences, MapRef, utc_timestamp
+from ursim_core.correspondences.exporters import clique_label
 from ursim_core.errors import SegmentationError
 from ursim_gui.model.history import History
 from ursim_gui.model.session_documents import DocumentOperations
@@ -59,7 +60,7 @@ __all__ = [
 
 
 def _untouched_automatic(clique: Clique) -> bool:
-    return clique.source == "auto" and clique.status is None and not clique.note
+    return clique.source == "auto" and clique.status is None and not clique.note and clique_label(clique) is None
 
 
 class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations, LabelEditOperations):

@@ -187,6 +187,19 @@ class EditOperations:
             self._corr.with_clique(dataclasses.replace(clique, note=str(text))),
         )
 
+    def set_label(self, clique_id: int, label: str | None) -> None:
+        """Set a clique's semantic label (room name / type; blank removes it), one undo step.
+
+        Saved in the clique's JSON as ``label`` and carried into the GeoJSON / labelme / QGIS exports.
+        """
+        from ursim_core.correspondences.exporters import clique_label, with_clique_label
+
+        clique = self._corr.clique(clique_id)
+        text = (label or "").strip() or None
+        if text == clique_label(clique):
+            return
+        self._commit(f"Label clique {clique.id}", self._corr.with_clique(with_clique_label(clique, text)))
+
     def apply_match(self, result) -> None:
         """Replace every automatic clique by one clique per pair of ``result`` (one undo step).
 

@@ -11,10 +11,14 @@ from PySide6.QtCore import QAbstractTableModel, QItemSelectionModel, QModelIndex
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView, QVBoxLayout, QWidget
 
+from ursim_core.correspondences.exporters import clique_label
+
 __all__ = ["CorrespondenceTableModel", "CorrespondenceTable", "COLUMNS"]
 
-COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval", "Note")
+COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval", "Label", "Note")
 _NOTE_COLUMN = COLUMNS.index("Note")
+_LABEL_COLUMN = COLUMNS.index("Label")
+_EDITABLE = (_NOTE_COLUMN, _LABEL_COLUMN)
 _MARK_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
 _STATUS_COLOURS = {"accepted": QColor(30, 120, 60), "rejected": QColor(170, 40, 40), "pending": QColor(120, 120, 120)}
 
@@ -84,6 +88,8 @@ class CorrespondenceTableModel(QAbstractTableModel):
                 return _STATUS_COLOURS.get(clique.effective_status)
         if role == Qt.ItemDataRole.UserRole:
             return clique.id
+        if role == Qt.ItemDataRole.ToolTipRole and column == _LABEL_COLUMN:
+            return "Room name or type (double-click to edit); saved in the JSON and carried into the exports"
         if role == Qt.ItemDataRole.ToolTipRole and clique.note:
             return clique.note
         return None
@@ -103,6 +109,8 @@ class CorrespondenceTableModel(QAbstractTableModel):
             return clique.effective_status
         if column == 6:
             return self._mark(clique.id)
+        if column == _LABEL_COLUMN:
+            return clique_label(clique) or ""
         return clique.note
 
     def _mark(self, clique_id: int) -> str:
@@ -111,16 +119,18 @@ class CorrespondenceTableModel(QAbstractTableModel):
 
     def flags(self, index: QModelIndex):
         flags = super().flags(index)
-        if index.isValid() and index.column() == _NOTE_COLUMN:
+        if index.isValid() and index.column() in _EDITABLE:
             flags |= Qt.ItemFlag.ItemIsEditable
         return flags
 
     def setData(self, index: QModelIndex, value, role=Qt.ItemDataRole.EditRole) -> bool:
-        """Editing the Note cell sets the clique's note in the session (one undo step)."""
-        if not index.isValid() or index.column() != _NOTE_COLUMN or role != Qt.ItemDataRole.EditRole:
+        """Editing the Note or Label cell sets the clique's note or label in the session (one undo step)."""
+        if not index.isValid() or index.column() not in _EDITABLE or role != Qt.ItemDataRole.EditRole:
             return False
         clique = self._cliques[index.row()]
-        if str(value) != clique.note:
+        if index.column() == _LABEL_COLUMN:
+            self._session.set_label(clique.id, str(value))
+        elif str(value) != clique.note:
             self._session.set_note(clique.id, str(value))
         return True
 
@@ -147,7 +157,7 @@ class CorrespondenceTable(QWidget):
         self.view.setModel(self.model)
         self.view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.view.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
-        # Only the Note column is editable (see the model's flags).
+        # Only the Label and Note columns are editable (see the model's flags).
         self.view.setEditTriggers(
             QAbstractItemView.EditTrigger.DoubleClicked | QAbstractItemView.EditTrigger.EditKeyPressed
         )

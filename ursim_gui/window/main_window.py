@@ -41,6 +41,7 @@ from ursim_gui.window.agreement_controller import AgreementController
 from ursim_gui.window.campaign_controller import CampaignController
 from ursim_gui.window.document_controller import DocumentController
 from ursim_gui.window.edit_commands import EditCommands
+from ursim_gui.window.navigation_controller import NavigationController
 from ursim_gui.window.preferences import Preferences
 from ursim_gui.window.shortcuts import SHORTCUTS, ShortcutSheet, make_action
 from ursim_gui.window.window_commands import WindowTools
@@ -65,6 +66,9 @@ _TOOLBAR = (
     "fit",
     "link_zoom",
     "connectors",
+    None,
+    "goal_tool",
+    "route_tool",
 )
 _DISPLAY = ("outlines", "region_ids", "graph")
 #: Display toggles remembered between runs, with their first-run state.
@@ -285,6 +289,7 @@ class MainWindow(QMainWindow):
         a["clear_selection"].triggered.connect(lambda: editor.set_mode(""))
         a["merge_regions"].triggered.connect(editor.merge_selected)
         editor.message.connect(lambda text: self.statusBar().showMessage(text, 4000))
+        self.navigation = NavigationController(self, editor)
 
     def _stroke_mode_toggled(self, mode: str, on: bool) -> None:
         editor = self.segmentation_editor

@@ -103,6 +103,40 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Segment",
         checkable=True,
     ),
+    ActionSpec(
+        "goal_tool",
+        "&Goal tool",
+        ("T",),
+        "Click the sketch: the goal it gives in the metric map",
+        "Navigate",
+        checkable=True,
+    ),
+    ActionSpec(
+        "route_tool",
+        "&Route tool",
+        ("P",),
+        "Drag a route on the sketch: waypoints in the metric map",
+        "Navigate",
+        checkable=True,
+    ),
+    ActionSpec(
+        "goal_nearest",
+        "Goal at the &nearest matched region",
+        ("Shift+T",),
+        "After a tap on an unmatched region: place the goal in the nearest matched one",
+        "Navigate",
+    ),
+    ActionSpec("clear_navigation", "&Clear goals and route", (), "Remove the goals and the route", "Navigate"),
+    ActionSpec(
+        "export_navigation", "Export goals as &JSON…", (), "Goals and route as PoseStamped-like JSON", "Navigate"
+    ),
+    ActionSpec(
+        "export_nav2",
+        "Export nav2 &waypoints…",
+        (),
+        "The route (or goals) as nav2's RViz-panel waypoint file",
+        "Navigate",
+    ),
     ActionSpec("next_pair", "&Next pair", ("D",), "Save this pair and open the next one of the campaign", "Campaign"),
     ActionSpec("prev_pair", "&Previous pair", ("A",), "Save this pair and open the previous one", "Campaign"),
     ActionSpec("shortcuts", "&Keyboard shortcuts", ("F1",), "This sheet", "Help"),
@@ -115,6 +149,7 @@ MOUSE_GESTURES: tuple[tuple[str, str], ...] = (
     ("Drag / middle drag", "Pan"),
     ("Hover", "Highlight the partner regions in the other view"),
     ("Drop a file", "Open it as this view's map"),
+    ("Click / drag on the sketch (goal / route tool)", "Place a goal / draw a route"),
 )
 
 

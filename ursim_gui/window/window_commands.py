@@ -103,8 +103,22 @@ class WindowTools:
 
             x, y = pixel_to_world(map_, row, col)
             world = (float(x), float(y))
-        region = self.window.views[side].region_at(row, col) if row >= 0 else 0
+        view = self.window.views[side]
+        region = view.region_at(row, col) if row >= 0 else 0
         self.window.status.show_cursor(side, row, col, world, region)
+        view.viewport().setToolTip(self.region_tooltip(side, region))
+
+    def region_tooltip(self, side: str, region: int) -> str:
+        """``'Region 4 · clique 2 “kitchen”'`` for the map's hover tooltip ('' off the regions)."""
+        from ursim_core.correspondences.exporters import clique_label
+
+        if region <= 0:
+            return ""
+        parts = [f"Region {region}"]
+        for clique_id in self.session.clique_of(side, region):
+            label = clique_label(self.session.clique(clique_id))
+            parts.append(f"clique {clique_id}" + (f" “{label}”" if label else ""))
+        return " · ".join(parts)
 
     # ---- command-line inputs ------------------------------------------------------------------------
     def open_inputs(
