@@ -97,3 +97,33 @@ def test_raster_renumbering_is_that_of_the_scoring_module():
     for shape in ((1, 1), (6, 1), (1, 7), (30, 41)):
         labels = rng.choice(np.array([0, 3, 4, 9], np.int32), size=shape)
         assert np.array_equal(_in_raster_order(labels), relabel_in_raster_order(labels))
+
+
+# Digests of the label images before the speed-up of the basin peaks (np.maximum.at instead
+# of ndimage.maximum): a speed change must leave every label where it was.
+_ROBOT_MAPS_DIGEST = "4170346fbeb837cea91083c30960d78331d12bbb7d7592dcfbeb710944e4bd30"
+_BUILDING_600_DIGEST = "59a6cd8abf64bd5b8f9c8f4ed954bba14e0171e2c6808becacdce63fc8323535"
+
+
+def test_labels_of_a_generated_building_are_those_before_the_speed_up():
+    import hashlib
+
+    from ursim_core.synth import make_large_building
+
+    labels = watershed_labels(make_large_building(600).free)
+    assert hashlib.sha256(labels.tobytes()).hexdigest() == _BUILDING_600_DIGEST
+
+
+def test_labels_of_the_robot_maps_are_those_before_the_speed_up():
+    import hashlib
+
+    from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
+    from ursim_core.segmentation.presets_cv import load_benchmark
+
+    root = dataset_root()
+    if root is None:
+        pytest.skip(MISSING_REASON)
+    digest = hashlib.sha256()
+    for item in load_benchmark(root, "robot_maps"):
+        digest.update(watershed_labels(item.free).tobytes())
+    assert digest.hexdigest() == _ROBOT_MAPS_DIGEST
