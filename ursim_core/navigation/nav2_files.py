@@ -7,15 +7,13 @@
   each with ``pose: [x, y, z]`` and ``orientation: [w, x, y, z]`` (the panel's order, w first).
   The panel appends ``.yaml`` to the name it is given; give it the name without the suffix.
 
-Source check (round 6): the save / load / loop buttons came with ros-navigation/navigation2
-PR #3165 ("Feature - load, save and loop waypoints", merged 2023-01-06, Iron and later; the
-docs.nav2.org PR #383 documents it). The two versions of
-``nav2_rviz_plugins/src/nav2_panel.cpp`` in the reference index (commits 031275bc and
-47235f4a) predate that PR: they hold the waypoint accumulation (``onNewGoal``:
-``pose.pose.orientation = orientationAroundZAxis(theta)``, frame from the goal tool) but no
-file code, so the key names and the w-first quaternion order here could not be re-read from
-the source in this session; they stand as written against PR #3165 and are to be checked
-against a nav2 Iron+ checkout (``Nav2Panel::handleGoalSaver`` / ``handleGoalLoader``).
+Source check: the save / load / loop buttons came with ros-navigation/navigation2 PR #3165
+("Feature - load, save and loop waypoints", merged 2023-01-06, Iron and later). The indexed
+upstream copies of ``nav2_rviz_plugins/src/nav2_panel.cpp`` predate it, but a fork carrying it
+(YazawaKenichi/navigation2 at 7f7c97eb, ``Nav2Panel::handleGoalSaver``) writes exactly this: a
+``waypoints`` map, keys ``"waypoint" + std::to_string(i)``, each with ``pose`` = {x, y, z} and
+``orientation`` = {w, x, y, z} of the pose (that fork adds a ``wait`` key of its own, which
+upstream's loader does not read). Upstream's ``handleGoalLoader`` reads the same keys.
 """
 
 from __future__ import annotations
