@@ -13,7 +13,7 @@ upstream copies of ``nav2_rviz_plugins/src/nav2_panel.cpp`` predate it, but a fo
 (YazawaKenichi/navigation2 at 7f7c97eb, ``Nav2Panel::handleGoalSaver``) writes exactly this: a
 ``waypoints`` map, keys ``"waypoint" + std::to_string(i)``, each with ``pose`` = {x, y, z} and
 ``orientation`` = {w, x, y, z} of the pose (that fork adds a ``wait`` key of its own, which
-upstream's loader does not read). Upstream's ``handleGoalLoader`` reads the same keys.
+upstream's loader does not read); its ``handleGoalLoader`` reads the same ``pose`` and ``orientation`` keys.
 """
 
 from __future__ import annotations
