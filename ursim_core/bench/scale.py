@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ursim_core.bench.segmentation import add_growth
 from ursim_core.synth import make_large_building
 
 __all__ = ["bench_match_process"]
@@ -78,9 +79,6 @@ def bench_match_process(sizes: Iterable[int] = (1000, 2000, 4000, 8000)) -> list
                 rows.append(row)
                 continue
             row.update(wall_s=round(wall, 2), cpu_s=round(cpu, 2), maxrss_mb=round(rss, 1))
-            if previous is not None:
-                row["pixel_ratio"] = round(row["pixels"] / previous[0], 2)
-                row["time_ratio"] = round(wall / previous[1], 2) if previous[1] > 0 else None
-            previous = (row["pixels"], wall)
+            previous = add_growth(row, previous, wall)
             rows.append(row)
     return rows

@@ -176,12 +176,18 @@ def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, 
             "peak_traced_mb": round(peak / 2**20, 1),
             "maxrss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
         }
-        if previous is not None:
-            row["pixel_ratio"] = round(row["pixels"] / previous[0], 2)
-            row["time_ratio"] = round(wall / previous[1], 2) if previous[1] > 0 else None
-        previous = (row["pixels"], wall)
+        previous = add_growth(row, previous, wall)
         rows.append(row)
     return rows
+
+
+def add_growth(row: dict, previous: tuple[int, float] | None, wall: float) -> tuple[int, float]:
+    """Add ``pixel_ratio`` and ``time_ratio`` against the previous size's ``(pixels, wall)``
+    to ``row`` (none for the first); return this size's ``(pixels, wall)``."""
+    if previous is not None:
+        row["pixel_ratio"] = round(row["pixels"] / previous[0], 2)
+        row["time_ratio"] = round(wall / previous[1], 2) if previous[1] > 0 else None
+    return (row["pixels"], wall)
 
 
 def bench_quality(
