@@ -22,6 +22,7 @@ shapes = st.tuples(st.integers(1, 12), st.integers(1, 12))
 thresholds = st.integers(0, 254)
 
 
+@settings(deadline=None)  # a shared, loaded CI machine: no per-example time limit
 @given(grey=arrays(np.uint8, shapes), threshold=thresholds)
 def test_free_is_grey_above_threshold(grey, threshold):
     expected = grey > threshold
@@ -34,6 +35,7 @@ def test_free_is_grey_above_threshold(grey, threshold):
     np.testing.assert_array_equal(loaded.image, grey)
 
 
+@settings(deadline=None)  # a shared, loaded CI machine: no per-example time limit
 @given(rgb=arrays(np.uint8, st.tuples(st.integers(1, 8), st.integers(1, 8), st.just(3))))
 def test_colour_grey_equals_opencv_rgb2gray(rgb):
     rgb[0, 0] = 255  # keep one free pixel so the map is valid
@@ -41,6 +43,7 @@ def test_colour_grey_equals_opencv_rgb2gray(rgb):
     np.testing.assert_array_equal(loaded.image, cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY))
 
 
+@settings(deadline=None)  # a shared, loaded CI machine: no per-example time limit
 @given(words=arrays(np.uint16, shapes))
 def test_16_bit_is_rounded_division_by_257(words):
     words[0, 0] = 65535
@@ -49,6 +52,7 @@ def test_16_bit_is_rounded_division_by_257(words):
     np.testing.assert_array_equal(map_from_array(words, threshold=0).image, expected)
 
 
+@settings(deadline=None)  # a shared, loaded CI machine: no per-example time limit
 @given(
     rgba=arrays(np.uint8, st.tuples(st.integers(1, 8), st.integers(1, 8), st.just(4))),
     threshold=thresholds,
@@ -61,6 +65,7 @@ def test_transparent_pixels_are_never_free(rgba, threshold):
     np.testing.assert_array_equal(loaded.free, loaded.image > threshold)
 
 
+@settings(deadline=None)  # a shared, loaded CI machine: no per-example time limit
 @given(
     resolution=st.floats(0.001, 10.0),
     origin_x=st.floats(-1e4, 1e4),
