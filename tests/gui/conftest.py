@@ -108,6 +108,22 @@ def window(qtbot, tmp_path, map_files):
     win.jobs.runner.shutdown()
 
 
+@pytest.fixture
+def example_window(qtbot, tmp_path):
+    """Main window shown on the bundled example pair, segmented and matched."""
+    from ursim_gui.model.example import example_inputs
+    from ursim_gui.window.main_window import MainWindow
+
+    if example_inputs() is None:
+        pytest.skip("resources/example is not generated in this checkout")
+    win = MainWindow(data_dir=tmp_path / "data")
+    qtbot.addWidget(win)
+    win.resize(1200, 700)
+    win.show()
+    assert win.open_inputs(example=True, wait=True)
+    return win
+
+
 def region_point(view, region: int):
     """Viewport position of a region's interior point (to click or hover it)."""
     return view.mapFromScene(view.region_scene_point(region))

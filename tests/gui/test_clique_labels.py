@@ -4,24 +4,10 @@ from __future__ import annotations
 
 import json
 
-import pytest
 from PySide6.QtCore import Qt
 
 from ursim_core.correspondences.exporters import clique_label, correspondences_to_geojson
 from ursim_gui.panels.correspondence_table import COLUMNS
-
-
-@pytest.fixture
-def example_window(qtbot, tmp_path):
-    from ursim_gui.model.example import example_inputs
-    from ursim_gui.window.main_window import MainWindow
-
-    if example_inputs() is None:
-        pytest.skip("resources/example is not generated in this checkout")
-    window = MainWindow(data_dir=tmp_path / "data")
-    qtbot.addWidget(window)
-    assert window.open_inputs(example=True, wait=True)
-    return window
 
 
 def test_label_edited_in_the_table_is_one_undo_step_and_round_trips(example_window, tmp_path):

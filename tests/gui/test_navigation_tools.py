@@ -14,18 +14,10 @@ from ursim_core.navigation.nav2_files import load_waypoints_yaml
 
 
 @pytest.fixture
-def example_window(qtbot, tmp_path):
-    from ursim_gui.model.example import example_inputs
-    from ursim_gui.window.main_window import MainWindow
-
-    if example_inputs() is None:
-        pytest.skip("resources/example is not generated in this checkout")
-    window = MainWindow(data_dir=tmp_path / "data")
-    qtbot.addWidget(window)
-    window.resize(1200, 700)
-    window.show()
-    assert window.open_inputs(example=True, wait=True)
-    # Georeference the example's metric PNG as a map_server YAML would, so that goals get poses.
+def georeferenced_window(example_window):
+    """The example pair with its metric PNG georeferenced as a map_server YAML would be, so
+    that goals get poses."""
+    window = example_window
     session = window.session
     segmentation = session.segmentation("metric")
     session.set_map("metric", dataclasses.replace(session.map("metric"), resolution=0.05, origin=(-3.0, -2.0, 0.0)))
@@ -54,8 +46,8 @@ def _viewport_pos(view, row, col) -> QPoint:
     return view.mapFromScene(QPointF(col + 0.5, row + 0.5))
 
 
-def test_goal_tool_click_gives_the_core_goal_and_exports(example_window, qtbot, tmp_path):
-    window = example_window
+def test_goal_tool_click_gives_the_core_goal_and_exports(georeferenced_window, qtbot, tmp_path):
+    window = georeferenced_window
     session, view = window.session, window.views["sketch"]
     window.actions["goal_tool"].trigger()
     assert window.navigation.tools.mode == "goal" and view.stroke_mode
@@ -88,8 +80,8 @@ def test_goal_tool_click_gives_the_core_goal_and_exports(example_window, qtbot, 
     assert window.navigation.tools.mode == "" and not window.actions["goal_tool"].isChecked()
 
 
-def test_unmatched_tap_names_the_nearest_matched_region(example_window, qtbot):
-    window = example_window
+def test_unmatched_tap_names_the_nearest_matched_region(georeferenced_window, qtbot):
+    window = georeferenced_window
     session, view = window.session, window.views["sketch"]
     window.actions["goal_tool"].trigger()
     row, col = _matched_sketch_points(session, 1)[0]
@@ -119,8 +111,8 @@ def test_unmatched_tap_names_the_nearest_matched_region(example_window, qtbot):
     assert goal.ok and goal.pixel == expected.pixel
 
 
-def test_route_tool_drag_gives_waypoints_that_follow_the_cliques(example_window, qtbot, tmp_path):
-    window = example_window
+def test_route_tool_drag_gives_waypoints_that_follow_the_cliques(georeferenced_window, qtbot, tmp_path):
+    window = georeferenced_window
     session, view = window.session, window.views["sketch"]
     window.actions["route_tool"].trigger()
     assert not window.actions["goal_tool"].isChecked()
@@ -155,8 +147,8 @@ def test_route_tool_drag_gives_waypoints_that_follow_the_cliques(example_window,
     assert window.navigation.model.route == route
 
 
-def test_new_segmentation_clears_the_goals_with_a_note(example_window, qtbot):
-    window = example_window
+def test_new_segmentation_clears_the_goals_with_a_note(georeferenced_window, qtbot):
+    window = georeferenced_window
     session = window.session
     window.actions["goal_tool"].trigger()
     row, col = _matched_sketch_points(session, 1)[0]
