@@ -1,5 +1,8 @@
 """Whether this install's MAORIS kernels are compiled on disk, without importing numba.
 
+By default the kernels come from the module built ahead of time
+(:mod:`ursim_core.segmentation.maoris.compiled`): :func:`kernels_cached` is true when it is
+built for these sources. With ``URSIM_KERNELS=jit`` it asks numba's cache instead:
 numba compiles a ``cache=True`` function on its first call and writes it to a cache
 directory (``NUMBA_CACHE_DIR`` if set, else ``__pycache__`` beside the module, else the
 user's cache directory) as an index file ``<module>.<function>-<line>.pyXY.nbi`` plus data
