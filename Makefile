@@ -9,6 +9,11 @@ PIP := $(BIN)/python -m pip
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 
+# The core alone: what the kernel build needs, so `make .venv/.kernels` (or `make -j`) works on its own.
+$(VENV)/.installed-core: pyproject.toml | $(BIN)/python
+	$(PIP) install -q -e .
+	touch $@
+
 $(VENV)/.installed-gui: pyproject.toml | $(BIN)/python
 	$(PIP) install -q -e ".[gui]"
 	touch $@
@@ -19,7 +24,7 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 
 # numba compiles the segmentation kernels on first use and caches them beside the module: do it
 # once here rather than inside the first segmentation (or in both test workers at once).
-$(VENV)/.kernels: $(shell find ursim_core/segmentation -name '*.py') | $(BIN)/python
+$(VENV)/.kernels: $(shell find ursim_core/segmentation -name '*.py') | $(VENV)/.installed-core
 	@echo "Building the segmentation kernels ahead of time (once; about 25 s of CPU)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; print(f'{compile_kernels():.1f} s')"
 	touch $@

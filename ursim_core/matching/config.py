@@ -102,6 +102,12 @@ class MatchConfig:
     mirrored : bool or None
         Whether the sketch is a left-right mirror image of the map; None (default) = unknown,
         both are tried with ``orientation='any'`` (with 'upright' or a number, None = no).
+    orientation_overlap : bool
+        With ``orientation='any'``, rank the orientations by their hypothesis score divided by
+        the free-space overlap of the sketch fitted onto the metric map in that orientation
+        (:mod:`ursim_core.matching.alignment`); False = by the score alone (round 5). Needs the
+        label images (segmentations, not bare graphs). Graphs over 60 regions are screened by
+        assignment cost alone.
     """
 
     variant: str = "T4"
@@ -125,6 +131,7 @@ class MatchConfig:
     score_weight: float = 8.0
     orientation: Any = "any"
     mirrored: bool | None = None
+    orientation_overlap: bool = True
 
     def __post_init__(self):
         choices = {

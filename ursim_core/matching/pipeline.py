@@ -119,6 +119,13 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     else:
         prepared_candidates = {index: candidate(index) for index in range(len(candidates))}
         finalists = range(len(candidates))
+    overlaps = _candidate_overlaps(config, sketch_seg, metric_seg, candidates)
+
+    def ranked(cost: float, index: int) -> float:
+        # The hypothesis score divided by the free-space overlap in that orientation: both must
+        # agree (see ursim_core.matching.alignment). Scale-free, so nothing to tune.
+        return cost / overlaps[index] if overlaps else cost
+
     if (
         len(finalists) > 1
         and config.m == "auto"
@@ -128,7 +135,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
         # Screen every orientation on a coarse m grid first; only the best few get the full sweep.
         coarse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: _COARSE_STEP]))
         screened = [
-            (match_prepared(dataclasses.replace(prepared, config=coarse)).normalised_cost, index)
+            (ranked(match_prepared(dataclasses.replace(prepared, config=coarse)).normalised_cost, index), index)
             for index, prepared in prepared_candidates.items()
         ]
         finalists = sorted(index for _, index in sorted(screened)[:_FINALISTS])
@@ -136,7 +143,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
         result = match_prepared(prepared, progress=_share_of(progress, step, len(finalists)))
-        trials.append((result.normalised_cost, index, prepared, result))
+        trials.append((ranked(result.normalised_cost, index), index, prepared, result))
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(
@@ -153,6 +160,26 @@ _COARSE_STEP = 2
 _FINALISTS = 2
 #: Above this many regions in either map, orientations are screened by assignment cost instead.
 _SCREEN_BY_ASSIGNMENT = 60
+
+
+def _candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates) -> dict[int, float]:
+    """Free-space overlap of the sketch fitted onto the metric map, per candidate orientation
+    (empty when not asked for or when either side is a bare graph with no label image)."""
+    sketch_labels = getattr(sketch_seg, "labels", None)
+    metric_labels = getattr(metric_seg, "labels", None)
+    if not config.orientation_overlap or sketch_labels is None or metric_labels is None:
+        return {}
+    from ursim_core.matching.alignment import fit_alignment
+
+    overlaps = {}
+    for index, (degrees, mirrored) in enumerate(candidates):
+        fitted = fit_alignment(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored)
+        overlaps[index] = max(fitted.overlap, _SMALLEST_OVERLAP)
+    return overlaps
+
+
+#: Floor of an overlap used as a divisor (a sketch with no free space, say).
+_SMALLEST_OVERLAP = 1e-3
 
 
 def _share_of(progress, index: int, count: int):
