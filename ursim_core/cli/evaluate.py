@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -12,7 +13,9 @@ HELP = "Run the paper's experiments on a dataset folder and write a report."
 EXAMPLES = """examples:
   ursim evaluate ../shared/datasets/ursim_kth_sketches -o report/
   ursim evaluate ../shared/datasets/ursim_halmstad_robot_maps/E5 --matchers planar --variants T4
-  ursim evaluate ../shared/datasets/ursim_kth_sketches --matchers planar --variants T4 --augment dihedral"""
+  ursim evaluate ../shared/datasets/ursim_kth_sketches --matchers planar --variants T4 --augment dihedral
+  ursim evaluate ../shared/datasets/ursim_kth_sketches --matchers planar --variants T4 --augment dihedral \
+      --cross-validate orientation_overlap=0,0.5,1,2"""
 
 _MATCHERS = ["planar", "hungarian", "vf2"]
 _VARIANTS = ["baseline", "T1", "T2", "T3", "T4"]
@@ -61,6 +64,19 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="also score every sketch turned / mirrored, each orientation as its own run: 'dihedral' "
         "(the 8 orientations) or 'angles=15,30,...' (degrees counter-clockwise; upright always included)",
     )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a matching option for every run (a MatchConfig field, e.g. orientation=upright); repeatable",
+    )
+    parser.add_argument(
+        "--cross-validate",
+        metavar="NAME=V1,V2,...",
+        help="evaluate once per value of a matching option and report leave-one-map-out figures: each "
+        "map scored with the value that does best on the other maps (needs one matcher and one variant)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -77,34 +93,83 @@ def run(args: argparse.Namespace) -> int:
     progress = progress_bar(1, "evaluate")
 
     legacy: bool | str = {"none": False, "as-built": True, "fnfix": "fnfix"}[args.legacy_scoring]
-    overrides = None
-    if args.paper:
-        import dataclasses
+    overrides = _overrides(args)
+    choices = None
+    if args.cross_validate:
+        from ursim_core.errors import ParameterError
+        from ursim_core.evaluation.crossval import parse_choices
 
+        choices = parse_choices(args.cross_validate)
+        if len(args.matchers) != 1 or len(args.variants) != 1:
+            raise ParameterError("needs exactly one --matchers and one --variants value", field="cross_validate")
+    values = choices[1] if choices else [None]
+    # One segmentation of each map serves every value.
+    segmentations: dict = {}
+    results = {}
+    for value in values:
+        run_overrides = dict(overrides or {})
+        if choices:
+            run_overrides[choices[0]] = value
+        results[json.dumps(value)] = run_evaluation(
+            Path(args.dataset),
+            matchers=args.matchers,
+            variants=args.variants,
+            preset=args.preset,
+            metric_preset=args.metric_preset,
+            legacy_scoring=legacy,
+            released=args.released,
+            maps=args.maps,
+            workers=args.workers,
+            cache_dir=args.cache,
+            config_overrides=run_overrides or None,
+            progress=progress,
+            augment=augment,
+            scheduler=args.scheduler,
+            segmentation_cache=segmentations,
+        )
+    for key, result in results.items():
+        for warning in result.warnings:
+            print(f"warning: {warning}", file=sys.stderr)
+        if choices:
+            print(f"\n## {choices[0]} = {key}")
+        print(format_tables(result))
+        if args.output:
+            folder = Path(args.output) / f"{choices[0]}={key}" if choices else Path(args.output)
+            write_report(result, folder)
+            print(f"report written to {folder}")
+    if choices:
+        from ursim_core.evaluation.crossval import cross_validate
+
+        cv = cross_validate(
+            {json.loads(key): result for key, result in results.items()},
+            option=choices[0],
+            matcher=args.matchers[0],
+            variant=args.variants[0],
+        )
+        print(f"\nLeave-one-map-out cross-validation of {choices[0]} (automatic m):")
+        print(cv.table())
+        if args.output:
+            from ursim_core.io.atomic import atomic_write_text
+
+            path = Path(args.output) / "crossval.md"
+            atomic_write_text(path, f"# Cross-validation of {choices[0]}\n\n" + cv.table(markdown=True) + "\n")
+            print(f"cross-validation written to {path}")
+    return 0
+
+
+def _overrides(args: argparse.Namespace) -> dict | None:
+    """Matching options from --paper and --set (--set wins)."""
+    import dataclasses
+
+    from ursim_core.evaluation.crossval import parse_option
+
+    overrides: dict = {}
+    if args.paper:
         from ursim_core.matching import MatchConfig
 
         set_by_runner = {"variant", "matcher", "m", "weights", "m_grid"}
         overrides = {k: v for k, v in dataclasses.asdict(MatchConfig.paper()).items() if k not in set_by_runner}
-    result = run_evaluation(
-        Path(args.dataset),
-        matchers=args.matchers,
-        variants=args.variants,
-        preset=args.preset,
-        metric_preset=args.metric_preset,
-        legacy_scoring=legacy,
-        released=args.released,
-        maps=args.maps,
-        workers=args.workers,
-        cache_dir=args.cache,
-        config_overrides=overrides,
-        progress=progress,
-        augment=augment,
-        scheduler=args.scheduler,
-    )
-    for warning in result.warnings:
-        print(f"warning: {warning}", file=sys.stderr)
-    print(format_tables(result))
-    if args.output:
-        write_report(result, Path(args.output))
-        print(f"report written to {args.output}")
-    return 0
+    for text in args.set:
+        name, value = parse_option(text)
+        overrides[name] = value
+    return overrides or None

@@ -27,7 +27,7 @@ import numpy as np
 
 from ursim_core.matching.orientation import transform_points
 
-__all__ = ["Alignment", "fit_alignment", "orientation_matrix"]
+__all__ = ["Alignment", "fit_alignment", "fit_alignments", "orientation_matrix"]
 
 #: Long side, in pixels, of the metric map's free space when the overlap is measured: coarse
 #: enough for a few hundred overlaps per orientation in milliseconds, fine enough for corridors
@@ -73,17 +73,43 @@ def orientation_matrix(*, degrees: float, mirrored: bool) -> np.ndarray:
     return transform_points(np.eye(2), degrees=degrees, mirrored=mirrored).T
 
 
-def _to_opencv(matrix: np.ndarray) -> np.ndarray:
-    """A (row, col) 2 x 3 matrix as OpenCV's (x, y) one."""
-    swap = np.array([[0.0, 1.0], [1.0, 0.0]])
-    return np.hstack([swap @ matrix[:, :2] @ swap, (swap @ matrix[:, 2])[:, None]])
-
-
 def _shrunk(mask: np.ndarray, factor: float) -> np.ndarray:
     import cv2
 
     shape = (max(1, round(mask.shape[1] * factor)), max(1, round(mask.shape[0] * factor)))
     return cv2.resize(mask.astype(np.uint8), shape, interpolation=cv2.INTER_AREA)
+
+
+class _FreeSpace:
+    """What the fits need of one map's free space, computed once for every orientation tried."""
+
+    def __init__(self, free, *, shrink_to: int):
+        free = np.asarray(free) != 0
+        self.shape = free.shape
+        self.empty = not free.any()
+        if self.empty:
+            return
+        rows = np.flatnonzero(free.any(axis=1))
+        cols = np.flatnonzero(free.any(axis=0))
+        self.low = np.array([rows[0], cols[0]], float)
+        self.high = np.array([rows[-1], cols[-1]], float)
+        self.factor = min(1.0, shrink_to / max(free.shape))
+        self.shrunk = _shrunk(free, self.factor)
+
+
+def fit_alignments(sketch_free, metric_free, orientations) -> list[Alignment]:
+    """:func:`fit_alignment` for several ``(degrees, mirrored)`` orientations, the maps read once.
+
+    Examples
+    --------
+    >>> free = np.zeros((40, 80), bool); free[5:35, 5:30] = True; free[15:25, 30:75] = True
+    >>> [round(a.overlap, 1) for a in fit_alignments(free, free, [(0.0, False), (0.0, True)])][0]
+    1.0
+    """
+    metric = _FreeSpace(metric_free, shrink_to=_SIDE)
+    # The sketch is shrunk to twice the target's resolution, which keeps its thin strokes.
+    sketch = _FreeSpace(sketch_free, shrink_to=2 * _SIDE)
+    return [_fit(sketch, metric, float(degrees), bool(mirrored)) for degrees, mirrored in orientations]
 
 
 def fit_alignment(sketch_free, metric_free, *, degrees: float = 0.0, mirrored: bool = False) -> Alignment:
@@ -112,64 +138,79 @@ def fit_alignment(sketch_free, metric_free, *, degrees: float = 0.0, mirrored: b
     >>> fit_alignment(free, free, degrees=180).overlap < 0.7
     True
     """
+    return fit_alignments(sketch_free, metric_free, [(degrees, mirrored)])[0]
+
+
+def _fit(sketch: _FreeSpace, metric: _FreeSpace, degrees: float, mirrored: bool) -> Alignment:
     import cv2
 
-    sketch_free = np.asarray(sketch_free) != 0
-    metric_free = np.asarray(metric_free) != 0
     turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
-    if not sketch_free.any() or not metric_free.any():
-        return Alignment(0.0, np.hstack([turn, np.zeros((2, 1))]), float(degrees), bool(mirrored))
-    rows, cols = np.nonzero(metric_free)
-    metric_low = np.array([rows.min(), cols.min()], float)
-    metric_high = np.array([rows.max(), cols.max()], float)
-    rows, cols = np.nonzero(sketch_free)
-    corners = np.array([[rows.min(), cols.min()], [rows.min(), cols.max()], [rows.max(), cols.min()], [rows.max(), cols.max()]], float)
+    if sketch.empty or metric.empty:
+        return Alignment(0.0, np.hstack([turn, np.zeros((2, 1))]), degrees, mirrored)
+    corners = np.array(
+        [[sketch.low[0], sketch.low[1]], [sketch.low[0], sketch.high[1]], [sketch.high[0], sketch.low[1]], sketch.high]
+    )
     turned = corners @ turn.T
     sketch_low, sketch_high = turned.min(axis=0), turned.max(axis=0)
-    metric_extent = np.maximum(metric_high - metric_low, 1.0)
+    metric_extent = np.maximum(metric.high - metric.low, 1.0)
     base_scale = metric_extent / np.maximum(sketch_high - sketch_low, 1.0)
-    metric_centre = (metric_low + metric_high) / 2
-    sketch_centre = (sketch_low + sketch_high) / 2
-
-    factor = _SIDE / max(metric_free.shape)
-    target = _shrunk(metric_free, factor) > 0
+    metric_centre = ((metric.low + metric.high) / 2).tolist()
+    # The sketch point that the turn sends to the turned box's centre.
+    sketch_centre = np.linalg.solve(turn, (sketch_low + sketch_high) / 2)
+    target = metric.shrunk > 0
     target_area = np.count_nonzero(target)
-    # The sketch is shrunk once to about the target's resolution (twice it, to keep thin strokes).
-    sketch_factor = min(1.0, 2 * _SIDE / max(sketch_free.shape))
-    source = _shrunk(sketch_free, sketch_factor)
     size = (target.shape[1], target.shape[0])
+    to_coarse = metric.factor / sketch.factor
 
-    def matrix_of(params: np.ndarray) -> np.ndarray:
+    (t00, t01), (t10, t11) = turn.tolist()
+    scale_rows, scale_cols = base_scale.tolist()
+    centre_rows, centre_cols = sketch_centre.tolist()
+
+    def linear_offset(params) -> tuple[float, ...]:
+        # linear = turn(angle) @ diag(scales) @ turn; plain floats: this runs ~150 times a fit.
         log_rows, log_cols, shift_rows, shift_cols, angle = params
         c, s = math.cos(angle), math.sin(angle)
-        linear = np.array([[c, -s], [s, c]]) @ np.diag(base_scale * np.exp([log_rows, log_cols])) @ turn
+        a, d = scale_rows * math.exp(log_rows), scale_cols * math.exp(log_cols)
+        m00, m01, m10, m11 = a * t00, a * t01, d * t10, d * t11
+        l00, l01, l10, l11 = c * m00 - s * m10, c * m01 - s * m11, s * m00 + c * m10, s * m01 + c * m11
         # The turned sketch's box centre lands on the metric box centre plus the shift.
-        offset = metric_centre + np.array([shift_rows, shift_cols]) * metric_extent
-        offset = offset - linear @ np.linalg.solve(turn, sketch_centre)
-        return np.hstack([linear, offset[:, None]])
+        o0 = metric_centre[0] + shift_rows * metric_extent[0] - (l00 * centre_rows + l01 * centre_cols)
+        o1 = metric_centre[1] + shift_cols * metric_extent[1] - (l10 * centre_rows + l11 * centre_cols)
+        return l00, l01, l10, l11, o0, o1
 
-    def overlap_of(params: np.ndarray) -> float:
-        matrix = matrix_of(params)
-        coarse = np.hstack([matrix[:, :2] * (factor / sketch_factor), matrix[:, 2:] * factor])
-        warped = cv2.warpAffine(source, _to_opencv(coarse), size, flags=cv2.INTER_NEAREST) > 0
+    def overlap_of(params) -> float:
+        l00, l01, l10, l11, o0, o1 = linear_offset(params)
+        k, f = to_coarse, metric.factor
+        # Pixel centres: index q of a map shrunk by g is the full-size index (q + 0.5) / g - 0.5
+        # (cv2.resize), so the offset gains (k - f) * linear @ (0.5, 0.5) + 0.5 * f - 0.5.
+        half = 0.5 * (k - f)
+        c0 = f * o0 + half * (l00 + l01) + 0.5 * f - 0.5
+        c1 = f * o1 + half * (l10 + l11) + 0.5 * f - 0.5
+        # OpenCV's matrix is (x, y) = (col, row): rows and columns of the (row, col) one swapped.
+        opencv = np.array([[l11 * k, l10 * k, c1], [l01 * k, l00 * k, c0]])
+        warped = cv2.warpAffine(sketch.shrunk, opencv, size, flags=cv2.INTER_NEAREST) > 0
         inter = np.count_nonzero(warped & target)
         union = np.count_nonzero(warped) + target_area - inter
         return inter / union if union else 0.0
 
-    params = np.zeros(5)
+    def matrix_of(params) -> np.ndarray:
+        l00, l01, l10, l11, o0, o1 = linear_offset(params)
+        return np.array([[l00, l01, o0], [l10, l11, o1]])
+
+    params = [0.0] * 5
     best = overlap_of(params)
-    steps = np.array(_FIRST_STEPS)
+    steps = list(_FIRST_STEPS)
     for _ in range(_MAX_ROUNDS):
         improved = False
         for axis in range(len(params)):
             for sign in (1.0, -1.0):
-                trial = params.copy()
+                trial = list(params)
                 trial[axis] += sign * steps[axis]
                 value = overlap_of(trial)
                 if value > best + 1e-12:
                     best, params, improved = value, trial, True
         if not improved:
-            steps /= 2
-            if steps.max() < _SMALLEST_STEP:
+            steps = [step / 2 for step in steps]
+            if max(steps) < _SMALLEST_STEP:
                 break
-    return Alignment(float(best), matrix_of(params), float(degrees), bool(mirrored))
+    return Alignment(float(best), matrix_of(params), degrees, mirrored)

@@ -102,12 +102,12 @@ class MatchConfig:
     mirrored : bool or None
         Whether the sketch is a left-right mirror image of the map; None (default) = unknown,
         both are tried with ``orientation='any'`` (with 'upright' or a number, None = no).
-    orientation_overlap : bool
-        With ``orientation='any'``, rank the orientations by their hypothesis score divided by
-        the free-space overlap of the sketch fitted onto the metric map in that orientation
-        (:mod:`ursim_core.matching.alignment`); False = by the score alone (round 5). Needs the
-        label images (segmentations, not bare graphs). Graphs over 60 regions are screened by
-        assignment cost alone.
+    orientation_overlap : float
+        With ``orientation='any'``, the orientations are ranked by their hypothesis score divided
+        by the free-space overlap (intersection over union) of the sketch fitted onto the metric
+        map in that orientation, raised to this power (:mod:`ursim_core.matching.alignment`);
+        0 = by the score alone. Needs the label images (segmentations, not bare graphs); graphs
+        of more than 60 regions are screened by assignment cost alone.
     """
 
     variant: str = "T4"
@@ -131,7 +131,7 @@ class MatchConfig:
     score_weight: float = 8.0
     orientation: Any = "any"
     mirrored: bool | None = None
-    orientation_overlap: bool = True
+    orientation_overlap: float = 1.0
 
     def __post_init__(self):
         choices = {
@@ -159,7 +159,14 @@ class MatchConfig:
             raise ParameterError(
                 f"must be 'auto', None or a positive integer, not {self.max_seeds!r}", field="max_seeds"
             )
-        for name in ("position_weight", "score_weight", "uniqueness_k", "size_weight_floor", "vf2_timeout"):
+        for name in (
+            "position_weight",
+            "score_weight",
+            "uniqueness_k",
+            "size_weight_floor",
+            "vf2_timeout",
+            "orientation_overlap",
+        ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise ParameterError(f"must be a non-negative number, not {value!r}", field=name)

@@ -119,12 +119,14 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     else:
         prepared_candidates = {index: candidate(index) for index in range(len(candidates))}
         finalists = range(len(candidates))
-    overlaps = _candidate_overlaps(config, sketch_seg, metric_seg, candidates)
+    overlaps = (
+        _candidate_overlaps(config, sketch_seg, metric_seg, candidates, list(finalists)) if len(finalists) > 1 else {}
+    )
 
     def ranked(cost: float, index: int) -> float:
         # The hypothesis score divided by the free-space overlap in that orientation: both must
-        # agree (see ursim_core.matching.alignment). Scale-free, so nothing to tune.
-        return cost / overlaps[index] if overlaps else cost
+        # agree (see ursim_core.matching.alignment). A ratio is scale-free: no weight to tune.
+        return cost / overlaps[index] ** config.orientation_overlap if overlaps else cost
 
     if (
         len(finalists) > 1
@@ -162,20 +164,17 @@ _FINALISTS = 2
 _SCREEN_BY_ASSIGNMENT = 60
 
 
-def _candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates) -> dict[int, float]:
+def _candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates, indices) -> dict[int, float]:
     """Free-space overlap of the sketch fitted onto the metric map, per candidate orientation
     (empty when not asked for or when either side is a bare graph with no label image)."""
     sketch_labels = getattr(sketch_seg, "labels", None)
     metric_labels = getattr(metric_seg, "labels", None)
-    if not config.orientation_overlap or sketch_labels is None or metric_labels is None:
+    if config.orientation_overlap == 0 or sketch_labels is None or metric_labels is None:
         return {}
-    from ursim_core.matching.alignment import fit_alignment
+    from ursim_core.matching.alignment import fit_alignments
 
-    overlaps = {}
-    for index, (degrees, mirrored) in enumerate(candidates):
-        fitted = fit_alignment(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored)
-        overlaps[index] = max(fitted.overlap, _SMALLEST_OVERLAP)
-    return overlaps
+    fitted = fit_alignments(sketch_labels, metric_labels, [candidates[index] for index in indices])
+    return {index: max(alignment.overlap, _SMALLEST_OVERLAP) for index, alignment in zip(indices, fitted)}
 
 
 #: Floor of an overlap used as a divisor (a sketch with no free space, say).
