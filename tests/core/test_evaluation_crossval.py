@@ -65,7 +65,9 @@ def test_cli_cross_validates_an_option(synthetic_dataset, tmp_path, capsys):  # 
     out = capsys.readouterr().out
     assert "Leave-one-map-out cross-validation of position_weight" in out and "held-out F1" in out
     assert (report / "crossval.md").is_file()
-    assert (report / "position_weight=0" / "runs.csv").is_file() and (report / "position_weight=2" / "summary.md").is_file()
+    assert (report / "position_weight=0" / "runs.csv").is_file() and (
+        report / "position_weight=2" / "summary.md"
+    ).is_file()
 
 
 def test_cli_rejects_unknown_options_and_two_matchers(synthetic_dataset, capsys):  # noqa: F811

@@ -26,13 +26,16 @@ def run_bench(
     repeats: int = 5,
     sizes: tuple[int, ...] | None = None,
     csv: str | Path | None = None,
+    seeds: int = 8,
 ) -> int:
     """Run the benchmarks named by ``what`` and print figures.
 
     ``what``: 'segment', 'scale', 'match' or 'all' (those three), 'startup' (whole-process
     times, :mod:`ursim_core.bench.startup`), 'compile' (first-run kernel compilation), 'files'
     (correspondence files) or 'quality' (segmentation F1, in-sample and leave-one-map-out, of
-    every preset on maoris_segmentation, :mod:`ursim_core.bench.quality`; ``csv``: also the rows).
+    every preset on maoris_segmentation, :mod:`ursim_core.bench.quality`; ``csv``: also the rows)
+    or 'invariance' (matching accuracy on ``seeds`` generated pairs turned, mirrored, cropped and
+    rescaled, :mod:`ursim_core.bench.invariance`).
     ``sizes``: the building sides of 'scale' (default :data:`SCALE_SIZES`).
     Returns the exit code: 1 when the benchmark is not available.
     """
@@ -55,6 +58,12 @@ def run_bench(
         from ursim_core.bench.quality import bench_quality
 
         bench_quality(root, csv_path=csv)
+        return 0
+    if what == "invariance":
+        from ursim_core.bench.invariance import bench_invariance, print_invariance
+
+        print(f"== matching on {seeds} generated pairs, each transformed 6 ways (issue 11 bar: mean F1 >= 0.95)")
+        print_invariance(bench_invariance(range(seeds)))
         return 0
     if what in _OPTIONAL:
         import importlib

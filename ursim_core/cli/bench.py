@@ -9,10 +9,11 @@ EXAMPLES = """examples:
   ursim bench segment
   ursim bench startup --repeats 7
   ursim bench scale --sizes 1000 2000 4000
+  ursim bench invariance --seeds 12
   ursim bench all --datasets ../shared/datasets"""
 
 #: Benchmarks by name; "all" runs segment, scale and match (the others on request).
-BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "quality", "all")
+BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "quality", "invariance", "all")
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -23,11 +24,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default="all",
         help="startup: whole-process times of ursim --help / match / segment; compile: first-run kernel "
         "compilation; files: correspondence file load/save; quality: segmentation F1 of every preset, "
-        "in-sample and leave-one-map-out; all: segment, scale and match",
+        "in-sample and leave-one-map-out; invariance: matching F1 and place accuracy on generated pairs turned, "
+        "mirrored, cropped and rescaled; all: segment, scale and match",
     )
     parser.add_argument("--datasets", help="datasets folder (default: $URSIM_DATASETS or ../shared/datasets)")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--csv", metavar="FILE", help="quality: also write every row to FILE")
+    parser.add_argument("--seeds", type=int, default=8, help="invariance: generated pairs (default 8)")
     parser.add_argument(
         "--sizes",
         type=int,
@@ -40,4 +43,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from ursim_core.bench.runner import run_bench
 
-    return run_bench(args.what, datasets=args.datasets, repeats=args.repeats, sizes=args.sizes, csv=args.csv)
+    return run_bench(
+        args.what, datasets=args.datasets, repeats=args.repeats, sizes=args.sizes, csv=args.csv, seeds=args.seeds
+    )

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -58,7 +59,9 @@ def parse_choices(text: str) -> tuple[str, list[Any]]:
     name, sep, values = text.partition("=")
     parsed = [_value(v.strip()) for v in values.split(",") if v.strip()]
     if not sep or not name.strip() or len(parsed) < 2 or len({json.dumps(v) for v in parsed}) < len(parsed):
-        raise ParameterError(f"expected NAME=V1,V2,... with two or more distinct values, not {text!r}", field="cross_validate")
+        raise ParameterError(
+            f"expected NAME=V1,V2,... with two or more distinct values, not {text!r}", field="cross_validate"
+        )
     return name.strip(), parsed
 
 
@@ -106,11 +109,16 @@ class CrossValidation:
         body.append(["mean", "", number(self.f1), number(self.place_accuracy)])
         worst = self.worst
         body.append([f"worst ({worst[0]})", "", number(worst[2]), number(worst[3])])
-        for orientation, (f1, place) in sorted(self.by_orientation.items()):
+        for orientation, (f1, place) in sorted(self.by_orientation.items(), key=lambda item: _natural(item[0])):
             body.append([f"orientation {orientation or 'as drawn'}", "", number(f1), number(place)])
         for value, (f1, place) in self.in_sample.items():
             body.append([f"in-sample {self.option}={json.dumps(value)}", "(same data)", number(f1), number(place)])
         return (markdown_table if markdown else text_table)(header, body)
+
+
+def _natural(text: str) -> tuple:
+    """'rot15' before 'rot105': numbers compared as numbers."""
+    return tuple(int(part) if part.isdigit() else part for part in re.split(r"(\d+)", text))
 
 
 def _per_map(result, matcher: str, variant: str) -> dict[str, dict[str, list[tuple[float, float]]]]:

@@ -1,0 +1,44 @@
+"""The generated-pair invariance benchmark: transformations move the sketch and its points alike."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ursim_core.bench.invariance import KINDS, _parameters, run_case, transformed_sketch
+from ursim_core.synth import make_pair
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_points_stay_on_the_place_they_were_on(kind):
+    _, sketch = make_pair(seed=3)
+    rows, cols = np.nonzero(sketch.rooms)
+    pick = np.linspace(0, len(rows) - 1, 200).astype(int)
+    points = list(zip(rows[pick].tolist(), cols[pick].tolist()))
+    degrees, mirrored, scale, kept = _parameters(3, kind)
+    # The place ids drawn as an image go through the same transformation as the free space.
+    for place in np.unique(sketch.rooms[rows[pick], cols[pick]])[:6]:
+        image, moved = transformed_sketch(
+            sketch.rooms == place, points, degrees=degrees, mirrored=mirrored, scale=scale, kept=kept, seed=3
+        )
+        on_place = [p for p, q in zip(points, moved) if q is not None and sketch.rooms[p] == place]
+        landed = [image[q] for p, q in zip(points, moved) if q is not None and sketch.rooms[p] == place]
+        if on_place:
+            # Nearest-pixel rounding can put a border point one pixel off its place.
+            assert np.mean(landed) > 0.9, (kind, place)
+    if kept < 1.0:
+        assert any(q is None for q in moved) and any(q is not None for q in moved)
+    else:
+        assert all(q is not None for q in moved)
+
+
+def test_parameters_are_reproducible_and_in_range():
+    assert _parameters(5, "all") == _parameters(5, "all")
+    degrees, mirrored, scale, kept = _parameters(5, "all")
+    assert 0 <= degrees < 360 and mirrored and 0.5 <= scale <= 2 and 0.5 <= kept <= 0.8
+    assert _parameters(5, "upright") == (0.0, False, 1.0, 1.0)
+
+
+def test_an_upright_generated_pair_is_scored():
+    case = run_case(1, "upright")
+    assert case.f1 == pytest.approx(1.0) and case.place_accuracy == pytest.approx(1.0)
