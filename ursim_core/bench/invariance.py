@@ -21,6 +21,7 @@ Figures are printed, never asserted (issue 11's bar: mean F1 >= 0.95 over these 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import statistics
 from dataclasses import dataclass
@@ -105,8 +106,11 @@ def transformed_sketch(free: np.ndarray, points, *, degrees=0.0, mirrored=False,
     return image >= 128, moved
 
 
-def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None) -> InvarianceCase:
-    """Generate pair ``seed``, transform its sketch as ``kind`` says, match and score it."""
+def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None, plan_copy: bool = False) -> InvarianceCase:
+    """Generate pair ``seed``, transform its sketch as ``kind`` says, match and score it.
+
+    ``plan_copy``: transform a copy of the floor plan instead of the sketch (a robot-map-like
+    input: exact walls, only part of the building when cropped)."""
     from ursim_core.correspondences import regions_at_points
     from ursim_core.evaluation.scoring import place_problem, score_matches, score_places
     from ursim_core.matching import MatchConfig, match
@@ -115,10 +119,20 @@ def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None) -> In
 
     plan, sketch = make_pair(seed=seed)
     truth = ground_truth_correspondences(plan, sketch)
+    if plan_copy:
+        truth = dataclasses.replace(
+            truth, cliques=tuple(dataclasses.replace(c, sketch_points=c.metric_points) for c in truth.cliques)
+        )
     degrees, mirrored, scale, kept = _parameters(seed, kind)
     flat = [p for clique in truth.cliques for p in clique.sketch_points]
     image, moved = transformed_sketch(
-        sketch.free, flat, degrees=degrees, mirrored=mirrored, scale=scale, kept=kept, seed=seed
+        plan.free if plan_copy else sketch.free,
+        flat,
+        degrees=degrees,
+        mirrored=mirrored,
+        scale=scale,
+        kept=kept,
+        seed=seed,
     )
     sketch_seg = segment_canonical(image, preset="default")
     metric_seg = plan_segmentation if plan_segmentation is not None else segment_canonical(plan.free, preset="default")
@@ -140,8 +154,10 @@ def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None) -> In
     return InvarianceCase(seed, kind, degrees, mirrored, scale, kept, f1, place)
 
 
-def bench_invariance(seeds=range(8), kinds=KINDS, *, config=None, progress=None) -> list[InvarianceCase]:
-    """Every kind for every seed (the plan of a seed segmented once)."""
+def bench_invariance(
+    seeds=range(8), kinds=KINDS, *, config=None, progress=None, plan_copy: bool = False
+) -> list[InvarianceCase]:
+    """Every kind for every seed (the plan of a seed segmented once); ``plan_copy``: see :func:`run_case`."""
     from ursim_core.segmentation import segment_canonical
     from ursim_core.synth import make_pair
 
@@ -150,7 +166,7 @@ def bench_invariance(seeds=range(8), kinds=KINDS, *, config=None, progress=None)
         plan, _ = make_pair(seed=seed)
         plan_segmentation = segment_canonical(plan.free, preset="default")
         for kind in kinds:
-            cases.append(run_case(seed, kind, config=config, plan_segmentation=plan_segmentation))
+            cases.append(run_case(seed, kind, config=config, plan_segmentation=plan_segmentation, plan_copy=plan_copy))
             if progress is not None:
                 progress(cases[-1])
     return cases

@@ -64,6 +64,16 @@ def run_bench(
 
         print(f"== matching on {seeds} generated pairs, each transformed 6 ways (issue 11 bar: mean F1 >= 0.95)")
         print_invariance(bench_invariance(range(seeds)))
+        from ursim_core.matching import MatchConfig
+
+        print(
+            "== robot-map-like inputs: a copy of each plan turned, cropped (not rescaled, not mirrored), "
+            "overlay matcher told scale 1 and not mirrored"
+        )
+        overlay = MatchConfig(matcher="overlay", scale=1.0, mirrored=False)
+        print_invariance(
+            bench_invariance(range(seeds), kinds=("upright", "turned", "cropped"), config=overlay, plan_copy=True)
+        )
         return 0
     if what in _OPTIONAL:
         import importlib

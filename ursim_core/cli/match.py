@@ -62,7 +62,18 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
         help="whether the sketch is a mirror image of the map (default: unknown with 'any', no otherwise)",
     )
     parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
-    parser.add_argument("--matcher", choices=["planar", "hungarian", "vf2"], help="graph matcher")
+    parser.add_argument(
+        "--matcher",
+        choices=["planar", "hungarian", "vf2", "overlay"],
+        help="graph matcher (overlay: lay two metric maps on each other, see --scale)",
+    )
+    parser.add_argument(
+        "--scale",
+        type=float,
+        metavar="RATIO",
+        help="overlay matcher: metric-map pixels per input pixel when known (1 for two robot maps of one "
+        "resolution); the input may then cover any part of the metric map",
+    )
     parser.add_argument("--released", action="store_true", help="start from the released C++ code's options")
     parser.add_argument(
         "--sketch-preset",
@@ -112,6 +123,8 @@ def match_config(args: argparse.Namespace):
         overrides["variant"] = args.variant
     if args.matcher:
         overrides["matcher"] = args.matcher
+    if getattr(args, "scale", None) is not None:
+        overrides["scale"] = args.scale
     return base.replace(**overrides)
 
 

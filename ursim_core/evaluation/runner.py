@@ -49,6 +49,7 @@ from ursim_core.evaluation.pool import Progress, ProgressCallback
 from ursim_core.evaluation.results import (
     AUTO,
     DEFAULT_M_GRID,
+    DEFAULT_MATCHERS,
     MATCHERS,
     POOLED,
     VARIANTS,
@@ -83,7 +84,7 @@ __all__ = [
 def run_evaluation(
     dataset_dir: str | Path | Sequence[Experiment],
     *,
-    matchers: Sequence[str] = MATCHERS,
+    matchers: Sequence[str] = DEFAULT_MATCHERS,
     variants: Sequence[str] = VARIANTS,
     m_grid: Sequence[float] = DEFAULT_M_GRID,
     preset: str | None = None,

@@ -37,7 +37,7 @@ MATCH_PRESETS = {"sketch": "default", "metric": "default"}
 
 #: The released driver's sweep: 0, 0.025, ..., 0.475 (20 values).
 M_GRID = tuple(round(0.025 * i, 10) for i in range(20))
-MATCHERS = ("planar", "hungarian", "vf2")
+MATCHERS = ("planar", "hungarian", "vf2", "overlay")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -48,7 +48,9 @@ class MatchConfig:
     ----------
     variant : {'T4', 'T1', 'T2', 'T3', 'baseline'}
         Descriptor variant (paper Table 1): T4 = URSIM (anchors + weights).
-    matcher : {'planar', 'hungarian', 'vf2'}
+    matcher : {'planar', 'hungarian', 'vf2', 'overlay'}
+        'overlay': lay the maps on each other and pair what overlaps, for two metric maps
+        (:mod:`ursim_core.matching.overlay`); m does not apply to it.
     m : 'auto' or float
         Threshold on ``c`` below which two regions are "the same". ``'auto'`` picks it
         per map pair over ``m_grid`` (:mod:`ursim_core.matching.auto_m`).
@@ -108,6 +110,12 @@ class MatchConfig:
         map in that orientation, raised to this power (:mod:`ursim_core.matching.alignment`);
         0 = by the score alone. Needs the label images (segmentations, not bare graphs); graphs
         of more than 60 regions are screened by assignment cost alone.
+    scale : float or None
+        Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
+        resolution), for the overlay matcher: it then searches any placement, so either map may
+        cover only part of the other. None: unknown; both maps are taken to cover the same extent.
+    overlay_min_iou : float
+        The overlay matcher pairs regions whose intersection over union is at least this.
     """
 
     variant: str = "T4"
@@ -132,6 +140,8 @@ class MatchConfig:
     orientation: Any = "any"
     mirrored: bool | None = None
     orientation_overlap: float = 1.0
+    scale: float | None = None
+    overlay_min_iou: float = 0.15
 
     def __post_init__(self):
         choices = {
@@ -166,6 +176,7 @@ class MatchConfig:
             "size_weight_floor",
             "vf2_timeout",
             "orientation_overlap",
+            "overlay_min_iou",
         ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
@@ -178,6 +189,13 @@ class MatchConfig:
             raise ParameterError(
                 f"must be 'any', 'upright' or a number of degrees, not {self.orientation!r}", field="orientation"
             )
+        if self.scale is not None and (
+            isinstance(self.scale, bool)
+            or not isinstance(self.scale, (int, float))
+            or not math.isfinite(self.scale)
+            or self.scale <= 0
+        ):
+            raise ParameterError(f"must be a positive number or null, not {self.scale!r}", field="scale")
         if self.mirrored not in (None, True, False):
             raise ParameterError(f"must be true, false or null, not {self.mirrored!r}", field="mirrored")
         if not self.times:

@@ -90,6 +90,8 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     (3, 3)
     """
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
+    if config.matcher == "overlay":
+        return _prepare_overlay(sketch_seg, metric_seg, config)
     candidates = _orientations(config, sketch_seg, metric_seg)
     base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0])
     if len(candidates) == 1:
@@ -162,6 +164,52 @@ _COARSE_STEP = 2
 _FINALISTS = 2
 #: Above this many regions in either map, orientations are screened by assignment cost instead.
 _SCREEN_BY_ASSIGNMENT = 60
+
+
+def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig) -> Prepared:
+    """The overlay matcher's answer, found once: it does not depend on m."""
+    from ursim_core.errors import ParameterError
+    from ursim_core.matching.overlay import fit_overlay, overlay_pairs
+
+    sketch_labels = getattr(sketch_seg, "labels", None)
+    metric_labels = getattr(metric_seg, "labels", None)
+    if sketch_labels is None or metric_labels is None:
+        raise ParameterError("the overlay matcher needs segmentations (label images), not bare graphs", field="matcher")
+    if config.orientation == "any":
+        candidates = orientation_candidates(
+            orientation="any",
+            mirrored=config.mirrored,
+            sketch_angle=wall_angle(sketch_labels),
+            metric_angle=wall_angle(metric_labels),
+        )
+    else:
+        candidates = orientation_candidates(orientation=config.orientation, mirrored=config.mirrored)
+    fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
+    orientation = (fit.degrees, fit.mirrored)
+    base = _prepare_oriented(_graph_of(sketch_seg), _graph_of(metric_seg), config, orientation)
+    pairs = overlay_pairs(sketch_labels, metric_labels, fit.matrix, min_iou=config.overlay_min_iou)
+    descriptors = base.descriptors
+    reasons = list(base.notes)
+    if not pairs:
+        reasons.append(f"no regions overlap by IoU >= {config.overlay_min_iou:g}")
+    result = MatchResult(
+        pairs=pairs,
+        anchors=list(descriptors.anchors) if descriptors else [],
+        unique_sketch=list(descriptors.unique_sketch) if descriptors else [],
+        unique_metric=list(descriptors.unique_metric) if descriptors else [],
+        m=0.0,
+        # The share of the input that does not agree with the metric map where it was laid.
+        cost=1.0 - fit.overlap,
+        normalised_cost=1.0 - fit.overlap,
+        signatures=None,
+        c_matrix=base.c_matrix,
+        seeds_count=0,
+        hypotheses=len(candidates),
+        reason="; ".join(dict.fromkeys(reasons)),
+        config=config,
+        orientation=orientation,
+    )
+    return dataclasses.replace(base, chosen=result)
 
 
 def _candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates, indices) -> dict[int, float]:
@@ -290,6 +338,9 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
     [(0, 0), (1, 1), (2, 2), (3, 3)]
     """
     config = prepared.config
+    if config.matcher == "overlay" and prepared.chosen is not None:
+        # Its answer does not depend on m: the same at every m of a sweep.
+        return dataclasses.replace(prepared.chosen, m=float(m) if m is not None else prepared.chosen.m)
     if m is None and prepared.chosen is not None:
         return prepared.chosen
     if m is None:

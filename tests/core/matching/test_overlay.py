@@ -1,0 +1,104 @@
+"""The overlay matcher: two metric maps laid on each other, partial coverage, turns, errors."""
+
+from __future__ import annotations
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from ursim_core.errors import ParameterError
+from ursim_core.evaluation import augment
+from ursim_core.matching import MatchConfig, match, match_prepared, prepare
+from ursim_core.matching.overlay import fit_overlay, overlay_pairs
+from ursim_core.segmentation import segment
+from ursim_core.synth import make_pair
+
+OVERLAY = MatchConfig(matcher="overlay", scale=1.0, mirrored=False)
+
+
+@pytest.fixture(scope="module")
+def plan():
+    plan, _ = make_pair(seed=2)
+    return plan
+
+
+@pytest.fixture(scope="module")
+def plan_segmentation(plan):
+    return segment(plan.free, preset="default")
+
+
+def _identity_share(pairs, part_labels, full_labels, rows, cols):
+    """Share of the pairs whose regions overlap where the part was cut from."""
+    good = 0
+    for a, b in pairs:
+        inside = full_labels[rows, cols][part_labels == a]
+        good += np.count_nonzero(inside == b) > 0.5 * inside.size
+    return good / max(len(pairs), 1)
+
+
+@pytest.mark.parametrize("quarter_turns", [0, 1, 3])
+def test_a_cropped_turned_copy_is_laid_back_where_it_came_from(plan, plan_segmentation, quarter_turns):
+    rows, cols = plan.free.shape
+    window = (slice(rows // 5, rows // 5 + int(rows * 0.7)), slice(cols // 8, cols // 8 + int(cols * 0.75)))
+    turn = augment.Orientation(90.0 * quarter_turns, mirrored=False)
+    part = augment.transform_image(plan.free[window], turn)
+    part_seg = segment(part, preset="default")
+    result = match(part_seg, plan_segmentation, config=OVERLAY)
+    assert result.pairs and result.reason == ""
+    # The turn found undoes the one applied (up to the walls' small angle).
+    undo = (-90.0 * quarter_turns) % 360.0
+    assert abs((result.orientation[0] - undo + 180.0) % 360.0 - 180.0) < 5.0, result.orientation
+    # Where each part region lands: the full map's region under the same pixels (turned back).
+    back = augment.transform_image(part_seg.labels, augment.Orientation(-90.0 * quarter_turns % 360.0, mirrored=False))
+    full_rows, full_cols = np.mgrid[window[0], window[1]]
+    share = _identity_share(result.pairs, back, plan_segmentation.labels, full_rows, full_cols)
+    assert share >= 0.9, (share, result.pairs)
+
+
+def test_the_shift_of_a_crop_is_found_at_full_resolution(plan):
+    rows, cols = plan.free.shape
+    part = plan.free[40 : 40 + rows // 2, 60 : 60 + cols // 2]
+    fit = fit_overlay(part, plan.free, orientations=[(0.0, False), (180.0, False)], scale=1.0)
+    assert fit.degrees == 0.0
+    np.testing.assert_allclose(fit.matrix[:, :2], np.eye(2), atol=0.06)
+    # A coarse search: within a few coarse pixels (about 3 % of the map's side).
+    assert np.abs(fit.matrix[:, 2] - [40, 60]).max() <= 0.03 * max(rows, cols)
+
+
+def test_pairs_need_the_overlap_threshold():
+    labels = np.zeros((20, 30), np.int32)
+    labels[2:18, 2:14] = 1
+    labels[2:18, 16:28] = 2
+    shifted = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 9.0]])  # most of region 1 now lies on region 2
+    assert overlay_pairs(labels, labels, shifted, min_iou=0.9) == []
+    assert (1, 2) in overlay_pairs(labels, labels, shifted, min_iou=0.2)
+    assert overlay_pairs(np.zeros((5, 5), np.int32), labels, np.eye(2, 3)) == []
+
+
+def test_the_answer_does_not_depend_on_m(plan_segmentation):
+    prepared = prepare(plan_segmentation, plan_segmentation, OVERLAY)
+    answers = {tuple(match_prepared(prepared, m).pairs) for m in (0.0, 0.2, None)}
+    assert len(answers) == 1
+    pairs = next(iter(answers))
+    assert sorted(pairs) == [(n, n) for n in sorted(plan_segmentation.graph.nodes)]
+
+
+def test_overlay_options_are_checked():
+    with pytest.raises(ParameterError, match="scale"):
+        MatchConfig(scale=0)
+    with pytest.raises(ParameterError, match="overlay_min_iou"):
+        MatchConfig(overlay_min_iou=-0.1)
+    graph = nx.path_graph(3)
+    nx.set_node_attributes(graph, 10, "size")
+    nx.set_node_attributes(graph, 0.3, "pca_shape")
+    nx.set_node_attributes(graph, {0: (0, 0), 1: (0, 10), 2: (0, 20)}, "centroid")
+    with pytest.raises(ParameterError, match="label images"):
+        match(graph, graph, config=OVERLAY)
+
+
+def test_no_known_scale_fits_the_extents(plan, plan_segmentation):
+    import cv2
+
+    small = cv2.resize(plan.free.astype(np.uint8), None, fx=0.5, fy=0.5, interpolation=cv2.INTER_NEAREST) > 0
+    result = match(segment(small, preset="default"), plan_segmentation, config=MatchConfig(matcher="overlay"))
+    assert len(result.pairs) >= 0.8 * plan_segmentation.graph.number_of_nodes()
