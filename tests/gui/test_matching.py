@@ -72,3 +72,17 @@ def test_a_document_reopened_from_its_file_says_its_automatic_cliques_are_there(
     session.open(path)
     assert session.last_match is None
     assert window.matching_panel.summary.text().startswith(f"{automatic} automatic cliques from the file")
+
+
+def test_the_overlay_matcher_with_a_known_scale_runs_from_the_panel(window, qtbot):
+    panel = window.matching_panel
+    assert not panel.scale.isEnabled()
+    panel.matcher.setCurrentIndex(panel.matcher.findData("overlay"))
+    assert panel.scale.isEnabled() and panel.config().scale is None  # 0 = unknown
+    panel.scale.setValue(1.0)
+    assert panel.config().matcher == "overlay" and panel.config().scale == 1.0
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    result = window.session.last_match
+    assert result.config.matcher == "overlay" and result.pairs
+    assert "pairs" in panel.summary.text()

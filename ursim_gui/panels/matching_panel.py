@@ -36,7 +36,12 @@ VARIANTS = (
     ("T1", "T1"),
     ("baseline", "baseline"),
 )
-MATCHERS = (("planar", "planar expansion"), ("hungarian", "Hungarian"), ("vf2", "VF2"))
+MATCHERS = (
+    ("planar", "planar expansion"),
+    ("hungarian", "Hungarian"),
+    ("vf2", "VF2"),
+    ("overlay", "overlay (two metric maps)"),
+)
 
 
 def describe_result(result, *, automatic_cliques: int = 0) -> str:
@@ -97,6 +102,23 @@ class MatchingPanel(QWidget):
         self.matcher = _combo("match_matcher", MATCHERS)
         form.addRow("Variant", self.variant)
         form.addRow("Matcher", self.matcher)
+        # The overlay matcher's known scale (metric pixels per input pixel); 0 = unknown.
+        self.scale = QDoubleSpinBox()
+        self.scale.setObjectName("match_scale")
+        self.scale.setRange(0.0, 100.0)
+        self.scale.setDecimals(3)
+        self.scale.setSingleStep(0.05)
+        self.scale.setSpecialValueText("unknown (same extent)")
+        self.scale.setValue(0.0)
+        self.scale.setToolTip(
+            "Overlay matcher: metric-map pixels per input-map pixel (1 for two robot maps of one resolution); "
+            "with a known scale the input may cover any part of the metric map"
+        )
+        self.scale.setEnabled(False)
+        self.matcher.currentIndexChanged.connect(
+            lambda _: self.scale.setEnabled(self.matcher.currentData() == "overlay")
+        )
+        form.addRow("Scale", self.scale)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
         self.turn_left.setObjectName("orient_left")
@@ -146,11 +168,16 @@ class MatchingPanel(QWidget):
 
         m = "auto" if self.m_auto.isChecked() else float(self.m_value.value())
         fields = {field.name for field in dataclasses.fields(MatchConfig)}
+        matcher = self.matcher.currentData()
+        extra = {}
+        if matcher == "overlay" and self.scale.value() > 0:
+            extra["scale"] = float(self.scale.value())
         return MatchConfig(
             variant=self.variant.currentData(),
-            matcher=self.matcher.currentData(),
+            matcher=matcher,
             m=m,
             **self.orientation.match_options(fields),
+            **extra,
         )
 
     def set_orientation(self, orientation: SketchOrientation) -> None:
