@@ -100,3 +100,17 @@ def test_convert_bad_input(tmp_path, capsys):
     assert main(["convert", str(tmp_path / "bad.json"), str(tmp_path / "x.dat")]) == 1
     assert "bad.json" in capsys.readouterr().err
     assert main(["convert", str(tmp_path / "bad.json"), str(tmp_path / "x.txt")]) == 1
+
+
+def test_match_overlay_with_a_known_scale_lays_a_crop_back(tmp_path, capsys):
+    full = building()
+    part = full[:, 140:].copy()  # the right-hand part of the building only
+    cv2.imwrite(str(tmp_path / "full.png"), full)
+    cv2.imwrite(str(tmp_path / "part.png"), part)
+    args = ["match", str(tmp_path / "part.png"), str(tmp_path / "full.png"), "-o", str(tmp_path / "out")]
+    assert main(args + ["--matcher", "overlay", "--scale", "1", "--mirrored", "no"]) == 0
+    document = json.loads((tmp_path / "out" / "correspondences.json").read_text())
+    assert document["matcher"]["config"]["matcher"] == "overlay" and document["matcher"]["config"]["scale"] == 1.0
+    assert len(document["cliques"]) >= 3
+    assert main(args + ["--matcher", "overlay", "--scale", "0"]) != 0
+    assert "scale" in capsys.readouterr().err

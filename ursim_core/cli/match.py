@@ -188,6 +188,7 @@ OPTION_NAMES = (
     "mirrored",
     "variant",
     "matcher",
+    "scale",
     "released",
     "sketch_preset",
     "metric_preset",
