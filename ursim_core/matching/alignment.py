@@ -60,6 +60,12 @@ class Alignment:
     degrees: float
     mirrored: bool
 
+    @classmethod
+    def unfitted(cls, degrees: float, mirrored: bool) -> Alignment:
+        """No fit (a map without free space): overlap 0, the orientation's turn alone."""
+        turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
+        return cls(0.0, np.hstack([turn, np.zeros((2, 1))]), float(degrees), bool(mirrored))
+
 
 def orientation_matrix(*, degrees: float, mirrored: bool) -> np.ndarray:
     """The 2 x 2 (row, col) matrix of :func:`~ursim_core.matching.orientation.transform_points`.
@@ -146,7 +152,7 @@ def _fit(sketch: _FreeSpace, metric: _FreeSpace, degrees: float, mirrored: bool)
 
     turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
     if sketch.empty or metric.empty:
-        return Alignment(0.0, np.hstack([turn, np.zeros((2, 1))]), degrees, mirrored)
+        return Alignment.unfitted(degrees, mirrored)
     corners = np.array(
         [[sketch.low[0], sketch.low[1]], [sketch.low[0], sketch.high[1]], [sketch.high[0], sketch.low[1]], sketch.high]
     )

@@ -109,13 +109,7 @@ def fit_overlay(
         fits = fit_alignments(sketch_free, metric_free, orientations)
         return max(fits, key=lambda fit: fit.overlap)
     if not sketch_free.any() or not metric_free.any():
-        degrees, mirrored = orientations[0]
-        return Alignment(
-            0.0,
-            np.hstack([orientation_matrix(degrees=degrees, mirrored=mirrored), np.zeros((2, 1))]),
-            degrees,
-            mirrored,
-        )
+        return Alignment.unfitted(*orientations[0])
     factor = min(1.0, _SIDE / max(metric_free.shape))
     free = _coarse(metric_free, factor)
     walls = 1.0 - free
@@ -141,13 +135,7 @@ def fit_overlay(
                 matrix = np.hstack([linear / factor, (shift / factor)[:, None]])
                 best = (value, matrix, float(degrees), bool(mirrored))
     if best is None:
-        degrees, mirrored = orientations[0]
-        return Alignment(
-            0.0,
-            np.hstack([orientation_matrix(degrees=degrees, mirrored=mirrored), np.zeros((2, 1))]),
-            degrees,
-            mirrored,
-        )
+        return Alignment.unfitted(*orientations[0])
     return Alignment(min(best[0], 1.0), best[1], best[2], best[3])
 
 
