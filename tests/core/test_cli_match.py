@@ -114,3 +114,21 @@ def test_match_overlay_with_a_known_scale_lays_a_crop_back(tmp_path, capsys):
     assert len(document["cliques"]) >= 3
     assert main(args + ["--matcher", "overlay", "--scale", "0"]) != 0
     assert "scale" in capsys.readouterr().err
+
+
+def test_match_overlay_reads_the_scale_of_two_ros_maps(tmp_path):
+    full = building()
+    half = cv2.resize(full[:, 140:], None, fx=0.5, fy=0.5, interpolation=cv2.INTER_NEAREST)
+    cv2.imwrite(str(tmp_path / "full.png"), full)
+    cv2.imwrite(str(tmp_path / "half.png"), half)
+    for name, resolution in (("full", 0.05), ("half", 0.1)):
+        (tmp_path / f"{name}.yaml").write_text(
+            f"image: {name}.png\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+        )
+    out = tmp_path / "out"
+    args = ["match", str(tmp_path / "half.yaml"), str(tmp_path / "full.yaml"), "-o", str(out), "--matcher", "overlay"]
+    assert main(args + ["--mirrored", "no"]) == 0
+    document = json.loads((out / "correspondences.json").read_text())
+    assert document["matcher"]["config"]["scale"] == pytest.approx(2.0)
+    assert len(document["cliques"]) >= 3

@@ -72,7 +72,8 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
         type=float,
         metavar="RATIO",
         help="overlay matcher: metric-map pixels per input pixel when known (1 for two robot maps of one "
-        "resolution); the input may then cover any part of the metric map",
+        "resolution; read from the resolutions of two ROS YAML maps when not given); the input may then "
+        "cover any part of the metric map",
     )
     parser.add_argument("--released", action="store_true", help="start from the released C++ code's options")
     parser.add_argument(
@@ -224,6 +225,9 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
     # A bad ground-truth file is reported before any work.
     reference = None if reference_path is None else load_reference(reference_path)
     sketch_map, metric_map = load(sketch, args), load(metric, args)
+    if config.matcher == "overlay" and config.scale is None and sketch_map.resolution and metric_map.resolution:
+        # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
+        config = config.replace(scale=sketch_map.resolution / metric_map.resolution)
     params = segmentation_params(args)
     # The sketch is segmented in its canonical pose unless the matcher is told it is upright.
     canonical = config.orientation != "upright"
