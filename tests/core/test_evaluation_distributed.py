@@ -43,7 +43,10 @@ def test_local_cluster_gives_the_local_csv(synthetic_dataset, tmp_path):  # noqa
 
 
 def _task_keys(dask_scheduler=None):
-    return [str(key) for key in dask_scheduler.tasks]
+    # Every key the scheduler saw: a finished task whose future was released is no longer in
+    # ``tasks`` (how many are left depends on timing), but its transitions stay in the log.
+    seen = {str(entry[0]) for entry in dask_scheduler.transition_log}
+    return sorted(seen | {str(key) for key in dask_scheduler.tasks})
 
 
 def test_unreachable_scheduler_is_a_parameter_error(synthetic_dataset):  # noqa: F811

@@ -92,7 +92,8 @@ def transformed_sketch(free: np.ndarray, points, *, degrees=0.0, mirrored=False,
     linear = turn @ (scale * mirror)
     corners = np.array([[0, 0], [cols - 1, 0], [0, rows - 1], [cols - 1, rows - 1]], float) @ linear.T
     offset = -corners.min(axis=0)
-    width, height = (np.ceil(corners.max(axis=0) + offset) + 1).astype(int)
+    # Rounded first: cos(90 degrees) is 6e-17, not 0, and must not add a column.
+    width, height = (np.ceil(np.round(corners.max(axis=0) + offset, 6)) + 1).astype(int)
     matrix = np.hstack([linear, offset[:, None]])
     image = cv2.warpAffine(free.astype(np.uint8) * 255, matrix, (int(width), int(height)), flags=cv2.INTER_LINEAR)
     moved = []
