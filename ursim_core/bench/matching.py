@@ -267,7 +267,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--datasets", default=None)
     parser.add_argument("--sizes", type=int, nargs="*", default=[300, 1000])
-    parser.add_argument("--auto-sizes", type=int, nargs="*", default=[300], help="sizes also timed with m='auto'")
+    parser.add_argument("--auto-sizes", type=int, nargs="*", default=[300, 1000], help="sizes also timed with m='auto'")
     parser.add_argument("--skip-kth", action="store_true")
     parser.add_argument("--accuracy", action="store_true", help="also print the KTH accuracy table")
     arguments = parser.parse_args(argv)
