@@ -175,15 +175,7 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig) -> Prepared:
     metric_labels = getattr(metric_seg, "labels", None)
     if sketch_labels is None or metric_labels is None:
         raise ParameterError("the overlay matcher needs segmentations (label images), not bare graphs", field="matcher")
-    if config.orientation == "any":
-        candidates = orientation_candidates(
-            orientation="any",
-            mirrored=config.mirrored,
-            sketch_angle=wall_angle(sketch_labels),
-            metric_angle=wall_angle(metric_labels),
-        )
-    else:
-        candidates = orientation_candidates(orientation=config.orientation, mirrored=config.mirrored)
+    candidates = _orientations(config, sketch_seg, metric_seg)
     fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
     orientation = (fit.degrees, fit.mirrored)
     base = _prepare_oriented(_graph_of(sketch_seg), _graph_of(metric_seg), config, orientation)
@@ -244,9 +236,9 @@ def _orientations(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[flo
     """The orientations worth trying: only those that can change the answer."""
     if config.orientation != "any":
         return orientation_candidates(orientation=config.orientation, mirrored=config.mirrored)
-    if config.position_weight == 0:
+    if config.position_weight == 0 and config.matcher != "overlay":
         # Without the position term only a mirror image changes anything (the planar
-        # matcher's neighbour orders reverse); the other matchers do not see orientation.
+        # matcher's neighbour orders reverse); the other graph matchers do not see orientation.
         if config.matcher != "planar" or config.mirrored is not None:
             return [(0.0, bool(config.mirrored))]
         return [(0.0, False), (0.0, True)]
