@@ -5,7 +5,8 @@ narrow pass between two basins. :func:`watershed_labels`:
 
 1. clearance ``d`` = Euclidean distance transform of the free space;
 2. markers = the connected plateaus of local maxima of ``d`` (3x3), and a watershed of
-   ``-d`` over the free pixels (scikit-image) gives one basin per marker;
+   ``-d`` over the free pixels gives one basin per marker: scikit-image's labels, from
+   :mod:`ursim_core.segmentation.flooding` (its heap replayed in a compiled kernel);
 3. two touching basins a, b merge when their *saddle ratio* ``s(a, b) / min(peak(a),
    peak(b))`` is at least ``door_ratio``, highest ratio first: ``s`` is the largest
    clearance on their shared boundary (the widest point of the pass), ``peak`` a basin's
@@ -196,7 +197,8 @@ def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     """
     import cv2
     from scipy import ndimage
-    from skimage.segmentation import watershed
+
+    from ursim_core.segmentation.flooding import clearance_levels, flood_levels
 
     options = resolve_watershed_params(params)
     free = np.asarray(free)
@@ -206,9 +208,11 @@ def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     if not free.any():
         return np.zeros(free.shape, np.int32)
     clearance = cv2.distanceTransform(np.pad(free, 1).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
-    peaks = free & (clearance >= ndimage.maximum_filter(clearance, size=3))
+    # The 3x3 maximum; cv2 ignores the pixels beyond the border as ndimage's "reflect"
+    # does for a 3x3 window (it reflects the border pixel itself), 7 times faster.
+    peaks = free & (clearance >= cv2.dilate(clearance, np.ones((3, 3), np.uint8)))
     markers, _ = ndimage.label(peaks, structure=np.ones((3, 3), bool))
-    basins = watershed(-clearance, markers, mask=free).astype(np.int32)
+    basins = flood_levels(clearance_levels(clearance, free), markers, free, fallback=-clearance)
     count = int(basins.max()) + 1
     # Each basin's largest clearance. ndimage.maximum sorts every pixel by label (2.4 s at
     # 4000 px); an unbuffered maximum gives the same values in 0.15 s.
