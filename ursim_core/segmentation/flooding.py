@@ -65,23 +65,31 @@ def watershed_flood(image, markers, *, mask=None, connectivity: int = 1) -> np.n
 
 
 def clearance_levels(clearance: np.ndarray, free: np.ndarray) -> np.ndarray:
-    """Levels of ``-clearance`` for :func:`flood_levels`: 0 = the largest clearance.
+    """Levels of ``-clearance`` on ``free`` for :func:`flood_levels`: 0 = the largest clearance.
 
-    ``clearance`` is float32 and >= 0 (a distance transform): its bits order as its
-    values do, so the levels are ranks among the distinct values on ``free``, found by
-    :func:`numpy.unique` of the few distinct values and a search, never a sort of pixels.
+    ``clearance`` is a float32 distance transform (>= 0). The compiled
+    :func:`~ursim_core.segmentation.maoris.kernels.flooding.clearance_levels` ranks its
+    values through their squares (integers) in two passes; when they are not square roots
+    of integers, the ranks come from :func:`numpy.unique` of the values and a search.
 
     Examples
     --------
     >>> import numpy as np
     >>> clearance_levels(np.array([[0, 2, 1, 2]], np.float32), np.array([[0, 1, 1, 1]], bool)).tolist()
-    [[2, 0, 1, 0]]
+    [[0, 0, 1, 0]]
     """
+    from ursim_core.segmentation.maoris.compiled import kernels
+
+    clearance = np.ascontiguousarray(clearance)
     if clearance.dtype != np.float32:
         raise SegmentationError(f"clearance must be float32, got {clearance.dtype}")
+    free = np.ascontiguousarray(free, dtype=bool)
+    levels = kernels().clearance_levels(clearance, free.view(np.uint8))
+    if levels.shape == clearance.shape:
+        return levels
     # Largest clearance first: the complement of the bits of a non-negative float32.
-    keys = np.uint32(0x7F800000) - np.ascontiguousarray(clearance).view(np.uint32)
-    return np.searchsorted(np.unique(keys[free]), keys).astype(np.uint32)
+    keys = np.uint32(0x7F800000) - clearance.view(np.uint32)
+    return np.where(free, np.searchsorted(np.unique(keys[free]), keys), 0).astype(np.uint32)
 
 
 def flood_levels(

@@ -106,6 +106,61 @@ def flood_levels(levels, labels, mask, connectivity):
     return 0
 
 
+@njit(cache=True)
+def clearance_levels(clearance, free):
+    """Levels of ``-clearance`` on ``free`` (0 = largest clearance), or a 0 x 0 array.
+
+    A Euclidean distance transform holds square roots of integers: each pixel's
+    ``k = round(c^2)`` indexes a table of its value. The levels are exact only if every
+    ``k`` has one value and values grow with ``k`` (both checked: else the 0 x 0 array,
+    and the caller ranks the values itself); then a level is the number of distinct
+    larger values, two passes instead of a sort or a search per pixel.
+    """
+    rows, cols = clearance.shape
+    top = 0.0
+    for row in range(rows):
+        for col in range(cols):
+            if free[row, col] and clearance[row, col] > top:
+                top = clearance[row, col]
+    failed = np.zeros((0, 0), np.uint32)
+    if not top * top < rows * cols + 2.0:  # also NaN; the table stays smaller than the image
+        return failed
+    size = np.int64(np.rint(np.float64(top) * np.float64(top))) + 1
+    values = np.empty(size, np.float32)
+    for k in range(size):
+        values[k] = -1.0
+    for row in range(rows):
+        for col in range(cols):
+            if free[row, col]:
+                value = clearance[row, col]
+                if not value >= 0.0:
+                    return failed
+                k = np.int64(np.rint(np.float64(value) * np.float64(value)))
+                if values[k] < 0.0:
+                    values[k] = value
+                elif values[k] != value:
+                    return failed
+    rank = np.zeros(size, np.uint32)
+    level = -1
+    previous = np.float32(np.inf)
+    for k in range(size - 1, -1, -1):
+        if values[k] < 0.0:
+            continue
+        if values[k] > previous:
+            return failed
+        if values[k] < previous:
+            level += 1
+            previous = values[k]
+        rank[k] = level
+    levels = np.zeros((rows, cols), np.uint32)
+    for row in range(rows):
+        for col in range(cols):
+            if free[row, col]:
+                value = np.float64(clearance[row, col])
+                levels[row, col] = rank[np.int64(np.rint(value * value))]
+    return levels
+
+
 @loop_helper
 def _bit_length(value):
     bits = 0

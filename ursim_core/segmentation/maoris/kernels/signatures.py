@@ -46,6 +46,7 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
     ("fusion", "merge_ripples"): (_I32, _FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
     ("fusion", "remove_doors"): (_FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
     ("flooding", "flood_levels"): (_U32_2D, _I32_2D, _U8_2D, _INT),
+    ("flooding", "clearance_levels"): (_F32_2D, _U8_2D),
 }
 
 _MODULES = {
