@@ -113,9 +113,13 @@ def flood_levels(
         raise ParameterError(f"must be 1 or 2, got {connectivity!r}", field="connectivity")
     mask = np.ascontiguousarray(mask, dtype=bool)
     labels = np.asarray(markers)
-    if labels.size and (labels.min() < np.iinfo(np.int32).min or labels.max() > np.iinfo(np.int32).max):
-        raise SegmentationError("marker labels must fit in int32")
-    labels = np.where(mask, labels, 0).astype(np.int32)
+    if labels.shape != mask.shape:
+        raise SegmentationError(f"markers must have the mask's shape {mask.shape}, got {labels.shape}")
+    # -2^31 marks the pixels outside the mask inside the kernel.
+    if labels.size and (labels.min() <= np.iinfo(np.int32).min or labels.max() > np.iinfo(np.int32).max):
+        raise SegmentationError("marker labels must lie in -2^31 + 1 .. 2^31 - 1")
+    labels = labels.astype(np.int32)  # a copy the kernel fills
+    labels[~mask] = 0
     status = kernels().flood_levels(
         np.ascontiguousarray(levels, np.uint32), labels, mask.view(np.uint8), int(connectivity)
     )

@@ -28,6 +28,7 @@ from numba import njit
 
 from ursim_core.segmentation.maoris.kernels.helpers import _prefetch, inner_kernel, loop_helper
 
+_OUTSIDE = np.int32(-(2**31))
 _ROW_STEPS = (-1, 0, 0, 1, -1, -1, 1, 1)
 _COL_STEPS = (0, -1, 1, 0, -1, 1, -1, 1)
 
@@ -38,8 +39,9 @@ def flood_levels(levels, labels, mask, connectivity):
 
     ``levels`` are the ranks of the image values (0 = lowest, popped first); the
     neighbours are those of ``skimage.morphology`` connectivity 1 (4) or 2 (8), in
-    its order (by distance, then raster offset). Markers outside the mask must be 0.
-    Returns 0, or -1 without flooding when ``level | age | pixel`` exceeds 64 bits.
+    its order (by distance, then raster offset). Markers outside the mask must be 0,
+    and no marker may be -2^31. Returns 0, or -1 without flooding when
+    ``level | age | pixel`` exceeds 64 bits.
     """
     rows, cols = levels.shape
     n = rows * cols
@@ -49,61 +51,168 @@ def flood_levels(levels, labels, mask, connectivity):
     top_level = 0
     markers = 0
     for i in range(n):
-        if flat_mask[i] and flat_levels[i] > top_level:
-            top_level = flat_levels[i]
-        if flat_labels[i] != 0:
-            markers += 1
+        if flat_mask[i]:
+            top_level = max(top_level, flat_levels[i])
+            markers += flat_labels[i] != 0
+        else:
+            flat_labels[i] = _OUTSIDE  # one array to test a neighbour: free and unlabelled is 0
     pixel_bits = _bit_length(n - 1)
     age_bits = _bit_length(n + 1)  # ages run from 2 to (pushes + 1) <= n + 1
     if pixel_bits + age_bits + _bit_length(top_level) > 64:
+        _restore_outside(flat_labels)
         return -1
-    age_shift = np.uint64(pixel_bits)
-    level_shift = np.uint64(pixel_bits + age_bits)
-    pixel_mask = (np.uint64(1) << age_shift) - np.uint64(1)
-    neighbours = 4 if connectivity == 1 else 8
-    row_steps = np.array(_ROW_STEPS, np.int64)
-    col_steps = np.array(_COL_STEPS, np.int64)
-    offsets = row_steps * cols + col_steps
-
-    capacity = max(markers, 1024)
-    heap = np.empty(capacity + 2, np.uint64)  # slots 1..items
+    shifts = (np.uint64(pixel_bits), np.uint64(pixel_bits + age_bits))
+    heap = np.empty(max(markers, 1024) + 2, np.uint64)  # slots 1..items
     items = 0
     for i in range(n):
-        if flat_labels[i] == 0:
+        if flat_labels[i] != 0 and flat_labels[i] != _OUTSIDE:
+            items += 1
+            _sift_up(heap, items, (np.uint64(flat_levels[i]) << shifts[1]) | np.uint64(i), shifts[0])
+    state = _heap_flood(
+        flat_levels,
+        flat_labels,
+        levels.shape,
+        connectivity,
+        heap,
+        items,
+        shifts,
+        _last_tie(flat_levels, flat_labels, top_level),
+    )
+    _bucket_flood(flat_levels, flat_labels, levels.shape, connectivity, state[0], state[1], state[2], shifts, top_level)
+    _restore_outside(flat_labels)
+    return 0
+
+
+@inner_kernel
+def _last_tie(flat_levels, flat_labels, top_level):
+    """The highest level whose markers carry two labels or more (-1 if none).
+
+    The heap's own order matters only there: markers of one level pop in one run, and
+    permuting a run of pops of one label permutes the ages of what they push among
+    themselves only, which changes no label (each later run of one label labels the
+    same pixels whatever its order). Past this level a FIFO per level pops alike.
+    """
+    first = np.empty(top_level + 1, np.int32)
+    for level in range(top_level + 1):
+        first[level] = 0
+    last = -1
+    for i in range(len(flat_labels)):
+        label = flat_labels[i]
+        if label == 0 or label == _OUTSIDE:
             continue
-        items += 1
-        _sift_up(heap, items, (np.uint64(flat_levels[i]) << level_shift) | np.uint64(i), age_shift)
+        level = np.int64(flat_levels[i])
+        if first[level] == 0:
+            first[level] = label
+        elif first[level] != label and level > last:
+            last = level
+    return last
+
+
+@inner_kernel
+def _heap_flood(flat_levels, flat_labels, shape, connectivity, heap, items, shifts, last_tie):
+    """scikit-image's pops while a level of tied markers of two labels remains."""
+    rows, cols = shape
+    age_shift, level_shift = shifts
+    pixel_mask = (np.uint64(1) << age_shift) - np.uint64(1)
+    steps = _steps(cols, connectivity)
     age = np.uint64(1)
     while items > 0:
         popped = heap[1]
+        level = popped >> level_shift
+        if np.int64(level) > last_tie:
+            break
         last = heap[items]
         items -= 1
         if items > 0:
             _sift_down(heap, items, last, age_shift)
         pixel = np.int64(popped & pixel_mask)
-        level = popped >> level_shift
         row = pixel // cols
         col = pixel - row * cols
         label = flat_labels[pixel]
-        for k in range(neighbours):
-            r = row + row_steps[k]
-            c = col + col_steps[k]
+        for k in range(len(steps)):
+            r = row + steps[k, 0]
+            c = col + steps[k, 1]
             if r < 0 or r >= rows or c < 0 or c >= cols:
                 continue
-            neighbour = pixel + offsets[k]
-            if not flat_mask[neighbour] or flat_labels[neighbour] != 0:
+            neighbour = pixel + steps[k, 2]
+            if flat_labels[neighbour] != 0:
                 continue
             age += np.uint64(1)
             # Labelled when pushed: no later pop can reach it at a lower cost.
             flat_labels[neighbour] = label
-            raised = np.uint64(flat_levels[neighbour])
-            if raised < level:
-                raised = level
+            raised = max(np.uint64(flat_levels[neighbour]), level)
             if items + 2 > len(heap):
                 heap = _grown(heap, items)
             items += 1
             _sift_up(heap, items, (raised << level_shift) | (age << age_shift) | np.uint64(neighbour), age_shift)
-    return 0
+    return heap, items, age
+
+
+@inner_kernel
+def _bucket_flood(flat_levels, flat_labels, shape, connectivity, heap, items, age, shifts, top_level):
+    """The rest of the pops, in (level, age) order: the heap's entries sorted, then per
+    level those entries before the pixels pushed since (they are younger)."""
+    rows, cols = shape
+    age_shift, level_shift = shifts
+    pixel_mask = (np.uint64(1) << age_shift) - np.uint64(1)
+    steps = _steps(cols, connectivity)
+    # Sorted with their pixel bits: equal markers (of one label, see _last_tie) in raster order.
+    waiting = np.sort(heap[1 : items + 1])
+    following = np.empty(len(flat_labels), np.int32)
+    head = np.empty(top_level + 1, np.int64)
+    tail = np.empty(top_level + 1, np.int64)
+    for level in range(top_level + 1):
+        head[level] = -1
+        tail[level] = -1
+    next_waiting = 0
+    for level in range(top_level + 1):
+        while True:
+            if next_waiting < len(waiting) and np.int64(waiting[next_waiting] >> level_shift) == level:
+                pixel = np.int64(waiting[next_waiting] & pixel_mask)
+                next_waiting += 1
+            elif head[level] >= 0:
+                pixel = head[level]
+                head[level] = following[pixel]
+            else:
+                break
+            row = pixel // cols
+            col = pixel - row * cols
+            label = flat_labels[pixel]
+            for k in range(len(steps)):
+                r = row + steps[k, 0]
+                c = col + steps[k, 1]
+                if r < 0 or r >= rows or c < 0 or c >= cols:
+                    continue
+                neighbour = pixel + steps[k, 2]
+                if flat_labels[neighbour] != 0:
+                    continue
+                flat_labels[neighbour] = label
+                raised = max(np.int64(flat_levels[neighbour]), level)
+                following[neighbour] = -1
+                if head[raised] < 0:
+                    head[raised] = neighbour
+                else:
+                    following[tail[raised]] = neighbour
+                tail[raised] = neighbour
+
+
+@inner_kernel
+def _steps(cols, connectivity):
+    """(row step, col step, flat step) of each neighbour, in scikit-image's order."""
+    count = 4 if connectivity == 1 else 8
+    steps = np.empty((count, 3), np.int64)
+    for k in range(count):
+        steps[k, 0] = _ROW_STEPS[k]
+        steps[k, 1] = _COL_STEPS[k]
+        steps[k, 2] = _ROW_STEPS[k] * cols + _COL_STEPS[k]
+    return steps
+
+
+@loop_helper
+def _restore_outside(flat_labels):
+    for i in range(len(flat_labels)):
+        if flat_labels[i] == _OUTSIDE:
+            flat_labels[i] = 0
 
 
 @njit(cache=True)
