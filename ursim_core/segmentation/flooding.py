@@ -97,8 +97,9 @@ def flood_levels(
 ) -> np.ndarray:
     """Flood ``markers`` over ``mask`` by ``levels`` (uint32 ranks, 0 first), as scikit-image.
 
-    ``fallback`` is the image scikit-image floods when the kernel's words are too small
-    (default: the levels themselves, the same order).
+    Levels are ranks (at most the pixel count); ``fallback`` is the image scikit-image
+    floods when they are not, or when the kernel's words are too small (default: the
+    levels themselves, the same order).
 
     Examples
     --------
@@ -112,17 +113,17 @@ def flood_levels(
     if isinstance(connectivity, bool) or connectivity not in (1, 2):
         raise ParameterError(f"must be 1 or 2, got {connectivity!r}", field="connectivity")
     mask = np.ascontiguousarray(mask, dtype=bool)
+    levels = np.ascontiguousarray(levels, np.uint32)
     labels = np.asarray(markers)
+    if levels.shape != mask.shape or levels.ndim != 2:
+        raise SegmentationError(f"levels and mask must be 2-D of one shape, got {levels.shape} and {mask.shape}")
     if labels.shape != mask.shape:
         raise SegmentationError(f"markers must have the mask's shape {mask.shape}, got {labels.shape}")
     # -2^31 marks the pixels outside the mask inside the kernel.
     if labels.size and (labels.min() <= np.iinfo(np.int32).min or labels.max() > np.iinfo(np.int32).max):
         raise SegmentationError("marker labels must lie in -2^31 + 1 .. 2^31 - 1")
-    labels = labels.astype(np.int32)  # a copy the kernel fills
-    labels[~mask] = 0
-    status = kernels().flood_levels(
-        np.ascontiguousarray(levels, np.uint32), labels, mask.view(np.uint8), int(connectivity)
-    )
+    labels = np.array(labels, dtype=np.int32, order="C")  # a copy the kernel fills (0 outside the mask)
+    status = kernels().flood_levels(levels, labels, mask.view(np.uint8), int(connectivity))
     if status != 0:
         from skimage.segmentation import watershed
 

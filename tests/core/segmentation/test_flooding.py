@@ -85,6 +85,16 @@ def test_clearance_levels_rank_the_values_largest_first():
         np.testing.assert_array_equal(clearance_levels(clearance, free), expected)
 
 
+def test_levels_beyond_the_kernels_words_are_flooded_by_scikit_image():
+    levels = np.array([[0, 10**6, 5, 10**6, 0], [7, 7, 7, 7, 7]], np.uint32)  # not ranks: the fallback
+    markers = np.asfortranarray(np.array([[1, 0, 0, 0, 2], [0, 0, 0, 0, 0]]))
+    mask = np.ones(levels.shape, bool)
+    expected = watershed(levels, markers, mask=mask)
+    np.testing.assert_array_equal(flood_levels(levels, markers, mask), expected)
+    ranks = np.searchsorted(np.unique(levels), levels).astype(np.uint32)
+    np.testing.assert_array_equal(flood_levels(ranks, markers, mask), expected)
+
+
 def test_bad_input_is_refused_with_a_typed_error():
     image, markers = np.zeros((3, 4)), np.zeros((3, 4), np.int32)
     with pytest.raises(ParameterError, match="connectivity"):

@@ -41,7 +41,7 @@ def flood_levels(levels, labels, mask, connectivity):
     neighbours are those of ``skimage.morphology`` connectivity 1 (4) or 2 (8), in
     its order (by distance, then raster offset). Markers outside the mask must be 0,
     and no marker may be -2^31. Returns 0, or -1 without flooding when
-    ``level | age | pixel`` exceeds 64 bits.
+    ``level | age | pixel`` exceeds 64 bits or a level the pixel count.
     """
     rows, cols = levels.shape
     n = rows * cols
@@ -58,7 +58,7 @@ def flood_levels(levels, labels, mask, connectivity):
             flat_labels[i] = _OUTSIDE  # one array to test a neighbour: free and unlabelled is 0
     pixel_bits = _bit_length(n - 1)
     age_bits = _bit_length(n + 1)  # ages run from 2 to (pushes + 1) <= n + 1
-    if pixel_bits + age_bits + _bit_length(top_level) > 64:
+    if pixel_bits + age_bits + _bit_length(top_level) > 64 or top_level > n:  # levels are ranks
         _restore_outside(flat_labels)
         return -1
     shifts = (np.uint64(pixel_bits), np.uint64(pixel_bits + age_bits))
