@@ -1,12 +1,15 @@
-"""Marker flooding with the labels of ``skimage.segmentation.watershed``, about twice as fast.
+"""Marker flooding with the labels of ``skimage.segmentation.watershed``, in less time.
 
 :func:`watershed_flood` gives exactly scikit-image's labels (2-D, no compactness, no
 watershed line) from the compiled kernel :func:`~ursim_core.segmentation.maoris.kernels.
 flooding.flood_levels`, which replays scikit-image's heap on one 64-bit word an entry
-(see there why it is a heap). :func:`clearance_levels` gives the kernel's levels of the
-clearance watershed (``-clearance``) without a sort of the pixels. When the words
-would not hold a pixel's level, age and index (images of about 2^21 px a side), scikit-image
-itself floods.
+while the heap's own order can still matter, then floods one FIFO per level (see there
+why both). :func:`clearance_levels` gives the kernel's levels of the clearance watershed
+(``-clearance``) without a sort of the pixels. At 4000 x 4000 px (the generated building
+of ``ursim bench segment``) the flood takes about 2.7 s of CPU where scikit-image's takes
+4.5 s plus 1 s of conversions and padding. When the levels are not ranks or the words
+would not hold a pixel's level, age and index (images of about 2^21 px a side),
+scikit-image itself floods.
 
 Examples
 --------

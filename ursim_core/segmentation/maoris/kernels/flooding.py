@@ -9,9 +9,12 @@ Ages are unique but for the markers, so only the order among markers of one valu
 on the heap's own arrangement: this heap makes the same comparisons and the same moves
 as scikit-image's (``heap_general.pxi``), hence pops equal markers in the same order.
 
-Why a heap and not a bucket queue per value (FIFO on ages): the pop order of equal
-markers depends on where the whole history left them in the heap, and it changes labels
-(two rooms of the same width meet in the door at the same time).
+Why a heap at all: the pop order of equal markers depends on where the whole history left
+them in the heap, and it changes labels (two rooms of the same width meet in the door at
+the same time; popping such markers in raster order moves 318 px of the 4000 px building).
+Why not a heap to the end: past the last level whose markers carry two labels, popping by
+(level, age) in any heap gives the same labels (:func:`_last_tie`), and a FIFO per level
+does it without sifting (the largest heaps come last, near the walls).
 
 Speed, for the same moves: an entry is one ``uint64``, ``level | age | pixel`` (the level
 is the rank of the value), compared without its pixel bits, so equal markers compare
@@ -39,7 +42,7 @@ def flood_levels(levels, labels, mask, connectivity):
 
     ``levels`` are the ranks of the image values (0 = lowest, popped first); the
     neighbours are those of ``skimage.morphology`` connectivity 1 (4) or 2 (8), in
-    its order (by distance, then raster offset). Markers outside the mask must be 0,
+    its order (by distance, then raster offset). Markers outside the mask are dropped,
     and no marker may be -2^31. Returns 0, or -1 without flooding when
     ``level | age | pixel`` exceeds 64 bits or a level the pixel count.
     """
