@@ -5,7 +5,8 @@ narrow pass between two basins. :func:`watershed_labels`:
 
 1. clearance ``d`` = Euclidean distance transform of the free space;
 2. markers = the connected plateaus of local maxima of ``d`` (3x3), and a watershed of
-   ``-d`` over the free pixels (scikit-image) gives one basin per marker;
+   ``-d`` over the free pixels gives one basin per marker: scikit-image's labels, from
+   :mod:`ursim_core.segmentation.flooding` (its heap replayed in a compiled kernel);
 3. two touching basins a, b merge when their *saddle ratio* ``s(a, b) / min(peak(a),
    peak(b))`` is at least ``door_ratio``, highest ratio first: ``s`` is the largest
    clearance on their shared boundary (the widest point of the pass), ``peak`` a basin's
@@ -149,8 +150,17 @@ def _merge_small(labels: np.ndarray, clearance: np.ndarray, min_size: int) -> np
     sizes = np.bincount(labels.ravel(), minlength=count).astype(np.int64)
     if min_size <= 0 or not (sizes[1:] < min_size).any():
         return labels
+    lengths = {pair: length for pair, (_, length) in _boundaries(labels, clearance, count).items()}
+    return _roots(_small_merge_parents(sizes, lengths, min_size))[labels]
+
+
+def _small_merge_parents(sizes: np.ndarray, lengths: dict, min_size: int) -> np.ndarray:
+    """The parent of each region after :func:`_merge_small`'s joins (0 = dropped), from the
+    region sizes and the boundary length of each touching pair ``(a, b)``, a < b."""
+    count = len(sizes)
+    sizes = sizes.copy()
     contacts: dict[int, dict[int, int]] = {}
-    for (a, b), (_, length) in _boundaries(labels, clearance, count).items():
+    for (a, b), length in lengths.items():
         contacts.setdefault(a, {})[b] = length
         contacts.setdefault(b, {})[a] = length
     parent = np.arange(count)
@@ -173,7 +183,7 @@ def _merge_small(labels: np.ndarray, clearance: np.ndarray, min_size: int) -> np
                 contacts[into][other] = contacts[other][into] = contacts[into].get(other, 0) + length
         if sizes[into] < min_size:
             heapq.heappush(heap, (int(sizes[into]), into))
-    return _roots(parent)[labels]
+    return parent
 
 
 def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
@@ -196,7 +206,8 @@ def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     """
     import cv2
     from scipy import ndimage
-    from skimage.segmentation import watershed
+
+    from ursim_core.segmentation.flooding import clearance_levels, flood_levels
 
     options = resolve_watershed_params(params)
     free = np.asarray(free)
@@ -205,38 +216,72 @@ def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     free = free.astype(bool, copy=False)
     if not free.any():
         return np.zeros(free.shape, np.int32)
-    clearance = cv2.distanceTransform(np.pad(free, 1).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
-    peaks = free & (clearance >= ndimage.maximum_filter(clearance, size=3))
+    # Contiguous: every step below reads it whole (a strided view is copied each time).
+    clearance = np.ascontiguousarray(
+        cv2.distanceTransform(np.pad(free, 1).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+    )
+    # The 3x3 maximum; cv2 ignores the pixels beyond the border as ndimage's "reflect"
+    # does for a 3x3 window (it reflects the border pixel itself), 7 times faster.
+    peaks = free & (clearance >= cv2.dilate(clearance, np.ones((3, 3), np.uint8)))
     markers, _ = ndimage.label(peaks, structure=np.ones((3, 3), bool))
-    basins = watershed(-clearance, markers, mask=free).astype(np.int32)
+    basins = flood_levels(clearance_levels(clearance, free), markers, free, fallback=-clearance)
     count = int(basins.max()) + 1
     # Each basin's largest clearance. ndimage.maximum sorts every pixel by label (2.4 s at
-    # 4000 px); an unbuffered maximum gives the same values in 0.15 s.
-    peak_of = np.zeros(count, np.float64)
-    np.maximum.at(peak_of, basins.ravel(), clearance.ravel().astype(np.float64))
+    # 4000 px); an unbuffered maximum gives the same values in 0.15 s, in float32 (the
+    # maximum of the float64 copies is the float64 copy of the maximum).
+    peak_of = np.zeros(count, np.float32)
+    np.maximum.at(peak_of, basins.ravel(), clearance.ravel())
+    peak_of = peak_of.astype(np.float64)
     peak_of[0] = 0.0
     parent = np.arange(count)
-    _merge_doorless(peak_of, _boundaries(basins, clearance, count), options["door_ratio"], parent)
-    merged = _roots(parent)[basins]
-    merged = _merge_small(merged, clearance, options["min_size"])
-    return _in_raster_order(merged)
+    boundaries = _boundaries(basins, clearance, count)
+    _merge_doorless(peak_of, boundaries, options["door_ratio"], parent)
+    doorless = _roots(parent)
+    # Step 4 on the basin tables rather than on a merged image (the same sizes and
+    # boundary lengths, summed per merged region), and one lookup of the basins at the
+    # end: each relabelling of the image costs a pass over every pixel.
+    merged_sizes = np.bincount(
+        doorless, weights=np.bincount(basins.ravel(), minlength=count), minlength=int(doorless.max()) + 1
+    ).astype(np.int64)
+    lengths: dict[tuple[int, int], int] = {}
+    for (a, b), (_, length) in boundaries.items():
+        a, b = int(doorless[a]), int(doorless[b])
+        if a != b:
+            pair = (a, b) if a < b else (b, a)
+            lengths[pair] = lengths.get(pair, 0) + length
+    final = doorless
+    if options["min_size"] > 0:
+        final = _roots(_small_merge_parents(merged_sizes, lengths, options["min_size"]))[doorless]
+    return _raster_lookup(basins, final)[basins]
+
+
+def _first_pixels(labels: np.ndarray, count: int) -> np.ndarray:
+    """Flat index of each label's first pixel in raster order (``labels.size`` if absent),
+    from the runs of equal labels along rows rather than every pixel."""
+    starts = np.ones(labels.shape, bool)
+    starts[:, 1:] = labels[:, 1:] != labels[:, :-1]
+    flat_starts = np.flatnonzero(starts)
+    first = np.full(count, labels.size, np.int64)
+    np.minimum.at(first, labels.ravel()[flat_starts], flat_starts)
+    return first
+
+
+def _raster_lookup(basins: np.ndarray, final: np.ndarray) -> np.ndarray:
+    """``lookup[basin]`` = the label of ``_in_raster_order(final[basins])``: a region's
+    first pixel is the first of its basins' first pixels."""
+    first = np.full(int(final.max()) + 1, basins.size, np.int64)
+    np.minimum.at(first, final, _first_pixels(basins, len(final)))
+    present = np.flatnonzero(first[1:] < basins.size) + 1
+    rank = np.zeros(len(first), np.int32)
+    rank[present[np.argsort(first[present], kind="stable")]] = np.arange(1, len(present) + 1, dtype=np.int32)
+    return rank[final]
 
 
 def _in_raster_order(labels: np.ndarray) -> np.ndarray:
     """Labels renumbered 1..N by the raster order of their first pixel (0 stays 0); as
     :func:`~ursim_core.segmentation.scoring.relabel_in_raster_order`, on the runs of
     equal labels along rows instead of a sort of every pixel."""
-    count = int(labels.max()) + 1
-    starts = np.ones(labels.shape, bool)
-    starts[:, 1:] = labels[:, 1:] != labels[:, :-1]
-    flat_starts = np.flatnonzero(starts)
-    run_labels = labels.ravel()[flat_starts]
-    first = np.full(count, labels.size, np.int64)
-    np.minimum.at(first, run_labels, flat_starts)
-    present = np.flatnonzero(first[1:] < labels.size) + 1
-    lookup = np.zeros(count, np.int32)
-    lookup[present[np.argsort(first[present], kind="stable")]] = np.arange(1, len(present) + 1, dtype=np.int32)
-    return lookup[labels]
+    return _raster_lookup(labels, np.arange(int(labels.max()) + 1))[labels]
 
 
 def merge_small_regions(labels: np.ndarray, clearance: np.ndarray, min_size: int) -> np.ndarray:

@@ -64,8 +64,10 @@ def jit_kernels(monkeypatch):
 
 
 def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit_kernels):
+    from ursim_core.segmentation.flooding import watershed_flood
     from ursim_core.segmentation.maoris import ZoneGraph, contact_tracking, flat_zones, maoris_labels, quantize
     from ursim_core.segmentation.maoris.kernels import signatures
+    from ursim_core.segmentation.watershed import watershed_labels
     from ursim_core.synth import make_large_building
 
     assert jit_kernels.source == "jit"
@@ -76,6 +78,8 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
     values = quantize(np.where(free, 100, 0).astype(np.uint8))
     ZoneGraph(flat_zones(values), values).contact_percent(1, 2)  # contact_table
     flat_zones(np.array([[5, 5, 0], [0, 5, 7]]))  # another dtype goes through the one signature too
+    watershed_labels(free)  # the flooding kernels of the watershed segmenter
+    watershed_flood(np.arange(6.0).reshape(2, 3), np.array([[1, 0, 0], [0, 0, 2]]), connectivity=2)
     for key, types in signatures.SIGNATURES.items():
         compiled = signatures.kernel(key).signatures
         assert compiled == [types], (key, compiled)

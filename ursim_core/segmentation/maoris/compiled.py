@@ -59,6 +59,7 @@ ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
     "adjacency": ("build_adjacency", "adjacency_entries", "_link_entries", "remove_small_zones"),
     "contacts": ("_compact_labels", "count_contacts", "join_counts", "contact_table"),
     "fusion": ("merge_ripples", "remove_doors"),
+    "flooding": ("flood_levels", "clearance_levels"),
 }
 
 MODULE_NAME = "_maoris_kernels"

@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from numba import types
 
-from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, flat_zones, fusion
+from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, flat_zones, flooding, fusion
 
 __all__ = ["SIGNATURES", "GROUPS", "compile_group"]
 
 _I32, _I64, _BOOL = types.int32[::1], types.int64[::1], types.bool_[::1]
 _I32_2D, _I64_2D = types.int32[:, ::1], types.int64[:, ::1]
-_F32_2D, _U8_2D = types.float32[:, ::1], types.uint8[:, ::1]
+_F32_2D, _U8_2D, _U32_2D = types.float32[:, ::1], types.uint8[:, ::1], types.uint32[:, ::1]
 _INT, _FLOAT = types.int64, types.float64
 # The compact zone graph (records, nodes); the contact counts of count_contacts; the
 # tracking state of start_tracking (original, compact_of, (parent, pixels, ...)).
@@ -45,6 +45,8 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
     ("contacts", "contact_table"): (_I32, _INT, _BOOL),
     ("fusion", "merge_ripples"): (_I32, _FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
     ("fusion", "remove_doors"): (_FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
+    ("flooding", "flood_levels"): (_U32_2D, _I32_2D, _U8_2D, _INT),
+    ("flooding", "clearance_levels"): (_F32_2D, _U8_2D),
 }
 
 _MODULES = {
@@ -53,6 +55,7 @@ _MODULES = {
     "adjacency": adjacency,
     "contacts": contacts,
     "fusion": fusion,
+    "flooding": flooding,
 }
 
 #: Kernel groups of about equal compilation time (measured), one process each.
