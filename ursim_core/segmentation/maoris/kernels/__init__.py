@@ -8,6 +8,8 @@
 * :mod:`.contact_table`: the contact counts' storage (per-zone slots and a shared hash table);
 * :mod:`.contacts`: counting contacts of a label image (in bands of rows on threads);
 * :mod:`.fusion`: ripple merging and door removal, which track contacts across fusions (steps 4, 6);
+* :mod:`.flooding`: the watershed's priority flood and clearance levels, for
+  :mod:`ursim_core.segmentation.flooding` (they live here to be built ahead of time with the rest);
 * :mod:`.signatures`: the one signature of each kernel called from Python, and compiling them.
 
 The Python side, :class:`ursim_core.segmentation.maoris.zone_graph.ZoneGraph`, owns the arrays;
