@@ -134,3 +134,20 @@ def test_convert_exports_by_name_and_by_format(tmp_path, capsys):
     assert main(["convert", str(source), str(tmp_path / "plain.txt"), "--format", "geojson"]) == 0
     assert "(geojson)" in capsys.readouterr().out
     assert main(["convert", str(source), str(tmp_path / "again.dat")]) == 0  # the two formats still convert
+
+
+def test_segment_picks_the_watershed_for_a_ros_map_unless_told(tmp_path, capsys):
+    source = two_rooms(tmp_path / "rooms.png")
+    (tmp_path / "rooms.yaml").write_text(
+        "image: rooms.png\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    cases = [([str(tmp_path / "rooms.yaml")], ("watershed", "robot")), ([str(source)], ("maoris", "sketch"))]
+    cases.append(([str(tmp_path / "rooms.yaml"), "--method", "maoris"], ("maoris", "sketch")))
+    cases.append(([str(tmp_path / "rooms.yaml"), "--preset", "robot"], ("maoris", "robot")))
+    cases.append(([str(source), "--method", "watershed"], ("watershed", "robot")))
+    for index, (args, (method, preset)) in enumerate(cases):
+        out = tmp_path / f"out{index}"
+        assert main(["segment", *args, "-o", str(out)]) == 0
+        document = json.loads(next(out.glob("*.regions.json")).read_text())
+        assert (document["segmentation"]["method"], document["segmentation"]["preset"]) == (method, preset), args
+    assert "ROS occupancy map" in capsys.readouterr().err
