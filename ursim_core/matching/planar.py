@@ -52,7 +52,13 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from ursim_core.matching.edit_distance import aligned_index_pairs, aligned_pairs, cyclic_align
+from ursim_core.matching.edit_distance import (
+    COMPILED_CELLS,
+    PackedOrders,
+    aligned_index_pairs,
+    aligned_pairs,
+    cyclic_align,
+)
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -206,8 +212,19 @@ def _arc(order: list[int], start: int, stop: int) -> list[int]:
     return elements
 
 
-def _expand_locked(first_order, second_order, matched, second_set, same, cache):
-    """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs."""
+#: Pairs of neighbour orders of at least this many cells (``len(first) * len(second)``) have their
+#: "same" cells packed once (:class:`~ursim_core.matching.edit_distance.PackedOrders`) and their long
+#: arcs aligned 64 rows per word: a building's corridor borders thousands of rooms, and its arcs
+#: are aligned again for every hypothesis. Smaller orders align their arcs as lists (same pairs).
+PACKED_CELLS = 1 << 16
+
+
+def _expand_locked(first_order, second_order, matched, second_set, same, cache, packed=None, key=None):
+    """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs.
+
+    ``packed``: a dict of :class:`PackedOrders` by ``key`` (the orders' identity), used when the
+    orders are :data:`PACKED_CELLS` cells or more and ``same`` is an array.
+    """
     locks = []  # (position in first_order, position in second_order), in first_order order
     for k, vertex in enumerate(first_order):
         partner = matched.get(vertex)
@@ -217,6 +234,9 @@ def _expand_locked(first_order, second_order, matched, second_set, same, cache):
         return []
     positions_second = {vertex: k for k, vertex in enumerate(second_order)}
     locks = [(k, positions_second[partner]) for k, partner in locks]
+    size_first, size_second = len(first_order), len(second_order)
+    if packed is not None and isinstance(same, np.ndarray) and size_first * size_second >= PACKED_CELLS:
+        return _expand_packed(first_order, second_order, locks, same, cache, packed, key)
     candidates = []
     for index, (first_position, second_position) in enumerate(locks):
         next_first, next_second = locks[(index + 1) % len(locks)]
@@ -224,11 +244,42 @@ def _expand_locked(first_order, second_order, matched, second_set, same, cache):
         second_arc = _arc(second_order, second_position, next_second)
         if first_arc and second_arc:
             # Expansions from different seeds meet the same arcs again: align each pair of arcs once.
-            key = (tuple(first_arc), tuple(second_arc))
-            aligned = cache.get(key)
+            arc_key = (tuple(first_arc), tuple(second_arc))
+            aligned = cache.get(arc_key)
             if aligned is None:
-                aligned = cache[key] = aligned_index_pairs(first_arc, second_arc, same)
+                aligned = cache[arc_key] = aligned_index_pairs(first_arc, second_arc, same)
             candidates.extend(aligned)
+    return candidates
+
+
+def _expand_packed(first_order, second_order, locks, same, cache, packed, key):
+    """:func:`_expand_locked` for long orders: arcs as cyclic ranges of positions (same pairs)."""
+    size_first, size_second = len(first_order), len(second_order)
+    candidates = []
+    for index, (first_position, second_position) in enumerate(locks):
+        next_first, next_second = locks[(index + 1) % len(locks)]
+        # Elements strictly between two locks, walking forward (all the others for one lock).
+        rows = (next_first - first_position - 1) % size_first
+        cols = (next_second - second_position - 1) % size_second
+        if not rows or not cols:
+            continue
+        # Positions in the same two orders give the same arcs: one key per pair of ranges.
+        arc_key = (key, first_position, next_first, second_position, next_second)
+        aligned = cache.get(arc_key)
+        if aligned is None:
+            if rows * cols < COMPILED_CELLS:
+                first_arc = _arc(first_order, first_position, next_first)
+                second_arc = _arc(second_order, second_position, next_second)
+                aligned = aligned_index_pairs(first_arc, second_arc, same)
+            else:
+                orders = packed.get(key)
+                if orders is None:
+                    orders = packed[key] = PackedOrders(first_order, second_order, same)
+                aligned = orders.aligned(
+                    (first_position + 1) % size_first, rows, (second_position + 1) % size_second, cols
+                )
+            cache[arc_key] = aligned
+        candidates.extend(aligned)
     return candidates
 
 
@@ -322,6 +373,7 @@ def planar_match(
     second_sets = [set(order) for order in second.neighbours]
     reversed_first = [order[::-1] for order in first.neighbours]
     arc_cache: dict = {}
+    packed: dict = {}
     alternatives: list = []
     for seed in seeds:
         if seed in consumed:
@@ -352,7 +404,14 @@ def planar_match(
             pairs.append((vertex, partner))
             matched[vertex] = partner
             for a, b in _expand_locked(
-                first_orders[vertex], second.neighbours[partner], matched, second_sets[partner], same, arc_cache
+                first_orders[vertex],
+                second.neighbours[partner],
+                matched,
+                second_sets[partner],
+                same,
+                arc_cache,
+                packed,
+                (vertex, partner, alignment.reflected),
             ):
                 if a not in seen_first and b not in seen_second:
                     queue.append((a, b))
