@@ -202,14 +202,15 @@ def _arc(order: list[int], start: int, stop: int) -> list[int]:
     """Elements strictly between positions ``start`` and ``stop`` walking forward (cyclic).
 
     ``start == stop`` gives every other element, starting after ``start``.
+
+    Examples
+    --------
+    >>> _arc([5, 6, 7, 8], 1, 3), _arc([5, 6, 7, 8], 2, 1), _arc([5, 6, 7, 8], 2, 2)
+    ([7], [8, 5], [8, 5, 6])
     """
-    size = len(order)
-    elements = []
-    position = (start + 1) % size
-    while position != stop:
-        elements.append(order[position])
-        position = (position + 1) % size
-    return elements
+    if start < stop:
+        return order[start + 1 : stop]
+    return order[start + 1 :] + order[:stop]
 
 
 #: Pairs of neighbour orders of at least this many cells (``len(first) * len(second)``) have their
@@ -219,21 +220,22 @@ def _arc(order: list[int], start: int, stop: int) -> list[int]:
 PACKED_CELLS = 1 << 16
 
 
-def _expand_locked(first_order, second_order, matched, second_set, same, cache, packed=None, key=None):
+def _expand_locked(first_order, second_order, matched, second_positions, same, cache, packed=None, key=None):
     """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs.
 
-    ``packed``: a dict of :class:`PackedOrders` by ``key`` (the orders' identity), used when the
-    orders are :data:`PACKED_CELLS` cells or more and ``same`` is an array.
+    ``second_positions``: the position of every element of ``second_order``. ``packed``: a dict
+    of :class:`PackedOrders` by ``key`` (the orders' identity), used when the orders are
+    :data:`PACKED_CELLS` cells or more and ``same`` is an array.
     """
     locks = []  # (position in first_order, position in second_order), in first_order order
     for k, vertex in enumerate(first_order):
         partner = matched.get(vertex)
-        if partner is not None and partner in second_set:
-            locks.append((k, partner))
+        if partner is not None:
+            position = second_positions.get(partner)
+            if position is not None:
+                locks.append((k, position))
     if not locks:
         return []
-    positions_second = {vertex: k for k, vertex in enumerate(second_order)}
-    locks = [(k, positions_second[partner]) for k, partner in locks]
     size_first, size_second = len(first_order), len(second_order)
     if packed is not None and isinstance(same, np.ndarray) and size_first * size_second >= PACKED_CELLS:
         return _expand_packed(first_order, second_order, locks, same, cache, packed, key)
@@ -371,6 +373,7 @@ def planar_match(
     seeds_expanded = 0
     first_sets = [set(order) for order in first.neighbours]
     second_sets = [set(order) for order in second.neighbours]
+    second_positions = [{vertex: k for k, vertex in enumerate(order)} for order in second.neighbours]
     reversed_first = [order[::-1] for order in first.neighbours]
     arc_cache: dict = {}
     packed: dict = {}
@@ -403,11 +406,14 @@ def planar_match(
             vertex, partner = queue.popleft()
             pairs.append((vertex, partner))
             matched[vertex] = partner
+            first_order, second_order = first_orders[vertex], second.neighbours[partner]
+            if len(first_order) <= 1 or len(second_order) <= 1:
+                continue  # one neighbour on either side: every arc between locks is empty
             for a, b in _expand_locked(
-                first_orders[vertex],
-                second.neighbours[partner],
+                first_order,
+                second_order,
                 matched,
-                second_sets[partner],
+                second_positions[partner],
                 same,
                 arc_cache,
                 packed,
