@@ -108,7 +108,7 @@ def run_bench(
 
         print("== segmentation scale (generated buildings; targets at 8000 px: 5 s, 1.5 GB)")
         print_table(bench_scale(sizes or SCALE_SIZES))
-        print("== whole-process `ursim match` of each building against itself (targets at 8000 px: 30 s, 3 GB)")
+        print("== whole-process `ursim match` of two different buildings of each size (targets at 8000 px: 30 s, 3 GB)")
         print_table(bench_match_process(sizes or SCALE_SIZES))
         print("time_ratio: wall time over the previous size's (each step is 4x the pixels; target <= 4.5)")
     if what in ("match", "all"):

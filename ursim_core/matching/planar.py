@@ -52,7 +52,13 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from ursim_core.matching.edit_distance import aligned_index_pairs, aligned_pairs, cyclic_align
+from ursim_core.matching.edit_distance import (
+    COMPILED_CELLS,
+    PackedOrders,
+    aligned_index_pairs,
+    aligned_pairs,
+    cyclic_align,
+)
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -196,27 +202,43 @@ def _arc(order: list[int], start: int, stop: int) -> list[int]:
     """Elements strictly between positions ``start`` and ``stop`` walking forward (cyclic).
 
     ``start == stop`` gives every other element, starting after ``start``.
+
+    Examples
+    --------
+    >>> _arc([5, 6, 7, 8], 1, 3), _arc([5, 6, 7, 8], 2, 1), _arc([5, 6, 7, 8], 2, 2)
+    ([7], [8, 5], [8, 5, 6])
     """
-    size = len(order)
-    elements = []
-    position = (start + 1) % size
-    while position != stop:
-        elements.append(order[position])
-        position = (position + 1) % size
-    return elements
+    if start < stop:
+        return order[start + 1 : stop]
+    return order[start + 1 :] + order[:stop]
 
 
-def _expand_locked(first_order, second_order, matched, second_set, same, cache):
-    """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs."""
+#: Pairs of neighbour orders of at least this many cells (``len(first) * len(second)``) have their
+#: "same" cells packed once (:class:`~ursim_core.matching.edit_distance.PackedOrders`) and their long
+#: arcs aligned 64 rows per word: a building's corridor borders thousands of rooms, and its arcs
+#: are aligned again for every hypothesis. Smaller orders align their arcs as lists (same pairs).
+PACKED_CELLS = 1 << 16
+
+
+def _expand_locked(first_order, second_order, matched, second_positions, same, cache, packed=None, key=None):
+    """makeMatching: align the arcs between locked neighbour pairs; return candidate pairs.
+
+    ``second_positions``: the position of every element of ``second_order``. ``packed``: a dict
+    of :class:`PackedOrders` by ``key`` (the orders' identity), used when the orders are
+    :data:`PACKED_CELLS` cells or more and ``same`` is an array.
+    """
     locks = []  # (position in first_order, position in second_order), in first_order order
     for k, vertex in enumerate(first_order):
         partner = matched.get(vertex)
-        if partner is not None and partner in second_set:
-            locks.append((k, partner))
+        if partner is not None:
+            position = second_positions.get(partner)
+            if position is not None:
+                locks.append((k, position))
     if not locks:
         return []
-    positions_second = {vertex: k for k, vertex in enumerate(second_order)}
-    locks = [(k, positions_second[partner]) for k, partner in locks]
+    size_first, size_second = len(first_order), len(second_order)
+    if packed is not None and isinstance(same, np.ndarray) and size_first * size_second >= PACKED_CELLS:
+        return _expand_packed(first_order, second_order, locks, same, cache, packed, key)
     candidates = []
     for index, (first_position, second_position) in enumerate(locks):
         next_first, next_second = locks[(index + 1) % len(locks)]
@@ -224,12 +246,62 @@ def _expand_locked(first_order, second_order, matched, second_set, same, cache):
         second_arc = _arc(second_order, second_position, next_second)
         if first_arc and second_arc:
             # Expansions from different seeds meet the same arcs again: align each pair of arcs once.
-            key = (tuple(first_arc), tuple(second_arc))
-            aligned = cache.get(key)
+            arc_key = (tuple(first_arc), tuple(second_arc))
+            aligned = cache.get(arc_key)
             if aligned is None:
-                aligned = cache[key] = aligned_index_pairs(first_arc, second_arc, same)
+                aligned = cache[arc_key] = aligned_index_pairs(first_arc, second_arc, same)
             candidates.extend(aligned)
     return candidates
+
+
+def _expand_packed(first_order, second_order, locks, same, cache, packed, key):
+    """:func:`_expand_locked` for long orders: arcs as cyclic ranges of positions (same pairs)."""
+    size_first, size_second = len(first_order), len(second_order)
+    candidates = []
+    for index, (first_position, second_position) in enumerate(locks):
+        next_first, next_second = locks[(index + 1) % len(locks)]
+        # Elements strictly between two locks, walking forward (all the others for one lock).
+        rows = (next_first - first_position - 1) % size_first
+        cols = (next_second - second_position - 1) % size_second
+        if not rows or not cols:
+            continue
+        # Positions in the same two orders give the same arcs: one key per pair of ranges.
+        arc_key = (key, first_position, next_first, second_position, next_second)
+        aligned = cache.get(arc_key)
+        if aligned is None:
+            if rows * cols < COMPILED_CELLS:
+                first_arc = _arc(first_order, first_position, next_first)
+                second_arc = _arc(second_order, second_position, next_second)
+                aligned = aligned_index_pairs(first_arc, second_arc, same)
+            else:
+                orders = packed.get(key)
+                if orders is None:
+                    orders = packed[key] = PackedOrders(first_order, second_order, same)
+                aligned = orders.aligned(
+                    (first_position + 1) % size_first, rows, (second_position + 1) % size_second, cols
+                )
+            cache[arc_key] = aligned
+        candidates.extend(aligned)
+    return candidates
+
+
+def _adjacency_ends(neighbour_sets) -> tuple[np.ndarray, np.ndarray]:
+    """Both ends of every (vertex, neighbour) entry of the neighbour sets, as two index arrays."""
+    sources = [vertex for vertex, neighbours in enumerate(neighbour_sets) for _ in neighbours]
+    targets = [neighbour for neighbours in neighbour_sets for neighbour in neighbours]
+    return np.asarray(sources, dtype=np.intp), np.asarray(targets, dtype=np.intp)
+
+
+def _inner_edges(ends, n_vertices: int, vertices) -> int:
+    """Edges between two of ``vertices``: entries with both ends in them, each edge seen twice.
+
+    The count of ``sum(1 for v in vertices for n in neighbours[v] if n in vertices) // 2`` with
+    one pass of NumPy over the entries instead of Python over thousands of matched regions.
+    """
+    inside = np.zeros(n_vertices, dtype=np.bool_)
+    inside[np.fromiter(vertices, dtype=np.intp)] = True
+    sources, targets = ends
+    return int(np.count_nonzero(inside[sources] & inside[targets])) // 2
 
 
 def planar_match(
@@ -320,8 +392,11 @@ def planar_match(
     seeds_expanded = 0
     first_sets = [set(order) for order in first.neighbours]
     second_sets = [set(order) for order in second.neighbours]
+    second_positions = [{vertex: k for k, vertex in enumerate(order)} for order in second.neighbours]
+    first_ends, second_ends = _adjacency_ends(first_sets), _adjacency_ends(second_sets)
     reversed_first = [order[::-1] for order in first.neighbours]
     arc_cache: dict = {}
+    packed: dict = {}
     alternatives: list = []
     for seed in seeds:
         if seed in consumed:
@@ -351,8 +426,18 @@ def planar_match(
             vertex, partner = queue.popleft()
             pairs.append((vertex, partner))
             matched[vertex] = partner
+            first_order, second_order = first_orders[vertex], second.neighbours[partner]
+            if len(first_order) <= 1 or len(second_order) <= 1:
+                continue  # one neighbour on either side: every arc between locks is empty
             for a, b in _expand_locked(
-                first_orders[vertex], second.neighbours[partner], matched, second_sets[partner], same, arc_cache
+                first_order,
+                second_order,
+                matched,
+                second_positions[partner],
+                same,
+                arc_cache,
+                packed,
+                (vertex, partner, alignment.reflected),
             ):
                 if a not in seen_first and b not in seen_second:
                     queue.append((a, b))
@@ -360,9 +445,8 @@ def planar_match(
                     seen_second.add(b)
                     consumed.add((a, b))
         hypotheses += 1
-        inner_first = sum(1 for v in matched for n in first_sets[v] if n in matched) // 2
-        matched_second = set(matched.values())
-        inner_second = sum(1 for v in matched_second for n in second_sets[v] if n in matched_second) // 2
+        inner_first = _inner_edges(first_ends, n_first, matched.keys())
+        inner_second = _inner_edges(second_ends, n_second, matched.values())
         structure = (
             (n_first - len(pairs))
             + (n_second - len(pairs))
