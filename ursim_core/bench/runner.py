@@ -48,6 +48,11 @@ def run_bench(
             print(f"startup: KTH cases skipped ({MISSING_REASON})")
         print("== whole-process start-up (issue 10 item 4 targets)")
         print_startup(bench_startup(kth, repeats=repeats))
+        if kth is not None:
+            from ursim_core.bench.startup import bench_segment_processes, print_segment_processes
+
+            print("== whole `ursim segment --preset default` process on every KTH map, against the C++ MAORIS")
+            print_segment_processes(bench_segment_processes(kth, repeats=max(1, repeats // 2)))
         return 0
     if what == "quality":
         import sys

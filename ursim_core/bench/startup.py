@@ -108,3 +108,42 @@ def print_startup(rows: list[dict]) -> None:
                 verdict += f" ({_TARGET_NOTES[row['case']]})"
         print(f"{row['case']:<32} {row['median_s']:>9.3f} {row['min_s']:>7.3f} {target_text:>9}  {verdict}")
     print(f"(median of {rows[0]['n'] if rows else 0} fresh processes after one warm-up run)")
+
+
+#: The released C++ MAORIS on the KTH maps with its library defaults (t 0.25, doors 40), wall
+#: seconds per map as measured in ../shared/design/released_code_results.md ("MAORIS region counts
+#: and times per map", column default_t025). The C++ figures are the segmentation alone, so a
+#: whole ``ursim segment`` process that beats them beats the C++ process by more.
+RELEASED_MAORIS_S = {
+    "00": 1.42, "01": 1.46, "03": 0.38, "04": 1.11, "06": 0.53, "07": 0.56, "08": 0.66, "10": 0.67,
+    "11": 0.26, "12": 6.29, "14": 0.34, "15": 0.79, "17": 1.66, "18": 13.54, "20": 8.71, "21": 7.56,
+    "23": 5.76, "24": 30.10, "model_simple": 0.71,
+}  # fmt: skip
+
+
+def bench_segment_processes(kth: Path, *, repeats: int = 3) -> list[dict]:
+    """Whole ``ursim segment --preset default`` processes on every KTH map beside the C++ figure."""
+    ursim = _ursim_command()
+    out = Path(tempfile.mkdtemp(prefix="ursim-bench-maps-"))
+    try:
+        paths = sorted((kth / "sketches").glob("*.png")) + [kth / "model" / "model_simple.png"]
+        rows = []
+        for path in paths:
+            if path.stem not in RELEASED_MAORIS_S:
+                continue
+            command = [*ursim, "segment", str(path), "--preset", "default", "-o", str(out / path.stem)]
+            times = _time(command, repeats)
+            rows.append({"map": path.stem, "median_s": statistics.median(times), "cpp_s": RELEASED_MAORIS_S[path.stem]})
+        return rows
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
+def print_segment_processes(rows: list[dict]) -> None:
+    print(f"{'map':<14} {'ursim segment s':>15} {'C++ MAORIS s':>13}  ratio")
+    for row in rows:
+        print(f"{row['map']:<14} {row['median_s']:>15.3f} {row['cpp_s']:>13.2f}  {row['cpp_s'] / row['median_s']:.1f}x")
+    slowest = min(rows, key=lambda row: row["cpp_s"] / row["median_s"]) if rows else None
+    if slowest is not None:
+        verdict = "faster on every map" if all(r["median_s"] < r["cpp_s"] for r in rows) else "NOT faster on every map"
+        print(f"{verdict}; closest: {slowest['map']} ({slowest['cpp_s'] / slowest['median_s']:.1f}x)")
