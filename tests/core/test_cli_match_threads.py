@@ -6,6 +6,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from test_cli import two_rooms
 
 from ursim_core.cli import main
 
@@ -13,15 +14,6 @@ from ursim_core.cli import main
 def _white(path: Path) -> Path:
     # Every pixel free: it loads, but MAORIS finds no wall and so no region.
     cv2.imwrite(str(path), np.full((60, 60), 255, np.uint8))
-    return path
-
-
-def _rooms(path: Path) -> Path:
-    image = np.zeros((80, 170), np.uint8)
-    image[5:75, 5:80] = 255
-    image[5:75, 90:165] = 255
-    image[35:45, 80:90] = 255
-    cv2.imwrite(str(path), image)
     return path
 
 
@@ -34,7 +26,7 @@ def test_when_both_maps_fail_the_sketch_is_named(tmp_path, capsys):
 
 
 def test_a_missing_metric_map_fails_before_any_segmentation(tmp_path, capsys):
-    sketch = _rooms(tmp_path / "rooms.png")
+    sketch = two_rooms(tmp_path / "rooms.png")
     assert main(["match", str(sketch), str(tmp_path / "missing.png"), "-o", str(tmp_path / "out")]) == 1
     assert "missing.png" in capsys.readouterr().err
     assert not (tmp_path / "out" / "sketch.labels.png").exists()
@@ -47,7 +39,7 @@ def test_threads_give_the_outputs_of_one_step_after_the_other(tmp_path):
     from ursim_core.cli.match import load_and_segment
     from ursim_core.cli.segment import segment_checked
 
-    sketch, metric = _rooms(tmp_path / "a.png"), _rooms(tmp_path / "b.png")
+    sketch, metric = two_rooms(tmp_path / "a.png"), two_rooms(tmp_path / "b.png")
     args = SimpleNamespace(
         threshold=250, nonzero_free=False, max_pixels=64_000_000, sketch_preset="sketch", metric_preset="default"
     )
