@@ -27,7 +27,7 @@ import numpy as np
 
 from ursim_core.matching.orientation import transform_points
 
-__all__ = ["Alignment", "fit_alignment", "fit_alignments", "orientation_matrix"]
+__all__ = ["Alignment", "fit_alignment", "fit_alignments", "free_box_corners", "orientation_matrix"]
 
 #: Long side, in pixels, of the metric map's free space when the overlap is measured: coarse
 #: enough for a few hundred overlaps per orientation in milliseconds, fine enough for corridors
@@ -86,19 +86,36 @@ def _shrunk(mask: np.ndarray, factor: float) -> np.ndarray:
     return cv2.resize(mask.astype(np.uint8), shape, interpolation=cv2.INTER_AREA)
 
 
+def free_box_corners(free: np.ndarray) -> np.ndarray | None:
+    """The four (row, col) corners of the box around a mask's True pixels; None when it has none.
+
+    Reads each row and column once (no index arrays of every free pixel), so it is cheap on
+    building-sized maps.
+
+    Examples
+    --------
+    >>> free = np.zeros((5, 6), bool); free[1:3, 2:5] = True
+    >>> free_box_corners(free).tolist()
+    [[1.0, 2.0], [1.0, 4.0], [2.0, 2.0], [2.0, 4.0]]
+    """
+    rows = np.flatnonzero(free.any(axis=1))
+    if not len(rows):
+        return None
+    cols = np.flatnonzero(free.any(axis=0))
+    top, bottom, left, right = float(rows[0]), float(rows[-1]), float(cols[0]), float(cols[-1])
+    return np.array([[top, left], [top, right], [bottom, left], [bottom, right]])
+
+
 class _FreeSpace:
     """What the fits need of one map's free space, computed once for every orientation tried."""
 
     def __init__(self, free, *, shrink_to: int):
         free = np.asarray(free) != 0
-        self.shape = free.shape
-        self.empty = not free.any()
+        self.corners = free_box_corners(free)
+        self.empty = self.corners is None
         if self.empty:
             return
-        rows = np.flatnonzero(free.any(axis=1))
-        cols = np.flatnonzero(free.any(axis=0))
-        self.low = np.array([rows[0], cols[0]], float)
-        self.high = np.array([rows[-1], cols[-1]], float)
+        self.low, self.high = self.corners[0], self.corners[3]
         self.factor = min(1.0, shrink_to / max(free.shape))
         self.shrunk = _shrunk(free, self.factor)
 
@@ -153,13 +170,11 @@ def _fit(sketch: _FreeSpace, metric: _FreeSpace, degrees: float, mirrored: bool)
     turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
     if sketch.empty or metric.empty:
         return Alignment.unfitted(degrees, mirrored)
-    corners = np.array(
-        [[sketch.low[0], sketch.low[1]], [sketch.low[0], sketch.high[1]], [sketch.high[0], sketch.low[1]], sketch.high]
-    )
-    turned = corners @ turn.T
+    turned = sketch.corners @ turn.T
     sketch_low, sketch_high = turned.min(axis=0), turned.max(axis=0)
-    metric_extent = np.maximum(metric.high - metric.low, 1.0)
-    base_scale = metric_extent / np.maximum(sketch_high - sketch_low, 1.0)
+    extent = np.maximum(metric.high - metric.low, 1.0)
+    base_scale = extent / np.maximum(sketch_high - sketch_low, 1.0)
+    metric_extent = extent.tolist()
     metric_centre = ((metric.low + metric.high) / 2).tolist()
     # The sketch point that the turn sends to the turned box's centre.
     sketch_centre = np.linalg.solve(turn, (sketch_low + sketch_high) / 2)

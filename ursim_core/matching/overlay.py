@@ -28,7 +28,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ursim_core.matching.alignment import Alignment, fit_alignments, orientation_matrix
+from ursim_core.matching.alignment import Alignment, fit_alignments, free_box_corners, orientation_matrix
 
 __all__ = ["fit_overlay", "overlay_pairs", "SCALE_SPREAD"]
 
@@ -46,15 +46,11 @@ def _coarse(free: np.ndarray, factor: float) -> np.ndarray:
     return cv2.resize(free.astype(np.float32), shape, interpolation=cv2.INTER_AREA)
 
 
-def _template(free: np.ndarray, linear: np.ndarray):
-    """The input map under ``linear`` (coarse metric pixels per input pixel): free-space and
-    wall-band templates, and the offset of the template's origin."""
+def _template(free: np.ndarray, corners: np.ndarray, linear: np.ndarray):
+    """The input map (float32 free space, the corners of its box) under ``linear`` (coarse metric
+    pixels per input pixel): free-space and wall-band templates, and the offset of their origin."""
     import cv2
 
-    rows, cols = np.nonzero(free)
-    corners = np.array(
-        [[rows.min(), cols.min()], [rows.min(), cols.max()], [rows.max(), cols.min()], [rows.max(), cols.max()]], float
-    )
     turned = corners @ linear.T
     low = turned.min(axis=0) - _BAND - 1
     high = turned.max(axis=0) + _BAND + 1
@@ -62,9 +58,7 @@ def _template(free: np.ndarray, linear: np.ndarray):
     offset = -low
     opencv = np.array([[linear[1, 1], linear[1, 0], offset[1]], [linear[0, 1], linear[0, 0], offset[0]]])
     shrinking = abs(np.linalg.det(linear)) < 1
-    warped = cv2.warpAffine(
-        free.astype(np.float32), opencv, size, flags=cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR
-    ).clip(0, 1)
+    warped = cv2.warpAffine(free, opencv, size, flags=cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR).clip(0, 1)
     solid = (warped > 0.25).astype(np.uint8)
     band = cv2.dilate(solid, np.ones((2 * _BAND + 1, 2 * _BAND + 1), np.uint8)) - solid
     return warped, band.astype(np.float32), offset
@@ -110,6 +104,9 @@ def fit_overlay(
         return max(fits, key=lambda fit: fit.overlap)
     if not sketch_free.any() or not metric_free.any():
         return Alignment.unfitted(*orientations[0])
+    # Read once for every orientation and scale tried.
+    corners = free_box_corners(sketch_free)
+    source = sketch_free.astype(np.float32)
     factor = min(1.0, _SIDE / max(metric_free.shape))
     free = _coarse(metric_free, factor)
     walls = 1.0 - free
@@ -118,7 +115,7 @@ def fit_overlay(
         turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
         for spread in SCALE_SPREAD:
             linear = turn * (scale * spread * factor)
-            template, band, offset = _template(sketch_free, linear)
+            template, band, offset = _template(source, corners, linear)
             rows, cols = template.shape
             mass = float(template.sum() + band.sum())
             if rows < 3 or cols < 3 or mass == 0:
