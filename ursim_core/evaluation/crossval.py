@@ -172,24 +172,30 @@ def cross_validate(
             f"needs two or more maps with automatic-m runs of {matcher} {variant}", field="cross_validate"
         )
 
-    def map_score(value, name) -> float:
-        runs = [pair for runs in tables[value][name].values() for pair in runs]
+    # Each map's runs (annotators x orientations) pooled, and its score: mean of F1 and place
+    # accuracy (F1 alone where no place could be scored), once per value.
+    pooled = {
+        value: {name: [run for runs in tables[value][name].values() for run in runs] for name in maps}
+        for value in values
+    }
+
+    def score_of(runs) -> float:
         f1, place = _mean(runs, 0), _mean(runs, 1)
         return f1 if math.isnan(place) else (f1 + place) / 2
 
+    scores = {value: {name: score_of(pooled[value][name]) for name in maps} for value in values}
     rows = []
     held_out: dict[str, list] = defaultdict(list)
     for name in maps:
-        others = [other for other in maps if other != name]
-        scores = [float(np.mean([map_score(value, other) for other in others])) for value in values]
-        chosen = values[int(np.argmax(scores))]
-        runs = [pair for orientation_runs in tables[chosen][name].values() for pair in orientation_runs]
+        fold = [float(np.mean([scores[value][other] for other in maps if other != name])) for value in values]
+        chosen = values[int(np.argmax(fold))]
+        runs = pooled[chosen][name]
         rows.append((name, chosen, _mean(runs, 0), _mean(runs, 1)))
         for orientation, orientation_runs in tables[chosen][name].items():
             held_out[orientation].extend(orientation_runs)
     by_orientation = {key: (_mean(runs, 0), _mean(runs, 1)) for key, runs in held_out.items()}
     in_sample = {}
     for value in values:
-        runs = [pair for name in maps for orientation_runs in tables[value][name].values() for pair in orientation_runs]
+        runs = [run for name in maps for run in pooled[value][name]]
         in_sample[value] = (_mean(runs, 0), _mean(runs, 1))
     return CrossValidation(option, tuple(values), tuple(rows), by_orientation, in_sample)
