@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import ursim_core.bench.runner as runner
 from ursim_core.bench.startup import print_startup
 
@@ -41,3 +43,14 @@ def test_scale_prints_both_tables_with_the_whole_process_match(capsys):
     assert "segmentation scale" in out and "whole-process `ursim match`" in out
     match_table = out.split("whole-process `ursim match`")[1]
     assert "maxrss_mb" in match_table and "time_ratio" in match_table and "error" not in match_table
+
+
+@pytest.mark.parametrize("option", ["--seeds", "--repeats"])
+@pytest.mark.parametrize("value", ["0", "-3", "x"])
+def test_counts_below_one_are_usage_errors(option, value, capsys):
+    from ursim_core.cli import main
+
+    with pytest.raises(SystemExit) as stopped:
+        main(["bench", "invariance", option, value])
+    assert stopped.value.code == 2
+    assert "at least 1" in capsys.readouterr().err

@@ -16,6 +16,17 @@ EXAMPLES = """examples:
 BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "quality", "invariance", "all")
 
 
+def _count(text: str) -> int:
+    """``--repeats`` and ``--seeds``: a whole number, at least 1 (else a usage error)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expects a whole number of at least 1, got '{text}'")
+    return value
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "what",
@@ -28,9 +39,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "mirrored, cropped and rescaled; all: segment, scale and match",
     )
     parser.add_argument("--datasets", help="datasets folder (default: $URSIM_DATASETS or ../shared/datasets)")
-    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--repeats", type=_count, default=5)
     parser.add_argument("--csv", metavar="FILE", help="quality: also write every row to FILE")
-    parser.add_argument("--seeds", type=int, default=8, help="invariance: generated pairs (default 8)")
+    parser.add_argument("--seeds", type=_count, default=8, help="invariance: generated pairs (default 8)")
     parser.add_argument(
         "--sizes",
         type=int,
