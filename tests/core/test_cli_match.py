@@ -132,3 +132,8 @@ def test_match_overlay_reads_the_scale_of_two_ros_maps(tmp_path):
     document = json.loads((out / "correspondences.json").read_text())
     assert document["matcher"]["config"]["scale"] == pytest.approx(2.0)
     assert len(document["cliques"]) >= 3
+    # With no --matcher, the known scale makes the default (auto) the overlay matcher, not mirrored.
+    assert main(args[:-2]) == 0
+    default = json.loads((out / "correspondences.json").read_text())
+    assert default["matcher"]["config"]["scale"] == pytest.approx(2.0)
+    assert default["cliques"] == document["cliques"]

@@ -76,11 +76,14 @@ def test_a_document_reopened_from_its_file_says_its_automatic_cliques_are_there(
 
 def test_the_overlay_matcher_with_a_known_scale_runs_from_the_panel(window, qtbot):
     panel = window.matching_panel
-    assert not panel.scale.isEnabled()
-    panel.matcher.setCurrentIndex(panel.matcher.findData("overlay"))
+    assert panel.matcher.currentData() == "auto" and panel.scale.isEnabled()
+    panel.matcher.setCurrentIndex(panel.matcher.findData("planar"))
+    assert not panel.scale.isEnabled()  # the planar matcher has no use for it
+    panel.matcher.setCurrentIndex(panel.matcher.findData("auto"))
     assert panel.scale.isEnabled() and panel.config().scale is None  # 0 = unknown
     panel.scale.setValue(1.0)
-    assert panel.config().matcher == "overlay" and panel.config().scale == 1.0
+    # A known scale: the automatic matcher lays the maps on each other.
+    assert panel.config().matcher == "auto" and panel.config().scale == 1.0
     with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
         qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
     result = window.session.last_match

@@ -33,7 +33,7 @@ def test_turning_the_sketch_keeps_points_in_the_image_frame(window, qtbot):
 def test_the_orientation_goes_to_the_match_config(window):
     panel = window.matching_panel
     fields = {field.name for field in dataclasses.fields(MatchConfig)}
-    assert panel.config().matcher == "planar"
+    assert panel.config().matcher == "auto"
     panel.turn_right.click()
     panel.angle.setValue(30.0)
     panel.angle.editingFinished.emit()

@@ -64,8 +64,9 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     parser.add_argument(
         "--matcher",
-        choices=["planar", "hungarian", "vf2", "overlay"],
-        help="graph matcher (overlay: lay two metric maps on each other, see --scale)",
+        choices=["auto", "planar", "hungarian", "vf2", "overlay"],
+        help="matcher (default auto: overlay when the scale is known, from --scale or two ROS YAML "
+        "maps, else planar; overlay lays two metric maps on each other)",
     )
     parser.add_argument(
         "--scale",
@@ -273,7 +274,12 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
     sketch_map, metric_map, sketch_seg, metric_seg = load_and_segment(
         sketch, metric, args, params=params, canonical=canonical
     )
-    if config.matcher == "overlay" and config.scale is None and sketch_map.resolution and metric_map.resolution:
+    if (
+        config.matcher in ("auto", "overlay")
+        and config.scale is None
+        and sketch_map.resolution
+        and metric_map.resolution
+    ):
         # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
         config = config.replace(scale=sketch_map.resolution / metric_map.resolution)
     started = time.perf_counter()

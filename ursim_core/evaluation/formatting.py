@@ -23,7 +23,7 @@ CHOICE_TITLES = {
     "fixed": "best single fixed m (highest mean F1 over the maps)",
     "auto": "automatic m",
 }
-MATCHER_NAMES = {"planar": "Planar", "hungarian": "Hungarian", "vf2": "VF2"}
+MATCHER_NAMES = {"auto": "Automatic", "planar": "Planar", "hungarian": "Hungarian", "vf2": "VF2"}
 VARIANT_NAMES = {"baseline": "Baseline", "T1": "T1", "T2": "T2", "T3": "T3", "T4": "T4"}
 
 

@@ -46,9 +46,11 @@ __all__ = [
 #: The released driver's sweep of m: 0, 0.025, ..., 0.475 (20 values).
 DEFAULT_M_GRID: tuple[float, ...] = tuple(round(0.025 * i, 10) for i in range(20))
 #: Matchers in the order of the report's rows.
-MATCHERS = ("planar", "hungarian", "vf2", "overlay")
-#: The matchers an evaluation runs when none are named (the overlay matcher is for metric maps).
-DEFAULT_MATCHERS = ("planar", "hungarian", "vf2")
+MATCHERS = ("auto", "planar", "hungarian", "vf2", "overlay")
+#: The matchers an evaluation runs when none are named. 'auto' is what ``ursim match`` runs by
+#: default: the planar matcher, or the overlay matcher when the maps' relative scale is known
+#: (:meth:`ursim_core.matching.MatchConfig.resolved`).
+DEFAULT_MATCHERS = ("auto", "hungarian", "vf2")
 #: Descriptor variants in the order of the paper's Table 1 columns.
 VARIANTS = ("baseline", "T1", "T2", "T3", "T4")
 #: How m is chosen in a summary.

@@ -37,7 +37,7 @@ MATCH_PRESETS = {"sketch": "default", "metric": "default"}
 
 #: The released driver's sweep: 0, 0.025, ..., 0.475 (20 values).
 M_GRID = tuple(round(0.025 * i, 10) for i in range(20))
-MATCHERS = ("planar", "hungarian", "vf2", "overlay")
+MATCHERS = ("auto", "planar", "hungarian", "vf2", "overlay")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -48,9 +48,12 @@ class MatchConfig:
     ----------
     variant : {'T4', 'T1', 'T2', 'T3', 'baseline'}
         Descriptor variant (paper Table 1): T4 = URSIM (anchors + weights).
-    matcher : {'planar', 'hungarian', 'vf2', 'overlay'}
+    matcher : {'auto', 'planar', 'hungarian', 'vf2', 'overlay'}
+        'planar': the seed-and-expand planar graph matcher of URSIM, built for sketches.
         'overlay': lay the maps on each other and pair what overlaps, for two metric maps
-        (:mod:`ursim_core.matching.overlay`); m does not apply to it.
+        (:mod:`ursim_core.matching.overlay`); m does not apply to it. 'auto' (default):
+        'overlay' when ``scale`` is known (two metric maps of known resolutions: a sketch has
+        none), else 'planar' (:meth:`resolved`).
     m : 'auto' or float
         Threshold on ``c`` below which two regions are "the same". ``'auto'`` picks it
         per map pair over ``m_grid`` (:mod:`ursim_core.matching.auto_m`).
@@ -103,7 +106,9 @@ class MatchConfig:
         many degrees counter-clockwise (after mirroring when ``mirrored``).
     mirrored : bool or None
         Whether the sketch is a left-right mirror image of the map; None (default) = unknown,
-        both are tried with ``orientation='any'`` (with 'upright' or a number, None = no).
+        both are tried with ``orientation='any'`` (with 'upright' or a number, None = no). For
+        the overlay matcher None means no: two metric maps are both seen from above, so neither
+        is a mirror image of the other (pass True to try mirror images all the same).
     orientation_overlap : float
         With ``orientation='any'``, the orientations are ranked by their hypothesis score divided
         by the free-space overlap (intersection over union) of the sketch fitted onto the metric
@@ -119,7 +124,7 @@ class MatchConfig:
     """
 
     variant: str = "T4"
-    matcher: str = "planar"
+    matcher: str = "auto"
     m: Any = "auto"
     times: tuple = DEFAULT_TIMES
     uniqueness_k: float = 1.0
@@ -268,6 +273,27 @@ class MatchConfig:
         )
         values.update(overrides)
         return cls(**values)
+
+    def resolved(self) -> MatchConfig:
+        """This configuration with its automatic choices made: what the matcher runs.
+
+        ``matcher='auto'`` becomes 'overlay' when ``scale`` is known and 'planar' otherwise;
+        for the overlay matcher an unknown ``mirrored`` becomes False.
+
+        Examples
+        --------
+        >>> MatchConfig().resolved().matcher, MatchConfig(scale=1.0).resolved().matcher
+        ('planar', 'overlay')
+        >>> MatchConfig(scale=1.0).resolved().mirrored
+        False
+        """
+        matcher = self.matcher
+        if matcher == "auto":
+            matcher = "overlay" if self.scale is not None else "planar"
+        mirrored = False if matcher == "overlay" and self.mirrored is None else self.mirrored
+        if (matcher, mirrored) == (self.matcher, self.mirrored):
+            return self
+        return dataclasses.replace(self, matcher=matcher, mirrored=mirrored)
 
     def replace(self, **changes) -> MatchConfig:
         """A copy with some fields changed (validated like a new config).

@@ -89,6 +89,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     >>> prepare(g, g.copy()).c_matrix.shape
     (3, 3)
     """
+    config = config.resolved()
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
     if config.matcher == "overlay":
         return _prepare_overlay(sketch_seg, metric_seg, config)

@@ -37,11 +37,14 @@ VARIANTS = (
     ("baseline", "baseline"),
 )
 MATCHERS = (
+    ("auto", "automatic (planar; overlay with a known scale)"),
     ("planar", "planar expansion"),
     ("hungarian", "Hungarian"),
     ("vf2", "VF2"),
     ("overlay", "overlay (two metric maps)"),
 )
+#: The matchers that use a known scale.
+_SCALED_MATCHERS = ("auto", "overlay")
 
 
 def describe_result(result, *, automatic_cliques: int = 0) -> str:
@@ -102,7 +105,7 @@ class MatchingPanel(QWidget):
         self.matcher = _combo("match_matcher", MATCHERS)
         form.addRow("Variant", self.variant)
         form.addRow("Matcher", self.matcher)
-        # The overlay matcher's known scale (metric pixels per input pixel); 0 = unknown.
+        # The known scale (metric pixels per input pixel; 0 = unknown): with it, 'auto' overlays.
         self.scale = QDoubleSpinBox()
         self.scale.setObjectName("match_scale")
         self.scale.setRange(0.0, 100.0)
@@ -111,12 +114,13 @@ class MatchingPanel(QWidget):
         self.scale.setSpecialValueText("unknown (same extent)")
         self.scale.setValue(0.0)
         self.scale.setToolTip(
-            "Overlay matcher: metric-map pixels per input-map pixel (1 for two robot maps of one resolution); "
-            "with a known scale the input may cover any part of the metric map"
+            "Metric-map pixels per input-map pixel when known (1 for two robot maps of one resolution): "
+            "the automatic matcher then lays the maps on each other (overlay), and the input may cover "
+            "any part of the metric map; leave it unknown for a sketch"
         )
-        self.scale.setEnabled(False)
+        self.scale.setEnabled(self.matcher.currentData() in _SCALED_MATCHERS)
         self.matcher.currentIndexChanged.connect(
-            lambda _: self.scale.setEnabled(self.matcher.currentData() == "overlay")
+            lambda _: self.scale.setEnabled(self.matcher.currentData() in _SCALED_MATCHERS)
         )
         form.addRow("Scale", self.scale)
         self.orientation = SketchOrientation()
@@ -170,7 +174,7 @@ class MatchingPanel(QWidget):
         fields = {field.name for field in dataclasses.fields(MatchConfig)}
         matcher = self.matcher.currentData()
         extra = {}
-        if matcher == "overlay" and self.scale.value() > 0:
+        if matcher in _SCALED_MATCHERS and self.scale.value() > 0:
             extra["scale"] = float(self.scale.value())
         return MatchConfig(
             variant=self.variant.currentData(),

@@ -102,3 +102,23 @@ def test_no_known_scale_fits_the_extents(plan, plan_segmentation):
     small = cv2.resize(plan.free.astype(np.uint8), None, fx=0.5, fy=0.5, interpolation=cv2.INTER_NEAREST) > 0
     result = match(segment(small, preset="default"), plan_segmentation, config=MatchConfig(matcher="overlay"))
     assert len(result.pairs) >= 0.8 * plan_segmentation.graph.number_of_nodes()
+
+
+def test_the_automatic_matcher_overlays_when_the_scale_is_known(plan, plan_segmentation):
+    rows, cols = slice(0, plan.free.shape[0]), slice(plan.free.shape[1] // 4, None)
+    part = segment(plan.free[rows, cols], preset="default")
+    told = prepare(part, plan_segmentation, MatchConfig(scale=1.0))
+    assert (told.config.matcher, told.config.mirrored) == ("overlay", False)
+    overlaid = match_prepared(told)
+    assert overlaid.pairs == match(part, plan_segmentation, config=OVERLAY).pairs
+    assert _identity_share(overlaid.pairs, part.labels, plan_segmentation.labels, rows, cols) >= 0.9
+    # No scale: a sketch, and the planar matcher's answer, exactly.
+    untold = prepare(part, plan_segmentation, MatchConfig())
+    assert untold.config.matcher == "planar"
+    assert match_prepared(untold).pairs == match(part, plan_segmentation, config=MatchConfig(matcher="planar")).pairs
+
+
+def test_a_mirror_image_is_tried_by_the_overlay_only_when_asked():
+    assert MatchConfig(matcher="overlay").resolved().mirrored is False
+    assert MatchConfig(matcher="overlay", mirrored=True).resolved().mirrored is True
+    assert MatchConfig(matcher="planar").resolved().mirrored is None
