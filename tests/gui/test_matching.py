@@ -89,3 +89,24 @@ def test_the_overlay_matcher_with_a_known_scale_runs_from_the_panel(window, qtbo
     result = window.session.last_match
     assert result.config.matcher == "overlay" and result.pairs
     assert "pairs" in panel.summary.text()
+
+
+def test_two_georeferenced_maps_are_overlaid_at_the_scale_of_their_resolutions(window, qtbot, map_files, tmp_path):
+    from ursim_core.segmentation import load_label_image
+
+    session = window.session
+    for side, resolution in (("sketch", 0.1), ("metric", 0.05)):  # the metric map is drawn twice as large
+        yaml_path = tmp_path / f"{side}.yaml"
+        yaml_path.write_text(
+            f"image: {map_files[side].name}\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+        )
+        session.load_map(side, yaml_path)
+        session.set_segmentation(side, load_label_image(map_files[f"{side}_labels"], shape=session.map(side).shape))
+    panel = window.matching_panel
+    assert panel.config().scale is None  # the panel does not know; the job reads the maps
+    with qtbot.waitSignal(session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    result = session.last_match
+    assert (result.config.matcher, result.config.scale) == ("overlay", 2.0)
+    assert sorted(result.pairs) == [(1, 1), (2, 2), (3, 3)]

@@ -274,14 +274,8 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
     sketch_map, metric_map, sketch_seg, metric_seg = load_and_segment(
         sketch, metric, args, params=params, canonical=canonical
     )
-    if (
-        config.matcher in ("auto", "overlay")
-        and config.scale is None
-        and sketch_map.resolution
-        and metric_map.resolution
-    ):
-        # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
-        config = config.replace(scale=sketch_map.resolution / metric_map.resolution)
+    # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
+    config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
     started = time.perf_counter()
     result = match(sketch_seg, metric_seg, config=config)
     elapsed = time.perf_counter() - started

@@ -295,6 +295,27 @@ class MatchConfig:
             return self
         return dataclasses.replace(self, matcher=matcher, mirrored=mirrored)
 
+    def with_resolutions(self, sketch_resolution: float | None, metric_resolution: float | None) -> MatchConfig:
+        """This configuration with ``scale`` read from the maps' resolutions (metres per pixel).
+
+        Two georeferenced maps (ROS YAML) tell their relative scale: metric pixels per input
+        pixel = input resolution / metric resolution. It is filled in only when the matcher
+        uses it ('auto' or 'overlay') and no scale was given; a map without a resolution (a
+        sketch, a bare image) leaves the configuration as it is.
+
+        Examples
+        --------
+        >>> MatchConfig().with_resolutions(0.1, 0.05).scale
+        2.0
+        >>> MatchConfig().with_resolutions(None, 0.05).scale is None
+        True
+        """
+        if self.matcher not in ("auto", "overlay") or self.scale is not None:
+            return self
+        if not sketch_resolution or not metric_resolution:
+            return self
+        return self.replace(scale=float(sketch_resolution) / float(metric_resolution))
+
     def replace(self, **changes) -> MatchConfig:
         """A copy with some fields changed (validated like a new config).
 

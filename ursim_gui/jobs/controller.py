@@ -135,7 +135,12 @@ class JobController(QObject):
             show_error(self._parent, "Cannot match", "Segment both maps (or load their label images) first.")
             self._queue.clear()
             return None
-        return MatchJob(sketch, metric, job.config)
+        config = job.config
+        sketch_map, metric_map = self._session.map("sketch"), self._session.map("metric")
+        if config is not None and sketch_map is not None and metric_map is not None:
+            # As `ursim match`: two georeferenced maps (ROS YAML) tell their relative scale.
+            config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
+        return MatchJob(sketch, metric, config)
 
     def submit(self, job) -> None:
         """Queue any other job (``run(progress, cancelled)``); its result comes as ``result_ready``."""
