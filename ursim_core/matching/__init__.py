@@ -9,8 +9,8 @@ May import: :mod:`ursim_core.segmentation` (values only), :mod:`ursim_core.io`,
 :mod:`ursim_core.errors`. Scoring against ground truth lives in :mod:`ursim_core.evaluation`.
 
 >>> from ursim_core.matching import MatchConfig
->>> MatchConfig().matcher
-'planar'
+>>> MatchConfig().matcher, MatchConfig().resolved().matcher  # a sketch: no known scale
+('auto', 'planar')
 """
 
 import lazy_loader as _lazy

@@ -90,6 +90,11 @@ class MatchConfig:
     position_weight : float
         beta in ``c = (c_signature + beta * d_position) / (1 + beta)`` (0 = paper); see
         :mod:`ursim_core.matching.descriptors`. Assumes the sketch keeps the map's orientation.
+    position_refits : int
+        Planar matcher with a position term: this many times, lay the sketch's positions on the
+        metric map by a scale and shift per axis fitted to the answer's pairs, match again, and
+        keep the new answer when its hypothesis score is lower (:mod:`ursim_core.matching.refit`);
+        0 = positions normalised to each map's extent only.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -140,6 +145,7 @@ class MatchConfig:
     vf2_timeout: float = 2.0
     signature_method: str = "auto"
     position_weight: float = 2.0
+    position_refits: int = 1
     hypothesis_score: str = "signature"
     score_weight: float = 8.0
     orientation: Any = "any"
@@ -203,6 +209,14 @@ class MatchConfig:
             raise ParameterError(f"must be a positive number or null, not {self.scale!r}", field="scale")
         if self.mirrored not in (None, True, False):
             raise ParameterError(f"must be true, false or null, not {self.mirrored!r}", field="mirrored")
+        if (
+            isinstance(self.position_refits, bool)
+            or not isinstance(self.position_refits, int)
+            or self.position_refits < 0
+        ):
+            raise ParameterError(
+                f"must be a non-negative integer, not {self.position_refits!r}", field="position_refits"
+            )
         if not self.times:
             raise ParameterError("needs at least one time", field="times")
         if not self.m_grid:
@@ -234,6 +248,7 @@ class MatchConfig:
             rotation_search="first",
             reflections=False,
             position_weight=0.0,
+            position_refits=0,
             hypothesis_score="structure",
             score_weight=0.0,
             orientation="upright",
@@ -266,6 +281,7 @@ class MatchConfig:
             rotation_search="min",
             reflections=False,
             position_weight=0.0,
+            position_refits=0,
             hypothesis_score="substitutions",
             score_weight=1.0,
             orientation="upright",

@@ -36,6 +36,7 @@ from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchCon
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph
 from ursim_core.matching.planar import planar_graph
+from ursim_core.matching.refit import refit_positions
 from ursim_core.matching.results import MatchResult, Prepared
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
 from ursim_core.segmentation.canonical import wall_angle
@@ -96,7 +97,10 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     candidates = _orientations(config, sketch_seg, metric_seg)
     base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0])
     if len(candidates) == 1:
-        return base
+        if not _refits(config):
+            return base
+        base, result = _refitted(base, match_prepared(base, progress=progress))
+        return dataclasses.replace(base, chosen=result)
 
     def candidate(index: int) -> Prepared:
         return base if index == 0 else _reoriented(base, sketch_graph, candidates[index])
@@ -148,12 +152,27 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
         result = match_prepared(prepared, progress=_share_of(progress, step, len(finalists)))
+        prepared, result = _refitted(prepared, result)
         trials.append((ranked(result.normalised_cost, index), index, prepared, result))
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(
         prepared, orientation_scan=scan, chosen=dataclasses.replace(result, orientation_scan=scan)
     )
+
+
+def _refits(config: MatchConfig) -> int:
+    """How many position refits apply (:mod:`ursim_core.matching.refit`): planar, with positions."""
+    return config.position_refits if config.matcher == "planar" and config.position_weight else 0
+
+
+def _refitted(prepared: Prepared, result: MatchResult) -> tuple[Prepared, MatchResult]:
+    for _ in range(_refits(prepared.config)):
+        refitted, answer = refit_positions(prepared, result, match_prepared)
+        if answer is result:
+            break
+        prepared, result = refitted, answer
+    return prepared, result
 
 
 #: With the automatic m, orientations are screened at every ``_COARSE_STEP``-th m of the grid and

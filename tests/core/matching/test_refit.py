@@ -1,0 +1,86 @@
+"""Positions refitted from a first answer (ursim_core.matching.refit)."""
+
+from __future__ import annotations
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from ursim_core.errors import ParameterError
+from ursim_core.matching import MatchConfig, match_prepared, prepare
+from ursim_core.matching.positions import region_positions
+from ursim_core.matching.refit import fit_axis_transform, refitted_graph
+
+
+def _grid_graph(transform=((1.0, 0.0), (1.0, 0.0))):
+    graph = nx.grid_2d_graph(3, 4)
+    graph = nx.convert_node_labels_to_integers(graph, label_attribute="cell")
+    for node, data in graph.nodes(data=True):
+        row, col = data.pop("cell")
+        r, c = 20.0 * row + 10, 20.0 * col + 10
+        r, c = transform[0][0] * r + transform[0][1], transform[1][0] * c + transform[1][1]
+        data.update(centroid=(r, c), size=100 + node, pca_shape=0.3)
+        half_r, half_c = 10 * transform[0][0], 10 * transform[1][0]
+        data["bbox"] = (r - half_r, c - half_c, r + half_r, c + half_c)
+    return graph
+
+
+def test_the_fit_undoes_a_scale_and_shift_per_axis():
+    sketch = _grid_graph()
+    metric = _grid_graph(((1.5, 30.0), (0.75, -4.0)))
+    pairs = [(n, n) for n in sketch.nodes]
+    assert np.allclose(fit_axis_transform(pairs, sketch, metric), [[1.5, 30.0], [0.75, -4.0]])
+
+
+def test_the_fit_lets_a_wrong_pair_go():
+    sketch = _grid_graph()
+    metric = _grid_graph(((2.0, 0.0), (2.0, 0.0)))
+    pairs = [(n, n) for n in sketch.nodes]
+    pairs[0] = (0, 11)  # far corner to far corner
+    assert np.allclose(fit_axis_transform(pairs, sketch, metric), [[2.0, 0.0], [2.0, 0.0]], atol=1e-6)
+
+
+@pytest.mark.parametrize("pairs", [[], [(0, 0), (1, 1)], [(0, 0), (0, 4), (0, 8)]])
+def test_too_few_or_degenerate_pairs_give_no_fit(pairs):
+    sketch, metric = _grid_graph(), _grid_graph()
+    metric.nodes[4]["centroid"] = metric.nodes[0]["centroid"]
+    metric.nodes[8]["centroid"] = metric.nodes[0]["centroid"]
+    assert fit_axis_transform(pairs, sketch, metric) is None
+
+
+def test_refitted_positions_are_the_partners_positions():
+    # A sketch of the left half of the map only: extent-normalised positions disagree, refitted agree.
+    metric = _grid_graph()
+    left = metric.subgraph([n for n, c in metric.nodes(data="centroid") if c[1] < 40]).copy()
+    sketch = nx.relabel_nodes(left, {n: n for n in left.nodes})
+    for data in sketch.nodes.values():  # drawn at another scale
+        data["centroid"] = (2.0 * data["centroid"][0], 3.0 * data["centroid"][1])
+        data["bbox"] = tuple(v * f for v, f in zip(data["bbox"], (2.0, 3.0, 2.0, 3.0)))
+    nodes = sorted(sketch.nodes)
+    plain = region_positions(sketch, nodes=nodes)
+    everything = sorted(metric.nodes)
+    partners = region_positions(metric, nodes=everything)[[everything.index(n) for n in nodes]]
+    assert not np.allclose(plain, partners)
+    moved = refitted_graph(sketch, metric, fit_axis_transform([(n, n) for n in nodes], sketch, metric))
+    assert np.allclose(region_positions(moved, nodes=nodes), partners)
+
+
+def test_refits_are_an_option_off_in_the_paper_and_released_configurations():
+    assert MatchConfig().position_refits == 1
+    assert MatchConfig.paper().position_refits == 0 and MatchConfig.released().position_refits == 0
+    for bad in (-1, 0.5, True):
+        with pytest.raises(ParameterError, match="position_refits"):
+            MatchConfig(position_refits=bad)
+
+
+def test_a_refit_never_raises_the_hypothesis_score():
+    metric = _grid_graph()
+    sketch = _grid_graph(((0.5, 7.0), (1.3, 2.0)))
+    for node in (3, 5, 8):
+        sketch.nodes[node]["size"] += 40  # unlike sizes: the signatures alone are ambiguous
+    plain = prepare(sketch, metric, MatchConfig(position_refits=0, orientation="upright"))
+    refitted = prepare(sketch, metric, MatchConfig(orientation="upright"))
+    first = match_prepared(plain)
+    assert refitted.chosen.normalised_cost <= first.normalised_cost
+    # The refitted preparation serves every later m too, with its own positions.
+    assert not np.allclose(refitted.c_matrix, plain.c_matrix) or refitted.chosen.pairs == first.pairs

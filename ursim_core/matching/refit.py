@@ -1,0 +1,152 @@
+"""Positions refitted from a first answer: the sketch laid on the metric map by its own matches.
+
+The position term of ``c`` (:mod:`ursim_core.matching.positions`) compares region centroids
+normalised to each map's extent, which assumes that the sketch covers the metric map's extent in
+proportion. A sketch that shows part of the building, or squeezes one wing, breaks that. Once the
+planar matcher has an answer, its pairs say where the sketch lies: a scale and a shift per axis
+(the sketch is already turned to the orientation tried), fitted to the pairs' centroids by
+weighted least squares that lets outlying pairs go (:func:`fit_axis_transform`). The sketch's
+centroids are then moved into the metric map's frame and normalised by the metric map's extent,
+``c`` is blended again and the matcher runs once more; the new answer is kept only when its
+hypothesis score is lower (:func:`refit_positions`), the score the orientations are ranked by.
+
+Measured (``MatchConfig(position_refits=0)`` is the old behaviour): generated pairs of
+``ursim bench invariance --seeds 8`` 0.805 -> 0.86 mean F1, KTH in 8 orientations 0.72 -> 0.74;
+one refit, not more: three gave the same on the generated pairs and 0.726 on KTH.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import networkx as nx
+import numpy as np
+
+from ursim_core.matching.positions import blend_positions
+
+__all__ = ["fit_axis_transform", "refitted_graph", "refit_positions"]
+
+#: Reweighting rounds of the fit; pairs whose residual exceeds ``_CUTOFF`` median residuals
+#: get no weight in the next round (Tukey's biweight).
+_ROUNDS = 3
+_CUTOFF = 3.0
+#: A fitted scale below this, relative to the ratio of the pairs' spreads (1 for a fit that keeps
+#: them apart as they are), or a negative one, squeezes the sketch into a line: not a placement.
+_SMALLEST_SCALE = 0.05
+
+
+def fit_axis_transform(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) -> np.ndarray | None:
+    """Scale and shift per axis that carry the sketch's centroids onto their partners'.
+
+    Parameters
+    ----------
+    pairs : sequence of (sketch node, metric node)
+    sketch_graph, metric_graph : networkx.Graph
+        Region graphs with ``centroid`` (row, col) and ``size`` node attributes.
+
+    Returns
+    -------
+    ndarray of shape (2, 2) or None
+        ``[[row scale, row shift], [col scale, col shift]]``; None with fewer than 3 pairs or a
+        degenerate fit. Each pair weighs the square root of its smaller region's size.
+
+    Examples
+    --------
+    >>> s, m = nx.Graph(), nx.Graph()
+    >>> for n, (r, c) in enumerate([(0, 0), (10, 0), (0, 20), (10, 20)]):
+    ...     s.add_node(n, centroid=(r, c), size=10)
+    ...     m.add_node(n, centroid=(2 * r + 5, c + 1), size=10)
+    >>> fit_axis_transform([(n, n) for n in range(4)], s, m).round(3).tolist()
+    [[2.0, 5.0], [1.0, 1.0]]
+    """
+    pairs = list(pairs)
+    if len(pairs) < 3:
+        return None
+    source = np.array([sketch_graph.nodes[a]["centroid"] for a, _ in pairs], float).reshape(-1, 2)
+    target = np.array([metric_graph.nodes[b]["centroid"] for _, b in pairs], float).reshape(-1, 2)
+    source_spread, target_spread = np.ptp(source, axis=0), np.ptp(target, axis=0)
+    if np.any(source_spread <= 0) or np.any(target_spread <= 0):
+        return None  # every pair on one line: no scale along the other axis
+    sizes = [min(sketch_graph.nodes[a]["size"], metric_graph.nodes[b]["size"]) for a, b in pairs]
+    weights = np.sqrt(np.maximum(np.asarray(sizes, float), 0.0))
+    transform = np.zeros((2, 2))
+    for axis in range(2):
+        design = np.stack([source[:, axis], np.ones(len(pairs))], axis=1)
+        current = weights.copy()
+        for _ in range(_ROUNDS):
+            if np.count_nonzero(current) < 2:
+                return None
+            solution = np.linalg.lstsq(design * current[:, None], target[:, axis] * current, rcond=None)[0]
+            residuals = np.abs(design @ solution - target[:, axis])
+            spread = _CUTOFF * float(np.median(residuals)) + 1e-9
+            current = weights * np.clip(1.0 - (residuals / spread) ** 2, 0.0, 1.0) ** 2
+        transform[axis] = solution
+    if np.any(transform[:, 0] * source_spread / target_spread < _SMALLEST_SCALE):
+        return None
+    return transform
+
+
+def refitted_graph(sketch_graph: nx.Graph, metric_graph: nx.Graph, transform: np.ndarray) -> nx.Graph:
+    """A copy of the sketch graph whose centroids are moved into the metric map's frame and whose
+    extent is the metric map's, so :func:`~ursim_core.matching.positions.region_positions`
+    normalises both maps alike."""
+    boxes = np.array([box for _, box in metric_graph.nodes(data="bbox")], float).reshape(-1, 4)
+    if len(boxes):
+        extent = (*boxes[:, :2].min(axis=0).tolist(), *boxes[:, 2:].max(axis=0).tolist())
+    else:
+        centroids = np.array([c for _, c in metric_graph.nodes(data="centroid")], float).reshape(-1, 2)
+        extent = (*centroids.min(axis=0).tolist(), *centroids.max(axis=0).tolist())
+    moved = sketch_graph.copy()
+    for _, data in moved.nodes(data=True):
+        row, col = data["centroid"]
+        data["centroid"] = (
+            float(transform[0, 0] * row + transform[0, 1]),
+            float(transform[1, 0] * col + transform[1, 1]),
+        )
+        data["bbox"] = extent
+    return moved
+
+
+def refit_positions(prepared, result, match_once):
+    """``(prepared, result)`` after one refit of the sketch's positions, or as given.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The planar matcher's preparation in one orientation.
+    result : MatchResult
+        Its answer.
+    match_once : callable
+        ``match_once(prepared) -> MatchResult`` (the configured m, automatic or fixed).
+
+    Returns
+    -------
+    (Prepared, MatchResult)
+        The refitted preparation and its answer when that answer's hypothesis score is lower;
+        else the inputs unchanged.
+    """
+    descriptors = prepared.descriptors
+    config = prepared.config
+    if descriptors is None or descriptors.signature_c is None or not config.position_weight:
+        return prepared, result
+    if any("bbox" not in data for _, data in prepared.metric_graph.nodes(data=True)):
+        return prepared, result
+    transform = fit_axis_transform(result.pairs, prepared.sketch_graph, prepared.metric_graph)
+    if transform is None:
+        return prepared, result
+    moved = refitted_graph(prepared.sketch_graph, prepared.metric_graph, transform)
+    c_matrix = blend_positions(
+        descriptors.signature_c,
+        moved,
+        descriptors.sketch_nodes,
+        prepared.metric_graph,
+        descriptors.metric_nodes,
+        config.position_weight,
+    )
+    candidate = dataclasses.replace(
+        prepared, descriptors=dataclasses.replace(descriptors, c_matrix=c_matrix), chosen=None
+    )
+    refitted = match_once(candidate)
+    if refitted.normalised_cost < result.normalised_cost:
+        return candidate, refitted
+    return prepared, result
