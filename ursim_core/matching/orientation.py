@@ -30,10 +30,20 @@ import numpy as np
 
 from ursim_core.segmentation.canonical import wall_angle
 
-__all__ = ["ORIENTATIONS", "wall_angle", "orientation_candidates", "oriented_graph", "transform_points"]
+__all__ = ["ORIENTATIONS", "SNAP_DEGREES", "wall_angle", "orientation_candidates", "oriented_graph", "transform_points"]
 
 #: The values of ``MatchConfig.orientation`` other than a number of degrees.
 ORIENTATIONS = ("any", "upright")
+
+
+#: Wall-angle differences below this many degrees are taken as none: the candidates are then the
+#: exact quarter turns. The wall angle of a map turned by a quarter turn can come out a degree or
+#: two apart (its outline is traced and simplified from another starting pixel), which turned
+#: near-ties between candidates into different answers for the same sketch drawn in different
+#: orientations; walls this close to the axes are how people draw, and the free-space fit
+#: (:mod:`ursim_core.matching.alignment`) turns by a few degrees itself. The same threshold as
+#: the canonical segmentation's (``ursim_core.segmentation.canonical``): below it, no resampling.
+SNAP_DEGREES = 3.0
 
 
 def orientation_candidates(
@@ -65,6 +75,8 @@ def orientation_candidates(
     [(90.0, True)]
     >>> orientation_candidates(mirrored=False, sketch_angle=10.0)
     [(350.0, False), (80.0, False), (170.0, False), (260.0, False)]
+    >>> orientation_candidates(mirrored=False, sketch_angle=1.5)  # within SNAP_DEGREES
+    [(0.0, False), (90.0, False), (180.0, False), (270.0, False)]
     """
     if orientation == "upright":
         return [(0.0, bool(mirrored))]
@@ -76,6 +88,8 @@ def orientation_candidates(
         # Mirroring negates every angle of the sketch, its walls' direction included.
         base = metric_angle - (-sketch_angle if flag else sketch_angle)
         base = (base + 45.0) % 90.0 - 45.0
+        if abs(base) < SNAP_DEGREES:
+            base = 0.0
         for quarter in range(4):
             candidates.append((round((base + 90.0 * quarter) % 360.0, 9) % 360.0, flag))
     return candidates

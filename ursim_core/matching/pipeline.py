@@ -176,12 +176,15 @@ def _refitted(prepared: Prepared, result: MatchResult) -> tuple[Prepared, MatchR
 
 
 #: With the automatic m, orientations are screened at every ``_COARSE_STEP``-th m of the grid and
-#: the ``_FINALISTS`` best get the full sweep (see :func:`prepare`).
-#: Chosen on the 18 KTH sketches (interleaved A/B in one session; tuned on the same data, but it
-#: changes no answer there): step 2 with 2 finalists gave the same F1 in every orientation as the
-#: full sweep of all 8 (0.651 overall) at 36 ms median per pair, against 58 ms with 3 finalists.
+#: the ``_FINALISTS`` best get the full sweep (and the position refit, see :func:`prepare`).
+#: Round 6 (tuned on the 18 KTH sketches, interleaved A/B in one session): step 2 with 2 finalists
+#: gave the same F1 in every orientation as the full sweep of all 8 (0.651 overall) at 36 ms
+#: median per pair, against 58 ms with 3 finalists. Round 8, with exact quarter-turn candidates
+#: and the refit: 2 and 3 finalists give the same on KTH (0.762 in every orientation) but 2 cut
+#: the right reading of a nearly symmetric generated plan (``ursim bench invariance``: 0.823
+#: against 0.858, the same as all 8), for about 15 % more time per pair (interleaved, loaded).
 _COARSE_STEP = 2
-_FINALISTS = 2
+_FINALISTS = 3
 #: Above this many regions in either map, orientations are screened by assignment cost instead.
 _SCREEN_BY_ASSIGNMENT = 60
 

@@ -14,9 +14,11 @@ orientations and 0.754 mirrored-and-half-turned (the orientations are ranked by 
 over free-space overlap; before, by the score alone: 0.644-0.658). The one thing chosen on these
 sketches is that ranking's power (``orientation_overlap``), so the headline figure is its
 leave-one-sketch-out cross-validation over 0 (score alone) and 1: held-out F1 0.72, place
-accuracy 0.74, in every orientation (without the position refit). The position refit
-(``position_refits``, designed on generated pairs) is cross-validated over 0 and 1 with the power at
-1: held out 0.74 / 0.75, 1 chosen in every fold. The matching issue's bar (0.80 in every orientation) is not
+accuracy 0.74, in every orientation (without the position refit). With the position refit
+(``position_refits``, designed on generated pairs) and exact quarter-turn candidates, every
+orientation gives the same answers: in sample 0.76 / 0.78 with one refit, 0.72 / 0.73 without;
+cross-validated over 0 and 1 with the power at 1, 0.72 / 0.73 held out (the fold that holds out
+sketch 01, the only sketch the refit changes much, chooses none). The matching issue's bar (0.80 in every orientation) is not
 reached; the annotators agree with each other at 0.74-0.77 on these sketches. These assertions keep
 what was reached. The released options on the released pipeline (oracle m, fnfix scoring)
 reproduce the authors' binary (0.565) within 0.05, upright as they were.
@@ -124,9 +126,12 @@ def test_cross_validated_position_refit_in_every_orientation(root):
         for refits in (0, 1)
     }
     cv = cross_validate(results, option="position_refits")
-    assert cv.f1 >= 0.73 and cv.place_accuracy >= 0.74, cv.table()
-    assert min(f1 for f1, _ in cv.by_orientation.values()) >= 0.71, cv.table()
-    assert cv.in_sample[1][0] > cv.in_sample[0][0], cv.table()
+    assert cv.f1 >= 0.71 and cv.place_accuracy >= 0.72, cv.table()
+    # Exact quarter-turn candidates: the same answers in every orientation.
+    by_orientation = [f1 for f1, _ in cv.by_orientation.values()]
+    assert len(by_orientation) == 8 and max(by_orientation) - min(by_orientation) < 1e-9, cv.table()
+    # The refit's gain in sample is sketch 01 alone (0.17 -> 1.00): held out, its fold chooses none.
+    assert cv.in_sample[1][0] > cv.in_sample[0][0] + 0.03, cv.table()
 
 
 _SEGMENTATIONS: dict = {}
