@@ -18,7 +18,7 @@ the input may cover any part of the metric map. With no known scale, both maps a
 the same extent and the free-space overlap fit of :mod:`ursim_core.matching.alignment` is used.
 
 Sketches are drawn out of proportion: for them the planar matcher is better (KTH: F1 0.72 against
-0.63). On E5 the overlay matcher with ``scale=1`` (not mirrored: its default) gives F1 0.67 (see the README).
+0.63). On E5 the overlay matcher with ``scale=1`` (not mirrored: its default) gives F1 0.66 (see the README).
 """
 
 from __future__ import annotations

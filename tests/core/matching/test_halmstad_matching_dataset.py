@@ -6,7 +6,7 @@ robot's sensor at one resolution (scale 1), so the default matcher (``matcher="a
 overlay matcher, not mirrored. The one value chosen on these maps is the overlay's IoU threshold,
 so the figure asserted is its leave-one-map-out cross-validation over 0.05, 0.15 and 0.3
 (0.15 chosen in every fold): measured mean F1 0.69 and place accuracy 0.65 over the 11 held-out
-maps (0.67 and 0.62 over the 20 runs); the worst map, E5_05, scores 0.14.
+maps (0.66 and 0.62 over the 20 runs); the worst map, E5_05, scores 0.14.
 The planar matcher, built for sketches, gives 0.27 here. The matching issue's bar is F1 0.65
 (DAM, a metric alignment method: 0.78).
 """
