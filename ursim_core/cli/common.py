@@ -89,6 +89,11 @@ def progress_bar(total: int, label: str) -> Callable[..., None]:
 
     Calling it with ``done >= total`` closes the bar.
     """
+    isatty = getattr(sys.stderr, "isatty", None)
+    if isatty is not None and not isatty():
+        # tqdm's disable=None would draw nothing here: skip importing it (about 20 ms, with
+        # importlib.metadata and multiprocessing's locks) for a bar nobody sees.
+        return _silent_progress()
     from tqdm import tqdm
 
     bar = tqdm(total=max(total, 1), desc=label, unit="step", file=sys.stderr, disable=None, leave=False)
@@ -103,6 +108,16 @@ def progress_bar(total: int, label: str) -> Callable[..., None]:
             bar.close()
 
     update.close = bar.close  # type: ignore[attr-defined]
+    return update
+
+
+def _silent_progress() -> Callable[..., None]:
+    """The callback of :func:`progress_bar` when stderr is not a terminal: does nothing."""
+
+    def update(done: int, new_total: int | None = None, text: str = "") -> None:
+        return None
+
+    update.close = lambda: None  # type: ignore[attr-defined]
     return update
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -75,7 +76,16 @@ def _command_of(argv: Sequence[str]) -> str | None:
     return None
 
 
+#: OpenBLAS's idle threads spin for 2**28 cycles (about 0.1 s) after numpy loads them before they
+#: sleep; 2**4 lets them sleep at once. Only how they wait changes, not their number nor any result:
+#: on the 2-CPU machine of the project the spinning thread cost every ``ursim`` process about
+#: 40 ms of CPU, taken from the main thread when the other CPU is busy. A value already set wins.
+_QUIET_BLAS_THREADS = {"OPENBLAS_THREAD_TIMEOUT": "4"}
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    for name, value in _QUIET_BLAS_THREADS.items():
+        os.environ.setdefault(name, value)  # before numpy is first imported (by the subcommand)
     argv = list(sys.argv[1:] if argv is None else argv)
     command = _command_of(argv)
     parser = build_parser(command if command in COMMANDS else "")
