@@ -160,16 +160,24 @@ def staged_folder(out: Path) -> Iterator[Path]:
 
     On an error (a full disk, an interruption) the temporary folder is removed and ``out`` is left
     as it was, so a run never leaves half of its outputs. Files are moved one by one with
-    ``os.replace`` (atomic on one file system), so each output in ``out`` is whole.
+    ``os.replace`` (atomic on one file system), so each output in ``out`` is whole, and ``out``
+    is synced once after the moves (the staging folder's own syncs are skipped: see
+    :func:`ursim_core.io.atomic.scratch_directory`).
     """
+    from ursim_core.io.atomic import scratch_directory, sync_directory
+
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
     try:
-        yield staging
+        # The staged files' contents are synced as they are saved; their names are made
+        # durable once, where they end up, not in the staging folder, which is removed.
+        with scratch_directory(staging):
+            yield staging
         out.mkdir(exist_ok=True)
         for item in sorted(staging.iterdir()):
             os.replace(item, out / item.name)
+        sync_directory(out)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 
