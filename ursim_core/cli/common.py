@@ -89,6 +89,11 @@ def progress_bar(total: int, label: str) -> Callable[..., None]:
 
     Calling it with ``done >= total`` closes the bar.
     """
+    isatty = getattr(sys.stderr, "isatty", None)
+    if isatty is not None and not isatty():
+        # tqdm's disable=None would draw nothing here: skip importing it (about 20 ms, with
+        # importlib.metadata and multiprocessing's locks) for a bar nobody sees.
+        return _silent_progress()
     from tqdm import tqdm
 
     bar = tqdm(total=max(total, 1), desc=label, unit="step", file=sys.stderr, disable=None, leave=False)
@@ -103,6 +108,16 @@ def progress_bar(total: int, label: str) -> Callable[..., None]:
             bar.close()
 
     update.close = bar.close  # type: ignore[attr-defined]
+    return update
+
+
+def _silent_progress() -> Callable[..., None]:
+    """The callback of :func:`progress_bar` when stderr is not a terminal: does nothing."""
+
+    def update(done: int, new_total: int | None = None, text: str = "") -> None:
+        return None
+
+    update.close = lambda: None  # type: ignore[attr-defined]
     return update
 
 
@@ -145,16 +160,24 @@ def staged_folder(out: Path) -> Iterator[Path]:
 
     On an error (a full disk, an interruption) the temporary folder is removed and ``out`` is left
     as it was, so a run never leaves half of its outputs. Files are moved one by one with
-    ``os.replace`` (atomic on one file system), so each output in ``out`` is whole.
+    ``os.replace`` (atomic on one file system), so each output in ``out`` is whole, and ``out``
+    is synced once after the moves (the staging folder's own syncs are skipped: see
+    :func:`ursim_core.io.atomic.scratch_directory`).
     """
+    from ursim_core.io.atomic import scratch_directory, sync_directory
+
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
     try:
-        yield staging
+        # The staged files' contents are synced as they are saved; their names are made
+        # durable once, where they end up, not in the staging folder, which is removed.
+        with scratch_directory(staging):
+            yield staging
         out.mkdir(exist_ok=True)
         for item in sorted(staging.iterdir()):
             os.replace(item, out / item.name)
+        sync_directory(out)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 

@@ -241,11 +241,11 @@ def _return_freed_memory() -> None:
     then taken from fresh pages, and the process peaks higher than with one thread.
     """
     import ctypes
-    import ctypes.util
 
-    name = ctypes.util.find_library("c")
+    # The process's own symbols include the C library's: ctypes.util.find_library("c") would
+    # run ``ldconfig -p`` in a subprocess to name it (10 ms of every ``ursim match``).
     try:
-        ctypes.CDLL(name).malloc_trim(0)
+        ctypes.CDLL(None).malloc_trim(0)
     except (OSError, AttributeError, TypeError):
         pass
 

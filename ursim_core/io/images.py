@@ -2,7 +2,8 @@
 
 The shared first half of every map loader (:mod:`ursim_core.io.maps` for plain images,
 :mod:`ursim_core.io.ros_yaml` for ROS map_server maps): read the file's bytes, decode them with
-Pillow under our own pixel limit, and turn the decoded image into :class:`Pixels` (colour and
+Pillow under our own pixel limit (a plain 8-bit PNG with OpenCV, to the same pixels:
+:mod:`ursim_core.io.png`), and turn the decoded image into :class:`Pixels` (colour and
 alpha arrays, 8 or 16 bit). The conversions to grey follow OpenCV (:func:`display_grey`) or
 ``cv::imread(IMREAD_GRAYSCALE)`` on a PNG (:func:`imread_grey`); the module docstring of
 :mod:`ursim_core.io.maps` says where each constant comes from.
@@ -25,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ursim_core.errors import MapError
+from ursim_core.io.png import decode_plain_png, plain_png_size
 from ursim_core.io.reading import read_regular_file
 
 __all__ = [
@@ -107,6 +109,8 @@ _LATE_HEADER_SIGNATURES = (b"II*\x00", b"MM\x00*", b"\xff\xd8", b"\x89PNG", b"8B
 
 def _check_header(head: bytes, path: Path, *, max_pixels: int, complete: bool) -> None:
     """Refuse from the first bytes alone: not an image, zero size, or too many pixels."""
+    if plain_png_size(head, max_pixels=max_pixels) is not None:
+        return  # a well-formed PNG header within the limit: what Pillow would let through too
     from PIL import Image
 
     with _quiet_pillow(max_pixels):
@@ -194,6 +198,11 @@ def _declared_size(data: bytes) -> tuple[int, int] | None:
 
 
 def decode_image(data: bytes, path: Path, *, max_pixels: int, apply_exif_orientation: bool) -> Pixels:
+    # Most maps are plain 8-bit PNGs, which OpenCV decodes to the same pixels without Pillow's
+    # import (:mod:`ursim_core.io.png`); everything else, and every error, is Pillow's.
+    plain = decode_plain_png(data, max_pixels=max_pixels)
+    if plain is not None:
+        return Pixels(*plain)
     from PIL import Image, UnidentifiedImageError
 
     with _quiet_pillow(max_pixels):
