@@ -9,9 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import cv2
-import numpy as np
 import pytest
+from test_cli import two_rooms
 
 from ursim_core.cli.common import progress_bar, staged_folder
 from ursim_core.io import atomic
@@ -19,15 +18,6 @@ from ursim_core.io import atomic
 # Modules the segment path has no use for (numba is left out: it compiles the kernels when
 # they are not built yet).
 NOT_ON_THE_SEGMENT_PATH = ("PIL", "tqdm", "scipy", "skimage", "matplotlib", "jsonschema", "multiprocessing")
-
-
-def two_rooms(path: Path) -> Path:
-    image = np.zeros((80, 170), np.uint8)
-    image[5:75, 5:80] = 255
-    image[5:75, 90:165] = 255
-    image[35:45, 80:90] = 255
-    cv2.imwrite(str(path), image)
-    return path
 
 
 def run_python(code: str, **environment: str) -> dict:

@@ -92,20 +92,25 @@ def test_default_matches_every_orientation_alike(root):
     assert max(means.values()) - min(means.values()) < 1e-9, means
 
 
-def test_cross_validated_orientation_ranking_in_every_orientation(root):
+def _cross_validated(root, option: str, values):
+    """Leave-one-sketch-out cross-validation of ``option`` over ``values`` (planar T4, dihedral)."""
     results = {
-        power: run_evaluation(
+        value: run_evaluation(
             root / "ursim_kth_sketches",
             matchers=["planar"],
             variants=["T4"],
             augment="dihedral",
             human=False,
-            config_overrides={"orientation_overlap": power},
+            config_overrides={option: value},
             segmentation_cache=_SEGMENTATIONS,
         )
-        for power in (0.0, 1.0)
+        for value in values
     }
-    cv = cross_validate(results, option="orientation_overlap")
+    return cross_validate(results, option=option)
+
+
+def test_cross_validated_orientation_ranking_in_every_orientation(root):
+    cv = _cross_validated(root, "orientation_overlap", (0.0, 1.0))
     assert cv.f1 >= 0.70 and cv.place_accuracy >= 0.72, cv.table()
     assert min(f1 for f1, _ in cv.by_orientation.values()) >= 0.70, cv.table()
     # Ranking by the score alone is worse held out too.
@@ -113,19 +118,7 @@ def test_cross_validated_orientation_ranking_in_every_orientation(root):
 
 
 def test_cross_validated_position_refit_in_every_orientation(root):
-    results = {
-        refits: run_evaluation(
-            root / "ursim_kth_sketches",
-            matchers=["planar"],
-            variants=["T4"],
-            augment="dihedral",
-            human=False,
-            config_overrides={"position_refits": refits},
-            segmentation_cache=_SEGMENTATIONS,
-        )
-        for refits in (0, 1)
-    }
-    cv = cross_validate(results, option="position_refits")
+    cv = _cross_validated(root, "position_refits", (0, 1))
     assert cv.f1 >= 0.71 and cv.place_accuracy >= 0.72, cv.table()
     # Exact quarter-turn candidates: the same answers in every orientation.
     by_orientation = [f1 for f1, _ in cv.by_orientation.values()]
