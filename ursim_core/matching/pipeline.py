@@ -71,7 +71,11 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     :func:`ursim_core.matching.orientation.orientation_candidates` is matched with the
     configured m (the automatic m by default) and the one whose answer scores lowest is kept;
     ties go to the earlier candidate, the identity first. The signatures are computed once:
-    only the position term and the neighbour orders depend on the orientation.
+    only the position term and the neighbour orders depend on the orientation. With
+    ``config.position_refits`` (the planar matcher), the answer in each orientation is matched
+    again with the sketch's positions laid on the metric map by its own pairs
+    (:mod:`ursim_core.matching.refit`); the answer found is kept in ``Prepared.chosen``.
+    ``config.matcher='auto'`` is resolved first (:meth:`MatchConfig.resolved`).
 
     Parameters
     ----------
