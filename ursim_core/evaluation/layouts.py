@@ -67,12 +67,6 @@ class Experiment:
         ``'kth'`` or ``'halmstad'``.
     dataset : Path
         The dataset folder the experiment was found in.
-    scale : float or None
-        Model-map pixels per input-map pixel when the layout knows it (as two ROS YAML
-        resolutions tell it): 1 for the Halmstad robot maps, which are all maps of one robot's
-        sensor at one resolution (the dataset's README: sensor-to-sensor ground-truth scale
-        0.998-1.000). None for sketches, which have no scale. ``MatchConfig(matcher="auto")``
-        then uses the overlay matcher.
     """
 
     name: str
@@ -81,7 +75,6 @@ class Experiment:
     ground_truth: dict[str, Path] = field(default_factory=dict)
     layout: str = "kth"
     dataset: Path | None = None
-    scale: float | None = None
 
     @property
     def annotators(self) -> tuple[str, ...]:
@@ -262,8 +255,6 @@ def _discover_halmstad(folder: Path) -> list[Experiment]:
                     ground_truth={annotator: gt_path},
                     layout="halmstad",
                     dataset=folder,
-                    # Both maps come from one robot's sensor: one resolution (see Experiment).
-                    scale=1.0,
                 )
             )
     return experiments

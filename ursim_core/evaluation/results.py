@@ -49,7 +49,7 @@ DEFAULT_M_GRID: tuple[float, ...] = tuple(round(0.025 * i, 10) for i in range(20
 MATCHERS = ("auto", "planar", "hungarian", "vf2", "overlay")
 #: The matchers an evaluation runs when none are named. 'auto' is what ``ursim match`` runs by
 #: default: the planar matcher, or the overlay matcher when the maps' relative scale is known
-#: (:meth:`ursim_core.matching.MatchConfig.resolved`).
+#: (``--set scale=R``; :meth:`ursim_core.matching.MatchConfig.resolved`).
 DEFAULT_MATCHERS = ("auto", "hungarian", "vf2")
 #: Descriptor variants in the order of the paper's Table 1 columns.
 VARIANTS = ("baseline", "T1", "T2", "T3", "T4")

@@ -295,7 +295,7 @@ def run_evaluation(
                 place_key=instance.place_job.key,
                 matcher=matcher,
                 variant=variant,
-                config=_config_for(base_config, matcher, variant, released, instance.experiment.scale),
+                config=_config_for(base_config, matcher, variant, released),
                 m_grid=tuple(m_grid),
                 references=reference,
                 legacy=legacy_mode,
@@ -434,11 +434,8 @@ def _scoring_mode(legacy: bool | str) -> str:
     return score_matches([], [], legacy=legacy).mode
 
 
-def _config_for(base, matcher: str, variant: str, released: bool, scale: float | None = None):
+def _config_for(base, matcher: str, variant: str, released: bool):
     changes: dict[str, Any] = {"matcher": matcher, "variant": variant, "m": AUTO}
-    if base.scale is None and scale is not None:
-        # What the layout knows of the maps' resolutions, as `ursim match` reads it from ROS YAML.
-        changes["scale"] = scale
     if released and variant != "T4":
         # The released code set uniqueness weights for URSIM (T4); the other variants are
         # defined by their own weights (T1/T2 equal, T3 size).
