@@ -137,3 +137,21 @@ def test_match_overlay_reads_the_scale_of_two_ros_maps(tmp_path):
     default = json.loads((out / "correspondences.json").read_text())
     assert default["matcher"]["config"]["scale"] == pytest.approx(2.0)
     assert default["cliques"] == document["cliques"]
+
+
+def test_match_a_metric_input_of_unknown_scale(tmp_path):
+    full = building()
+    part = cv2.resize(full[:, 140:], None, fx=0.7, fy=0.7, interpolation=cv2.INTER_NEAREST)
+    cv2.imwrite(str(tmp_path / "full.png"), full)
+    cv2.imwrite(str(tmp_path / "part.png"), part)
+    out = tmp_path / "out"
+    assert (
+        main(
+            ["match", str(tmp_path / "part.png"), str(tmp_path / "full.png"), "-o", str(out), "--input-kind", "metric"]
+        )
+        == 0
+    )
+    document = json.loads((out / "correspondences.json").read_text())
+    config = document["matcher"]["config"]
+    assert config["input_kind"] == "metric" and config["scale"] is None
+    assert len(document["cliques"]) >= 3

@@ -13,7 +13,7 @@ HELP = "Run the paper's experiments on a dataset folder and write a report."
 EXAMPLES = """examples:
   ursim evaluate ../shared/datasets/ursim_kth_sketches -o report/
   ursim evaluate ../shared/datasets/ursim_halmstad_robot_maps/E5 --matchers planar --variants T4
-  ursim evaluate ../shared/datasets/ursim_halmstad_robot_maps/E5 --matchers auto --variants T4 --set scale=1
+  ursim evaluate ../shared/datasets/ursim_halmstad_robot_maps/E5 --variants T4
   ursim evaluate ../shared/datasets/ursim_kth_sketches --matchers planar --variants T4 --augment dihedral
   ursim evaluate ../shared/datasets/ursim_kth_sketches --matchers planar --variants T4 --augment dihedral \
       --cross-validate orientation_overlap=0,0.5,1,2"""
@@ -32,8 +32,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=list(_DEFAULT_MATCHERS),
         choices=_MATCHERS,
-        help="default: auto hungarian vf2 (auto: what `ursim match` runs: the planar matcher, or the "
-        "overlay matcher when the maps' relative scale is given with --set scale=R)",
+        help="default: auto hungarian vf2 (auto: what `ursim match` runs: the planar matcher for "
+        "sketches, the overlay matcher for robot maps, as the Halmstad layout's are)",
     )
     parser.add_argument("--variants", nargs="+", default=_VARIANTS, choices=_VARIANTS)
     parser.add_argument(

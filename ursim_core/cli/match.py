@@ -72,9 +72,15 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
         "--scale",
         type=float,
         metavar="RATIO",
-        help="overlay matcher: metric-map pixels per input pixel when known (1 for two robot maps of one "
-        "resolution; read from the resolutions of two ROS YAML maps when not given); the input may then "
-        "cover any part of the metric map",
+        help="metric-map pixels per input pixel when known (1 for two robot maps of one resolution; read "
+        "from the resolutions of two ROS YAML maps when not given): the default matcher then overlays the "
+        "maps, and the input may cover any part of the metric map",
+    )
+    parser.add_argument(
+        "--input-kind",
+        choices=["sketch", "metric"],
+        help="what SKETCH is: 'metric' (a robot map, a floor plan drawn to scale) makes the default matcher "
+        "overlay the maps, estimating the scale when none is known (default: a sketch, unless the scale is known)",
     )
     parser.add_argument("--released", action="store_true", help="start from the released C++ code's options")
     parser.add_argument(
@@ -127,6 +133,8 @@ def match_config(args: argparse.Namespace):
         overrides["matcher"] = args.matcher
     if getattr(args, "scale", None) is not None:
         overrides["scale"] = args.scale
+    if getattr(args, "input_kind", None) is not None:
+        overrides["input_kind"] = args.input_kind
     return base.replace(**overrides)
 
 
@@ -191,6 +199,7 @@ OPTION_NAMES = (
     "variant",
     "matcher",
     "scale",
+    "input_kind",
     "released",
     "sketch_preset",
     "metric_preset",

@@ -67,6 +67,9 @@ class Experiment:
         ``'kth'`` or ``'halmstad'``.
     dataset : Path
         The dataset folder the experiment was found in.
+    input_kind : {'sketch', 'metric'}
+        What the input map is: 'metric' for the Halmstad robot maps (the layout holds robot maps
+        only), so that the automatic matcher overlays them (``MatchConfig.input_kind``).
     """
 
     name: str
@@ -75,6 +78,7 @@ class Experiment:
     ground_truth: dict[str, Path] = field(default_factory=dict)
     layout: str = "kth"
     dataset: Path | None = None
+    input_kind: str = "sketch"
 
     @property
     def annotators(self) -> tuple[str, ...]:
@@ -255,6 +259,7 @@ def _discover_halmstad(folder: Path) -> list[Experiment]:
                     ground_truth={annotator: gt_path},
                     layout="halmstad",
                     dataset=folder,
+                    input_kind="metric",
                 )
             )
     return experiments

@@ -48,8 +48,8 @@ DEFAULT_M_GRID: tuple[float, ...] = tuple(round(0.025 * i, 10) for i in range(20
 #: Matchers in the order of the report's rows.
 MATCHERS = ("auto", "planar", "hungarian", "vf2", "overlay")
 #: The matchers an evaluation runs when none are named. 'auto' is what ``ursim match`` runs by
-#: default: the planar matcher, or the overlay matcher when the maps' relative scale is known
-#: (``--set scale=R``; :meth:`ursim_core.matching.MatchConfig.resolved`).
+#: default: the planar matcher for sketches, the overlay matcher for metric maps (the layout says
+#: which its inputs are; :meth:`ursim_core.matching.MatchConfig.resolved`).
 DEFAULT_MATCHERS = ("auto", "hungarian", "vf2")
 #: Descriptor variants in the order of the paper's Table 1 columns.
 VARIANTS = ("baseline", "T1", "T2", "T3", "T4")

@@ -295,7 +295,7 @@ def run_evaluation(
                 place_key=instance.place_job.key,
                 matcher=matcher,
                 variant=variant,
-                config=_config_for(base_config, matcher, variant, released),
+                config=_config_for(base_config, matcher, variant, released, instance.experiment.input_kind),
                 m_grid=tuple(m_grid),
                 references=reference,
                 legacy=legacy_mode,
@@ -434,8 +434,11 @@ def _scoring_mode(legacy: bool | str) -> str:
     return score_matches([], [], legacy=legacy).mode
 
 
-def _config_for(base, matcher: str, variant: str, released: bool):
+def _config_for(base, matcher: str, variant: str, released: bool, input_kind: str = "sketch"):
     changes: dict[str, Any] = {"matcher": matcher, "variant": variant, "m": AUTO}
+    if base.input_kind is None:
+        # What the layout knows of its input maps (robot maps or sketches), unless told otherwise.
+        changes["input_kind"] = input_kind
     if released and variant != "T4":
         # The released code set uniqueness weights for URSIM (T4); the other variants are
         # defined by their own weights (T1/T2 equal, T3 size).

@@ -52,8 +52,8 @@ class MatchConfig:
         'planar': the seed-and-expand planar graph matcher of URSIM, built for sketches.
         'overlay': lay the maps on each other and pair what overlaps, for two metric maps
         (:mod:`ursim_core.matching.overlay`); m does not apply to it. 'auto' (default):
-        'overlay' when ``scale`` is known (two metric maps of known resolutions: a sketch has
-        none), else 'planar' (:meth:`resolved`).
+        'overlay' when the input is a metric map (``input_kind='metric'``) or ``scale`` is known
+        (two maps of known resolutions: a sketch has none), else 'planar' (:meth:`resolved`).
     m : 'auto' or float
         Threshold on ``c`` below which two regions are "the same". ``'auto'`` picks it
         per map pair over ``m_grid`` (:mod:`ursim_core.matching.auto_m`).
@@ -126,6 +126,10 @@ class MatchConfig:
         cover only part of the other. None: unknown; both maps are taken to cover the same extent.
     overlay_min_iou : float
         The overlay matcher pairs regions whose intersection over union is at least this.
+    input_kind : {'sketch', 'metric'} or None
+        What the input map is: 'metric' (a robot map, a floor plan drawn to scale) makes
+        ``matcher='auto'`` the overlay matcher; None (default) = unknown, taken as a sketch unless
+        ``scale`` is known.
     """
 
     variant: str = "T4"
@@ -153,6 +157,7 @@ class MatchConfig:
     orientation_overlap: float = 1.0
     scale: float | None = None
     overlay_min_iou: float = 0.15
+    input_kind: str | None = None
 
     def __post_init__(self):
         choices = {
@@ -207,6 +212,8 @@ class MatchConfig:
             or self.scale <= 0
         ):
             raise ParameterError(f"must be a positive number or null, not {self.scale!r}", field="scale")
+        if self.input_kind not in (None, "sketch", "metric"):
+            raise ParameterError(f"must be 'sketch', 'metric' or null, not {self.input_kind!r}", field="input_kind")
         if self.mirrored not in (None, True, False):
             raise ParameterError(f"must be true, false or null, not {self.mirrored!r}", field="mirrored")
         if (
@@ -293,19 +300,20 @@ class MatchConfig:
     def resolved(self) -> MatchConfig:
         """This configuration with its automatic choices made: what the matcher runs.
 
-        ``matcher='auto'`` becomes 'overlay' when ``scale`` is known and 'planar' otherwise;
-        for the overlay matcher an unknown ``mirrored`` becomes False.
+        ``matcher='auto'`` becomes 'overlay' when the input is a metric map or ``scale`` is known,
+        and 'planar' otherwise; for the overlay matcher an unknown ``mirrored`` becomes False.
 
         Examples
         --------
         >>> MatchConfig().resolved().matcher, MatchConfig(scale=1.0).resolved().matcher
         ('planar', 'overlay')
-        >>> MatchConfig(scale=1.0).resolved().mirrored
-        False
+        >>> MatchConfig(scale=1.0).resolved().mirrored, MatchConfig(input_kind="metric").resolved().matcher
+        (False, 'overlay')
         """
         matcher = self.matcher
         if matcher == "auto":
-            matcher = "overlay" if self.scale is not None else "planar"
+            metric = self.input_kind == "metric" or (self.input_kind is None and self.scale is not None)
+            matcher = "overlay" if metric else "planar"
         mirrored = False if matcher == "overlay" and self.mirrored is None else self.mirrored
         if (matcher, mirrored) == (self.matcher, self.mirrored):
             return self
@@ -316,8 +324,9 @@ class MatchConfig:
 
         Two georeferenced maps (ROS YAML) tell their relative scale: metric pixels per input
         pixel = input resolution / metric resolution. It is filled in only when the matcher
-        uses it ('auto' or 'overlay') and no scale was given; a map without a resolution (a
-        sketch, a bare image) leaves the configuration as it is.
+        uses it ('auto' or 'overlay') and no scale was given. An input with a resolution is a
+        metric map (``input_kind``, when not given); a map without one (a sketch, a bare image)
+        changes nothing.
 
         Examples
         --------
@@ -325,12 +334,17 @@ class MatchConfig:
         2.0
         >>> MatchConfig().with_resolutions(None, 0.05).scale is None
         True
+        >>> MatchConfig().with_resolutions(0.05, None).input_kind
+        'metric'
         """
-        if self.matcher not in ("auto", "overlay") or self.scale is not None:
-            return self
+        config = self
+        if sketch_resolution and config.input_kind is None:
+            config = config.replace(input_kind="metric")
+        if config.matcher not in ("auto", "overlay") or config.scale is not None:
+            return config
         if not sketch_resolution or not metric_resolution:
-            return self
-        return self.replace(scale=float(sketch_resolution) / float(metric_resolution))
+            return config
+        return config.replace(scale=float(sketch_resolution) / float(metric_resolution))
 
     def replace(self, **changes) -> MatchConfig:
         """A copy with some fields changed (validated like a new config).

@@ -111,7 +111,7 @@ class MatchingPanel(QWidget):
         self.scale.setRange(0.0, 100.0)
         self.scale.setDecimals(3)
         self.scale.setSingleStep(0.05)
-        self.scale.setSpecialValueText("unknown (same extent)")
+        self.scale.setSpecialValueText("unknown (estimated)")
         self.scale.setValue(0.0)
         self.scale.setToolTip(
             "Metric-map pixels per input-map pixel when known (1 for two robot maps of one resolution): "

@@ -122,3 +122,24 @@ def test_a_mirror_image_is_tried_by_the_overlay_only_when_asked():
     assert MatchConfig(matcher="overlay").resolved().mirrored is False
     assert MatchConfig(matcher="overlay", mirrored=True).resolved().mirrored is True
     assert MatchConfig(matcher="planar").resolved().mirrored is None
+
+
+@pytest.mark.parametrize("factor", [0.6, 1.5])
+def test_the_scale_of_a_rescaled_crop_is_estimated(plan, factor):
+    import cv2
+
+    from ursim_core.matching.overlay import estimate_scale
+
+    part = plan.free[:, plan.free.shape[1] // 4 :].astype(np.uint8)
+    rescaled = cv2.resize(part, None, fx=factor, fy=factor, interpolation=cv2.INTER_NEAREST) > 0
+    estimated = estimate_scale(rescaled, plan.free, orientations=[(0.0, False), (90.0, False), (180.0, False)])
+    assert abs(np.log(estimated * factor)) < np.log(1.1), estimated  # metric pixels per input pixel = 1 / factor
+
+
+def test_a_metric_input_is_overlaid_by_the_automatic_matcher(plan, plan_segmentation):
+    told = prepare(plan_segmentation, plan_segmentation, MatchConfig(input_kind="metric"))
+    assert (told.config.matcher, told.config.mirrored) == ("overlay", False)
+    assert sorted(match_prepared(told).pairs) == [(n, n) for n in sorted(plan_segmentation.graph.nodes)]
+    assert MatchConfig(input_kind="sketch", scale=1.0).resolved().matcher == "planar"
+    with pytest.raises(ParameterError, match="input_kind"):
+        MatchConfig(input_kind="robot")
