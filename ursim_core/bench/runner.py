@@ -72,13 +72,12 @@ def run_bench(
         from ursim_core.matching import MatchConfig
 
         print(
-            "== robot-map-like inputs: a copy of each plan turned, cropped (not rescaled, not mirrored), "
-            "overlay matcher told scale 1 and not mirrored"
+            "== robot-map-like inputs: a copy of each plan turned, cropped, rescaled (not mirrored), "
+            "the default matcher told only that the input is a metric map (the scale is estimated)"
         )
-        overlay = MatchConfig(matcher="overlay", scale=1.0, mirrored=False)
-        print_invariance(
-            bench_invariance(range(seeds), kinds=("upright", "turned", "cropped"), config=overlay, plan_copy=True)
-        )
+        metric = MatchConfig(input_kind="metric")
+        kinds = ("upright", "turned", "cropped", "rescaled")
+        print_invariance(bench_invariance(range(seeds), kinds=kinds, config=metric, plan_copy=True))
         return 0
     if what in _OPTIONAL:
         import importlib
