@@ -37,7 +37,7 @@ VARIANTS = (
     ("baseline", "baseline"),
 )
 MATCHERS = (
-    ("auto", "automatic (planar; overlay with a known scale)"),
+    ("auto", "automatic (planar for a sketch, overlay for a metric map)"),
     ("planar", "planar expansion"),
     ("hungarian", "Hungarian"),
     ("vf2", "VF2"),
