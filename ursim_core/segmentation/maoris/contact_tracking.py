@@ -51,6 +51,7 @@ def start_tracking(labels, width, alive, *, bands=None):
     joined = counted[0]
     for band in counted[1:]:
         joined = compiled.join_counts(joined, band)
-    pixels, following, head, tail, _, keys, counts, meta, slots, total = joined
+    pixels, used, keys, counts, meta, slots, total = joined
+    pixels, following, head, tail = compiled.group_candidates(labels, pixels, used, n)
     parent = np.arange(n, dtype=np.int32)
     return original, compact_of, (parent, pixels, following, head, tail, keys, counts, meta, slots, total)

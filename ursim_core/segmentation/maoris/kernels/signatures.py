@@ -22,7 +22,7 @@ _INT, _FLOAT = types.int64, types.float64
 # The compact zone graph (records, nodes); the contact counts of count_contacts; the
 # tracking state of start_tracking (original, compact_of, (parent, pixels, ...)).
 _GRAPH = types.UniTuple(_I32_2D, 2)
-_COUNTS = types.Tuple((_I32, _I32, _I32, _I32, _INT, _I64, _I64, _I64, _I64, _I64))
+_COUNTS = types.Tuple((_I32, _INT, _I64, _I64, _I64, _I64, _I64))
 _STATE = types.Tuple((_I32, _I32, _I32, _I32, _I32, _I64, _I64, _I64, _I64, _I64))
 _TRACKING = types.Tuple((_I32, _I32, _STATE))
 
@@ -42,6 +42,7 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
     ("contacts", "_compact_labels"): (_I32, _BOOL),
     ("contacts", "count_contacts"): (_I32, _INT, _INT, _INT, _INT),
     ("contacts", "join_counts"): (_COUNTS, _COUNTS),
+    ("contacts", "group_candidates"): (_I32, _I32, _INT, _INT),
     ("contacts", "contact_table"): (_I32, _INT, _BOOL),
     ("fusion", "merge_ripples"): (_I32, _FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
     ("fusion", "remove_doors"): (_FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
