@@ -10,7 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from ursim_core.errors import ParameterError
-from ursim_core.segmentation.maoris.inscribed_circle import _as_free_mask, _free_bbox, inscribed_circle_image, quantize
+from ursim_core.segmentation.maoris.inscribed_circle import (
+    _as_free_mask,
+    _free_bbox,
+    _quantized_radii,
+    inscribed_circle_radii,
+)
 from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
 from ursim_core.segmentation.maoris.steps import (
     mark_unbreakable_edges,
@@ -64,7 +69,7 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
-    values = quantize(inscribed_circle_image(free, max_radius=params.max_radius), quantum=params.quantum)
+    values = _quantized_radii(inscribed_circle_radii(free, max_radius=params.max_radius), params.quantum)
     graph = ZoneGraph(flat_zones(values), values)
     # Large temporaries go as soon as they are read: the zone graph keeps what it needs, and the
     # output is allocated last (at 8000 x 8000 each full-size image is 64-256 MB).
