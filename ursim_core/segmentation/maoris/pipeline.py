@@ -69,8 +69,12 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
-    values = _quantized_radii(inscribed_circle_radii(free, max_radius=params.max_radius), params.quantum)
-    graph = ZoneGraph(flat_zones(values), values)
+    radii = inscribed_circle_radii(free, max_radius=params.max_radius)
+    values = _quantized_radii(radii, params.quantum)
+    # The zones are labelled over the radii, read only for the values (a fresh image of that
+    # size costs more in page faults than the labelling).
+    graph = ZoneGraph(flat_zones(values, out=radii), values)
+    del radii
     # Large temporaries go as soon as they are read: the zone graph keeps what it needs, and the
     # output is allocated last (at 8000 x 8000 each full-size image is 64-256 MB).
     del values, free
