@@ -14,7 +14,7 @@ from ursim_core.segmentation.maoris.inscribed_circle import (
     _as_free_mask,
     _free_bbox,
     _quantized_radii,
-    inscribed_circle_radii,
+    _radii_in_storage,
 )
 from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
 from ursim_core.segmentation.maoris.steps import (
@@ -25,7 +25,7 @@ from ursim_core.segmentation.maoris.steps import (
     remove_small_zones,
     watershed_merge,
 )
-from ursim_core.segmentation.maoris.zone_graph import ZoneGraph, flat_zones
+from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, flat_zones
 
 __all__ = ["maoris_labels", "compile_kernels"]
 
@@ -69,12 +69,13 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
-    radii = inscribed_circle_radii(free, max_radius=params.max_radius)
+    # The window is its own bounding box: the radii of inscribed_circle_radii(free).
+    radii, storage = _radii_in_storage(free, params.max_radius, padding=_PAD)
     values = _quantized_radii(radii, params.quantum)
-    # The zones are labelled over the radii, read only for the values (a fresh image of that
-    # size costs more in page faults than the labelling).
-    graph = ZoneGraph(flat_zones(values, out=radii), values)
-    del radii
+    # The zones are labelled over the radii, read only for the values, and the graph pads
+    # them in place (a fresh image of that size costs more in page faults than the pass).
+    graph = ZoneGraph(flat_zones(values, out=radii), values, _storage=storage)
+    del radii, storage
     # Large temporaries go as soon as they are read: the zone graph keeps what it needs, and the
     # output is allocated last (at 8000 x 8000 each full-size image is 64-256 MB).
     del values, free

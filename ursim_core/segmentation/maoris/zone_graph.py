@@ -114,14 +114,15 @@ class ZoneGraph:
     ([1, 2], [2], 100)
     """
 
-    def __init__(self, zones: np.ndarray, values: np.ndarray):
+    def __init__(self, zones: np.ndarray, values: np.ndarray, *, _storage: np.ndarray | None = None):
+        # _storage (private): int32 memory whose first pixels are ``zones`` (C-ordered), with
+        # room for them padded; the labels are padded in it, in place, not copied.
         zones = np.asarray(zones)
         values = np.asarray(values)
         if zones.shape != values.shape or zones.ndim != 2:
             raise SegmentationError(f"zones {zones.shape} and values {values.shape} must be 2-D of equal shape")
         self.shape = zones.shape
         zones = zones.astype(np.int32, copy=False)
-        self._labels = np.pad(zones, _PAD)
         count = int(zones.max(initial=0))
         value, self._size = kernels().zone_values_and_sizes(zones, values, count + 1)
         self._value_array = value
@@ -131,6 +132,7 @@ class ZoneGraph:
         self._alive = self._size > 0
         self._alive[0] = False
         self._compact: tuple | None = kernels().build_adjacency(zones, value)
+        self._labels = np.pad(zones, _PAD) if _storage is None else _pad_in_place(zones, _storage)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         # Contact counts, computed for the whole image when first queried and
         # dropped by the next fusion (the compiled steps track their own).
@@ -347,6 +349,20 @@ class ZoneGraph:
         self._contacts = None
         for neighbour in self.adj.pop(zone):
             del self.adj[neighbour][zone]
+
+
+def _pad_in_place(zones: np.ndarray, storage: np.ndarray) -> np.ndarray:
+    """``np.pad(zones, _PAD)`` written in ``storage``, whose first pixels ``zones`` are."""
+    rows, cols = zones.shape
+    padded = storage[: (rows + 2 * _PAD) * (cols + 2 * _PAD)].reshape(rows + 2 * _PAD, cols + 2 * _PAD)
+    if zones.ctypes.data != storage.ctypes.data or not zones.flags.c_contiguous:
+        raise SegmentationError("zones must be the first pixels of their storage")
+    # Last row first: each row moves to a later place than any row above it starts from.
+    for row in range(rows - 1, -1, -1):
+        padded[row + _PAD, _PAD : _PAD + cols] = zones[row]
+    padded[:_PAD] = padded[-_PAD:] = 0
+    padded[:, :_PAD] = padded[:, -_PAD:] = 0
+    return padded
 
 
 def _adjacency_from_entries(zone, other, minimum, unbreakable, value):
