@@ -222,7 +222,9 @@ def count_contacts(labels, width, n, start, stop):
     contour sizes). The pixels outside the range are only read, so bands of
     rows can be counted at the same time (:func:`start_tracking`).
     """
-    pixels = np.empty(1024, np.int32)
+    # Room for every pixel of the range: pages never written are never faulted in, while
+    # growing by doubling copied the candidates about twice over, into fresh pages.
+    pixels = np.empty(max(stop - start, 1), np.int32)
     keys, counts, meta = _new_table(np.int64(16))
     slots = _filled(n * _SLOTS, -1, np.int64)
     for zone in range(n):
@@ -241,8 +243,6 @@ def count_contacts(labels, width, n, start, stop):
         # No fusion yet: every label is its own zone.
         if zone == 0 or _same_labels_around(labels, pixel, width):
             continue
-        if n_candidates == len(pixels):
-            pixels = _grown(pixels, 2 * n_candidates, 0)
         pixels[n_candidates] = pixel
         n_candidates += 1
         _raw_neighbourhood(labels, pixel, width, around)
