@@ -227,7 +227,8 @@ class ZoneGraph:
 
     @property
     def labels(self) -> np.ndarray:
-        """Current zone label image, shape ``self.shape`` (a view; do not modify)."""
+        """Current zone label image, shape ``self.shape`` (a view, rewritten in place by later
+        fusions; do not modify)."""
         self._flush()
         return self._labels[_PAD:-_PAD, _PAD:-_PAD]
 
@@ -282,7 +283,9 @@ class ZoneGraph:
             if np.array_equal(jumped, parent[zones]):
                 break
             parent[zones] = jumped
-        self._labels = parent[self._labels]
+        # In place: parent[self._labels] allocated a fresh full-size image (256 MB at 8000 px),
+        # whose page faults cost more than the pass. Views taken earlier (``labels``) change too.
+        kernels().relabel(self._labels.ravel(), parent)
         parent[zones] = zones
         self._pending = {}
 
