@@ -86,12 +86,8 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     remove_doors(graph, doors=params.doors)
     remove_small_zones(graph, min_size=params.small_after)
     remove_isolated_zones(graph)
-    inner = graph.label_image()
-    del graph
-    if inner.shape == shape:
-        return inner
     labels = np.zeros(shape, np.int32)
-    labels[window] = inner
+    graph._write_label_image(labels[window])
     return labels
 
 
