@@ -257,3 +257,36 @@ def test_segmentation_is_the_same_with_contacts_counted_in_bands(monkeypatch):
     monkeypatch.setattr(_contacts, "_BAND_PIXELS", 0)
     monkeypatch.setattr(_contacts, "_usable_cpus", lambda: 3)
     np.testing.assert_array_equal(maoris_labels(free, PRESETS["robot"]), expected)
+
+
+def test_grouped_candidates_are_each_zones_candidates_in_raster_order():
+    """group_candidates against a stable sort by zone: each zone's list holds its candidates
+    in raster order, stored contiguously."""
+    from ursim_core.segmentation.maoris.compiled import kernels
+
+    rng = np.random.default_rng(5)
+    labels = np.pad(rng.integers(1, 7, (9, 11)).astype(np.int32), 2).ravel()
+    n = 7
+    pixels = np.flatnonzero(labels).astype(np.int32)[::2].copy()  # any raster-ordered subset
+    used = len(pixels) - 3  # entries past ``used`` are ignored
+    grouped, following, head, tail = kernels().group_candidates(labels, pixels, used, n)
+    order = np.argsort(labels[pixels[:used]], kind="stable")
+    np.testing.assert_array_equal(grouped[:used], pixels[:used][order])
+    for zone in range(n):
+        walk, candidate = [], head[zone]
+        while candidate != -1:
+            walk.append(int(grouped[candidate]))
+            candidate = following[candidate]
+        expected = [int(p) for p in pixels[:used] if labels[p] == zone]
+        assert walk == expected
+        assert (head[zone] == -1) == (not expected)
+        if expected:
+            assert tail[zone] - head[zone] == len(expected) - 1
+
+
+def test_flat_zones_into_a_used_image_equal_fresh_ones():
+    from ursim_core.synth import make_large_building
+
+    values = quantize(inscribed_circle_image(make_large_building(300, seed=1).free), quantum=5)
+    out = np.full(values.shape, 12345, np.int32)
+    np.testing.assert_array_equal(flat_zones(values, out=out), flat_zones(values))

@@ -57,7 +57,7 @@ ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
     "discs": ("centre_rectangles", "paint_discs"),
     "flat_zones": ("label_flat_zones", "zone_values_and_sizes", "first_pixels", "resolve_parents", "relabel"),
     "adjacency": ("build_adjacency", "adjacency_entries", "_link_entries", "remove_small_zones"),
-    "contacts": ("_compact_labels", "count_contacts", "join_counts", "contact_table"),
+    "contacts": ("_compact_labels", "count_contacts", "join_counts", "group_candidates", "contact_table"),
     "fusion": ("merge_ripples", "remove_doors"),
     "flooding": ("flood_levels", "clearance_levels"),
 }

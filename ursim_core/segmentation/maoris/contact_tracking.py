@@ -31,9 +31,11 @@ def start_tracking(labels, width, alive, *, bands=None):
     compact_of, state)`` for the compiled steps that track contacts.
 
     The state is ``(parent, pixels, following, head, tail, keys, counts,
-    meta, slots, total)``: union-find parents of the labels, then the arrays
-    of ``count_contacts``. Large images are counted in ``bands`` of rows
-    at the same time (default: one per CPU, at most 4), each on a thread.
+    meta, slots, total)``: union-find parents of the labels, each zone's
+    border candidates linked by ``group_candidates`` (stored contiguously),
+    then the counts of ``count_contacts``. Large images are counted in
+    ``bands`` of rows at the same time (default: one per CPU, at most 4),
+    each on a thread.
     """
     compiled = kernels()
     original, compact_of, n = compiled._compact_labels(labels, alive)
@@ -51,6 +53,7 @@ def start_tracking(labels, width, alive, *, bands=None):
     joined = counted[0]
     for band in counted[1:]:
         joined = compiled.join_counts(joined, band)
-    pixels, following, head, tail, _, keys, counts, meta, slots, total = joined
+    pixels, used, keys, counts, meta, slots, total = joined
+    pixels, following, head, tail = compiled.group_candidates(labels, pixels, used, n)
     parent = np.arange(n, dtype=np.int32)
     return original, compact_of, (parent, pixels, following, head, tail, keys, counts, meta, slots, total)

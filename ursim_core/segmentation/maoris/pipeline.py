@@ -10,7 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from ursim_core.errors import ParameterError
-from ursim_core.segmentation.maoris.inscribed_circle import _as_free_mask, _free_bbox, inscribed_circle_image, quantize
+from ursim_core.segmentation.maoris.inscribed_circle import (
+    _as_free_mask,
+    _free_bbox,
+    _quantized_radii,
+    _radii_in_storage,
+)
 from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
 from ursim_core.segmentation.maoris.steps import (
     mark_unbreakable_edges,
@@ -20,7 +25,7 @@ from ursim_core.segmentation.maoris.steps import (
     remove_small_zones,
     watershed_merge,
 )
-from ursim_core.segmentation.maoris.zone_graph import ZoneGraph, flat_zones
+from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, flat_zones
 
 __all__ = ["maoris_labels", "compile_kernels"]
 
@@ -64,8 +69,13 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
-    values = quantize(inscribed_circle_image(free, max_radius=params.max_radius), quantum=params.quantum)
-    graph = ZoneGraph(flat_zones(values), values)
+    # The window is its own bounding box: the radii of inscribed_circle_radii(free).
+    radii, storage = _radii_in_storage(free, params.max_radius, padding=_PAD)
+    values = _quantized_radii(radii, params.quantum)
+    # The zones are labelled over the radii, read only for the values, and the graph pads
+    # them in place (a fresh image of that size costs more in page faults than the pass).
+    graph = ZoneGraph(flat_zones(values, out=radii), values, _storage=storage)
+    del radii, storage
     # Large temporaries go as soon as they are read: the zone graph keeps what it needs, and the
     # output is allocated last (at 8000 x 8000 each full-size image is 64-256 MB).
     del values, free
@@ -76,12 +86,8 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     remove_doors(graph, doors=params.doors)
     remove_small_zones(graph, min_size=params.small_after)
     remove_isolated_zones(graph)
-    inner = graph.label_image()
-    del graph
-    if inner.shape == shape:
-        return inner
     labels = np.zeros(shape, np.int32)
-    labels[window] = inner
+    graph._write_label_image(labels[window])
     return labels
 
 

@@ -18,10 +18,18 @@ from ursim_core.segmentation.maoris.kernels.constants import NO_MINIMUM
 __all__ = ["flat_zones", "ZoneGraph", "ZoneEdge"]
 
 
-def flat_zones(values: np.ndarray) -> np.ndarray:
+def flat_zones(values: np.ndarray, *, out: np.ndarray | None = None) -> np.ndarray:
     """4-connected components of equal non-zero value.
 
     Zones are numbered 1..N in the raster order of their first pixel; 0 stays 0.
+
+    Parameters
+    ----------
+    values : ndarray, shape (rows, cols)
+    out : ndarray of int32, shape (rows, cols), C-ordered, keyword-only
+        Where to write the labels (its content is ignored), e.g. an image no longer needed:
+        at 8000 px a fresh 256 MB image costs more in page faults than labelling it.
+        Default: a new array.
 
     Examples
     --------
@@ -31,7 +39,11 @@ def flat_zones(values: np.ndarray) -> np.ndarray:
     values = np.asarray(values)
     if values.ndim != 2:
         raise SegmentationError(f"value image must be 2-D, got shape {values.shape}")
-    return kernels().label_flat_zones(_as_value_bytes(values))
+    if out is None:
+        out = np.empty(values.shape, np.int32)
+    elif out.shape != values.shape or out.dtype != np.int32 or not out.flags.c_contiguous:
+        raise SegmentationError(f"out must be C-ordered int32 of shape {values.shape}")
+    return kernels().label_flat_zones(_as_value_bytes(values), out)
 
 
 def _as_value_bytes(values: np.ndarray) -> np.ndarray:
@@ -102,14 +114,15 @@ class ZoneGraph:
     ([1, 2], [2], 100)
     """
 
-    def __init__(self, zones: np.ndarray, values: np.ndarray):
+    def __init__(self, zones: np.ndarray, values: np.ndarray, *, _storage: np.ndarray | None = None):
+        # _storage (private): int32 memory whose first pixels are ``zones`` (C-ordered), with
+        # room for them padded; the labels are padded in it, in place, not copied.
         zones = np.asarray(zones)
         values = np.asarray(values)
         if zones.shape != values.shape or zones.ndim != 2:
             raise SegmentationError(f"zones {zones.shape} and values {values.shape} must be 2-D of equal shape")
         self.shape = zones.shape
         zones = zones.astype(np.int32, copy=False)
-        self._labels = np.pad(zones, _PAD)
         count = int(zones.max(initial=0))
         value, self._size = kernels().zone_values_and_sizes(zones, values, count + 1)
         self._value_array = value
@@ -119,6 +132,7 @@ class ZoneGraph:
         self._alive = self._size > 0
         self._alive[0] = False
         self._compact: tuple | None = kernels().build_adjacency(zones, value)
+        self._labels = np.pad(zones, _PAD) if _storage is None else _pad_in_place(zones, _storage)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         # Contact counts, computed for the whole image when first queried and
         # dropped by the next fusion (the compiled steps track their own).
@@ -213,7 +227,8 @@ class ZoneGraph:
 
     @property
     def labels(self) -> np.ndarray:
-        """Current zone label image, shape ``self.shape`` (a view; do not modify)."""
+        """Current zone label image, shape ``self.shape`` (a view, rewritten in place by later
+        fusions; do not modify)."""
         self._flush()
         return self._labels[_PAD:-_PAD, _PAD:-_PAD]
 
@@ -241,13 +256,24 @@ class ZoneGraph:
 
     def label_image(self) -> np.ndarray:
         """Labels renumbered 1..N in the raster order of each region's first pixel."""
+        return self._renumbering()[self.labels]
+
+    def _renumbering(self) -> np.ndarray:
+        """The lookup zone -> label of :meth:`label_image` (flushes)."""
         self._flush()
         zones = np.array(self.vertices(), np.int64)
         # The padding adds no labels, so raster order in it is raster order in the map.
         first = kernels().first_pixels(self._labels, len(self._value))[zones]
         lookup = np.zeros(len(self._value), np.int32)
         lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
-        return lookup[self.labels]
+        return lookup
+
+    def _write_label_image(self, out: np.ndarray) -> None:
+        """Write :meth:`label_image` into ``out`` (shape ``self.shape``, any strides), renumbering
+        the graph's own labels in place: the graph must not be used afterwards. At 8000 px this
+        spares a fresh 256 MB image (its page faults cost more than the pass)."""
+        kernels().relabel(self._labels.ravel(), self._renumbering())
+        out[...] = self._labels[_PAD:-_PAD, _PAD:-_PAD]
 
     # -- contacts and relabelling -------------------------------------------
 
@@ -268,7 +294,9 @@ class ZoneGraph:
             if np.array_equal(jumped, parent[zones]):
                 break
             parent[zones] = jumped
-        self._labels = parent[self._labels]
+        # In place: parent[self._labels] allocated a fresh full-size image (256 MB at 8000 px),
+        # whose page faults cost more than the pass. Views taken earlier (``labels``) change too.
+        kernels().relabel(self._labels.ravel(), parent)
         parent[zones] = zones
         self._pending = {}
 
@@ -335,6 +363,20 @@ class ZoneGraph:
         self._contacts = None
         for neighbour in self.adj.pop(zone):
             del self.adj[neighbour][zone]
+
+
+def _pad_in_place(zones: np.ndarray, storage: np.ndarray) -> np.ndarray:
+    """``np.pad(zones, _PAD)`` written in ``storage``, whose first pixels ``zones`` are."""
+    rows, cols = zones.shape
+    padded = storage[: (rows + 2 * _PAD) * (cols + 2 * _PAD)].reshape(rows + 2 * _PAD, cols + 2 * _PAD)
+    if zones.ctypes.data != storage.ctypes.data or not zones.flags.c_contiguous:
+        raise SegmentationError("zones must be the first pixels of their storage")
+    # Last row first: each row moves to a later place than any row above it starts from.
+    for row in range(rows - 1, -1, -1):
+        padded[row + _PAD, _PAD : _PAD + cols] = zones[row]
+    padded[:_PAD] = padded[-_PAD:] = 0
+    padded[:, :_PAD] = padded[:, -_PAD:] = 0
+    return padded
 
 
 def _adjacency_from_entries(zone, other, minimum, unbreakable, value):

@@ -215,18 +215,16 @@ def count_contacts(labels, width, n, start, stop):
     """Contact counts of the pixels ``start..stop - 1`` of a compact, padded,
     flattened label image (``n`` zones; every label its own zone).
 
-    Returns ``(pixels, following, head, tail, used, keys, counts, meta, slots,
-    total)``: the border candidates of each zone as linked lists over the
-    candidate arrays, in raster order (``pixels[k]`` a pixel, ``following[k]``
-    the next candidate or -1, ``head`` / ``tail`` per zone, ``used`` entries
-    in use); the contact counts (per-zone slots, the shared table, ``total`` =
+    Returns ``(pixels, used, keys, counts, meta, slots, total)``: the border
+    candidates (pixels not surrounded by their own label) in raster order,
+    ``used`` of them in use (:func:`group_candidates` links them into one list
+    per zone); the contact counts (per-zone slots, the shared table, ``total`` =
     contour sizes). The pixels outside the range are only read, so bands of
     rows can be counted at the same time (:func:`start_tracking`).
     """
-    pixels = np.empty(1024, np.int32)
-    following = np.empty(1024, np.int32)
-    head = _filled(n, -1, np.int32)
-    tail = _filled(n, -1, np.int32)
+    # Room for every pixel of the range: pages never written are never faulted in, while
+    # growing by doubling copied the candidates about twice over, into fresh pages.
+    pixels = np.empty(max(stop - start, 1), np.int32)
     keys, counts, meta = _new_table(np.int64(16))
     slots = _filled(n * _SLOTS, -1, np.int64)
     for zone in range(n):
@@ -245,16 +243,7 @@ def count_contacts(labels, width, n, start, stop):
         # No fusion yet: every label is its own zone.
         if zone == 0 or _same_labels_around(labels, pixel, width):
             continue
-        if n_candidates == len(pixels):
-            pixels = _grown(pixels, 2 * n_candidates, 0)
-            following = _grown(following, 2 * n_candidates, 0)
         pixels[n_candidates] = pixel
-        following[n_candidates] = -1
-        if tail[zone] == -1:
-            head[zone] = n_candidates
-        else:
-            following[tail[zone]] = n_candidates
-        tail[zone] = n_candidates
         n_candidates += 1
         _raw_neighbourhood(labels, pixel, width, around)
         own = around[4]
@@ -276,30 +265,21 @@ def count_contacts(labels, width, n, start, stop):
         if pending_keys[index] != _EMPTY:
             key = pending_keys[index]
             _contact_add(slots, keys, counts, meta, base, key // base, key % base, pending_counts[index])
-    return pixels, following, head, tail, n_candidates, keys, counts, meta, slots, total
+    return pixels, n_candidates, keys, counts, meta, slots, total
 
 
 @njit(cache=True)
 def join_counts(first, second):
     """The counts of two bands of rows (:func:`count_contacts`), ``second``
     below ``first``, as one: ``first``'s arrays, extended."""
-    pixels, following, head, tail, used, keys, counts, meta, slots, total = first
-    pixels_b, following_b, head_b, tail_b, used_b, keys_b, counts_b, meta_b, slots_b, total_b = second
-    n = len(head)
+    pixels, used, keys, counts, meta, slots, total = first
+    pixels_b, used_b, keys_b, counts_b, meta_b, slots_b, total_b = second
+    n = len(total)
     if used + used_b > len(pixels):
         pixels = _grown(pixels, used + used_b, 0)
-        following = _grown(following, used + used_b, 0)
     for k in range(used_b):
         pixels[used + k] = pixels_b[k]
-        following[used + k] = following_b[k] + used if following_b[k] != -1 else -1
     for zone in range(n):
-        if head_b[zone] == -1:
-            continue
-        if tail[zone] == -1:
-            head[zone] = head_b[zone] + used
-        else:
-            following[tail[zone]] = head_b[zone] + used
-        tail[zone] = tail_b[zone] + used
         total[zone] += total_b[zone]
     base = np.int64(n)
     # Room for every count of the second band, wherever each one lands.
@@ -315,7 +295,45 @@ def join_counts(first, second):
     for slot in range(len(keys_b)):
         if keys_b[slot] != _EMPTY and counts_b[slot] != 0:
             _contact_add(slots, keys, counts, meta, base, keys_b[slot] // base, keys_b[slot] % base, counts_b[slot])
-    return pixels, following, head, tail, used + used_b, keys, counts, meta, slots, total
+    return pixels, used + used_b, keys, counts, meta, slots, total
+
+
+@njit(cache=True, nogil=True)
+def group_candidates(labels, pixels, used, n):
+    """The border candidates ``pixels[:used]`` of :func:`count_contacts` (raster
+    order, compact labels, every label its own zone) as one linked list per zone:
+    ``(pixels, following, head, tail)``, ``pixels[k]`` a pixel, ``following[k]``
+    the next candidate of its zone or -1, ``head`` / ``tail`` per zone (-1: none).
+
+    Each zone's candidates are stored contiguously, in raster order: a fusion
+    walks the list of the zone it absorbs, and on a map of 8000 px a side, with
+    the candidates in raster order of the whole image, every row of a zone cost
+    a cache miss in arrays far larger than the cache, each waiting for the last.
+    """
+    start = np.zeros(n + 1, np.int64)
+    for k in range(used):
+        start[labels[pixels[k]] + 1] += 1
+    for zone in range(n):
+        start[zone + 1] += start[zone]
+    grouped = np.empty(max(used, 1), np.int32)
+    following = np.empty(max(used, 1), np.int32)
+    head = _filled(n, -1, np.int32)
+    tail = _filled(n, -1, np.int32)
+    for zone in range(n):
+        if start[zone + 1] > start[zone]:
+            head[zone] = start[zone]
+            tail[zone] = start[zone + 1] - 1
+    # ``start`` becomes each zone's next free position.
+    for k in range(used):
+        zone = labels[pixels[k]]
+        grouped[start[zone]] = pixels[k]
+        start[zone] += 1
+    for k in range(used):
+        following[k] = k + 1
+    for zone in range(n):
+        if tail[zone] != -1:
+            following[tail[zone]] = -1
+    return grouped, following, head, tail
 
 
 @njit(cache=True)
@@ -324,9 +342,7 @@ def contact_table(labels, width, alive):
     count)`` rows in original ids (other = 0: the zone's contour size)."""
     work = labels.copy()
     original, compact_of, n = _compact_labels(work, alive)
-    pixels, following, head, tail, used, keys, counts, meta, slots, total = count_contacts(
-        work, width, n, np.int64(0), work.size
-    )
+    pixels, used, keys, counts, meta, slots, total = count_contacts(work, width, n, np.int64(0), work.size)
     rows = 0
     for zone in range(1, n):
         if total[zone] > 0:

@@ -9,22 +9,23 @@ from ursim_core.segmentation.maoris.kernels.helpers import _filled, _grown, _zon
 
 
 @njit(cache=True)
-def label_flat_zones(values):
+def label_flat_zones(values, labels):
     """4-connected components of equal non-zero value, numbered 1..N in the
-    raster order of their first pixel (0 stays 0).
+    raster order of their first pixel (0 stays 0), written into ``labels``
+    (same shape; any content, every pixel is written) and returned.
 
     One raster pass with union-find over provisional labels: a set's root is
     always its smallest label, i.e. the one its first pixel created, so
     numbering the roots in order numbers the zones in first-pixel order.
     """
     rows, cols = values.shape
-    labels = np.zeros((rows, cols), np.int32)
     parent = np.empty(1024, np.int32)
     n = 0
     for row in range(rows):
         for col in range(cols):
             value = values[row, col]
             if value == 0:
+                labels[row, col] = 0
                 continue
             left = labels[row, col - 1] if col > 0 and values[row, col - 1] == value else 0
             up = labels[row - 1, col] if row > 0 and values[row - 1, col] == value else 0

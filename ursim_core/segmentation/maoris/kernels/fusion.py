@@ -53,12 +53,67 @@ def _mark(pixel, labels, seen, bits, affected, used, n_affected):
 
 # Border pixels of a fusion are loaded this many candidates ahead (_prefetch).
 _AHEAD = 6
+# The smallest hash tables of a fusion (bits): small fusions use a prefix of the scratch tables.
+_MIN_BITS = 8
+
+
+@loop_helper
+def _gather(head, following, pixels, here, walk, walk_pixels):
+    """Copy the candidates of compact zone ``here`` and their pixels into ``walk`` /
+    ``walk_pixels`` (as many as fit); returns how many there are."""
+    n_walk = 0
+    candidate = head[here]
+    while candidate != -1:
+        if n_walk < len(walk):
+            walk[n_walk] = candidate
+            walk_pixels[n_walk] = pixels[candidate]
+        n_walk += 1
+        candidate = following[candidate]
+    return n_walk
+
+
+@loop_helper
+def _room_needed(n_walk, scratch, keys, meta):
+    """Whether the scratch arrays or the contact table must grow before fusing a zone of
+    ``n_walk`` candidates (:func:`_with_room`)."""
+    walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed = scratch
+    # At most 9 affected pixels per candidate, and 9 count changes per affected pixel.
+    return (
+        n_walk > len(walk) or 4 * 9 * n_walk > len(seen) or 2 * 81 * n_walk > len(change_keys)
+        or 2 * (meta[0] + 81 * n_walk) > len(keys)
+    )  # fmt: skip
 
 
 @inner_kernel
-def _contacts_fuse(here, into, labels, width, state, scratch):
-    """Fuse compact zone ``here`` into ``into`` in the contact state; returns
-    the state (its table may have grown) and the scratch arrays, grown if needed.
+def _with_room(n_walk, scratch, keys, counts, meta):
+    """The scratch arrays and the contact table, grown for a fusion of ``n_walk`` candidates
+    (seldom: the arrays only ever grow)."""
+    walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed = scratch
+    if n_walk > len(walk):
+        walk = np.empty(2 * n_walk, np.int32)
+        walk_pixels = np.empty(2 * n_walk, np.int32)
+    if 4 * 9 * n_walk > len(seen):
+        size = len(seen)
+        while 4 * 9 * n_walk > size:
+            size *= 2
+        seen = _filled(size, _EMPTY, np.int64)
+        affected = np.empty(size // 4, np.int32)
+        used = np.empty(size // 4, np.int64)
+    if 2 * 81 * n_walk > len(change_keys):
+        size = len(change_keys)
+        while 2 * 81 * n_walk > size:
+            size *= 2
+        change_keys = _filled(size, _EMPTY, np.int64)
+        change_counts = np.zeros(size, np.int64)
+        changed = np.empty(size // 2, np.int64)
+    keys, counts = _table_reserve(keys, counts, meta, 81 * n_walk)
+    return (walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed), keys, counts
+
+
+@loop_helper
+def _contacts_fuse(here, into, n_walk, labels, width, state, scratch, keys, counts, work):
+    """Fuse compact zone ``here`` (``n_walk`` candidates, gathered by :func:`_gather`)
+    into ``into`` in the contact state, whose arrays have room (:func:`_room_needed`).
 
     Only the pixels around ``here`` are visited: its border candidates (those
     now inside are dropped for good) and their 8-neighbours, each once. The
@@ -73,31 +128,18 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
     * ``change_keys`` / ``change_counts``: the count changes summed per pair
       (``changed`` lists their slots), so that each pair's count, in a table
       far larger than the cache, is updated once per fusion.
+
+    The hash sets are probed from a prefix sized for this fusion (their
+    entries are cleared after it, so probing past it stays correct), which keeps
+    a small fusion's probes in a few cache lines. Allocates nothing, so the
+    loops calling it count no references (``loop_helper``); the arrays of
+    ``state`` other than the table (``keys`` / ``counts``) never change.
     """
-    parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
+    parent, pixels, following, head, tail, _, _, meta, slots, total = state
     walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed = scratch
+    around, partners, signs = work
     base = np.int64(len(parent))
-    around = np.empty(9, np.int32)
-    partners = np.empty(9, np.int32)
-    signs = np.empty(9, np.int64)
-    n_walk = 0
-    candidate = head[here]
-    while candidate != -1:
-        if n_walk == len(walk):
-            walk = _grown(walk, 2 * n_walk, 0)
-            walk_pixels = _grown(walk_pixels, 2 * n_walk, 0)
-        walk[n_walk] = candidate
-        walk_pixels[n_walk] = pixels[candidate]
-        n_walk += 1
-        candidate = following[candidate]
-    if 4 * 9 * n_walk > len(seen):
-        size = len(seen)
-        while 4 * 9 * n_walk > size:
-            size *= 2
-        seen = _filled(size, _EMPTY, np.int64)
-        affected = np.empty(size // 4, np.int32)
-        used = np.empty(size // 4, np.int64)
-    seen_bits = _bits(len(seen))
+    seen_bits = max(_bits(4 * 9 * n_walk), _MIN_BITS)
     for i in range(min(n_walk, _AHEAD)):
         _prefetch_rows(labels, walk_pixels[i], width)
     n_affected = 0
@@ -125,15 +167,8 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
         n_affected = _mark(down - 1, labels, seen, seen_bits, affected, used, n_affected)
         n_affected = _mark(down, labels, seen, seen_bits, affected, used, n_affected)
         n_affected = _mark(down + 1, labels, seen, seen_bits, affected, used, n_affected)
-    # At most 9 count changes per affected pixel; the table stays at most half full.
-    if 2 * 9 * n_affected > len(change_keys):
-        size = len(change_keys)
-        while 2 * 9 * n_affected > size:
-            size *= 2
-        change_keys = _filled(size, _EMPTY, np.int64)
-        change_counts = np.zeros(size, np.int64)
-        changed = np.empty(size // 2, np.int64)
-    change_bits = _bits(len(change_keys))
+    # At most 9 count changes per affected pixel; the prefix stays at most half full.
+    change_bits = max(_bits(2 * 9 * n_affected), _MIN_BITS)
     n_changed = np.int64(0)
     for k in range(n_affected):
         _neighbourhood(labels, parent, affected[k], width, around)
@@ -148,7 +183,6 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
                 n_changed += 1
             change_counts[slot] += signs[i]
         seen[used[k]] = _EMPTY
-    keys, counts = _table_reserve(keys, counts, meta, n_changed)
     for k in range(n_changed):
         slot = changed[k]
         if change_counts[slot] != 0:
@@ -163,14 +197,12 @@ def _contacts_fuse(here, into, labels, width, state, scratch):
             following[tail[into]] = kept_head
         tail[into] = kept_tail
     head[here] = tail[here] = -1
-    state = (parent, pixels, following, head, tail, keys, counts, meta, slots, total)
-    return state, (walk, walk_pixels, seen, affected, used, change_keys, change_counts, changed)
 
 
 @inner_kernel
 def _new_scratch():
-    """Empty scratch arrays of :func:`_contacts_fuse`."""
-    return (
+    """Empty scratch arrays of :func:`_contacts_fuse`, and its 3x3 work arrays."""
+    scratch = (
         np.empty(1024, np.int32),
         np.empty(1024, np.int32),
         _filled(np.int64(4096), _EMPTY, np.int64),
@@ -180,12 +212,24 @@ def _new_scratch():
         np.zeros(4096, np.int64),
         np.empty(2048, np.int64),
     )
+    return scratch, (np.empty(9, np.int32), np.empty(9, np.int32), np.empty(9, np.int64))
 
 
 @loop_helper
-def _contact_percent(state, zone, other):
+def _fuse_tracked(here, into, labels, width, state, scratch, keys, counts, work):
+    """:func:`_contacts_fuse` when its arrays have room; returns False (nothing done) when
+    they must grow first (the caller then calls :func:`_with_room` and again)."""
+    n_walk = _gather(state[3], state[2], state[1], here, scratch[0], scratch[1])
+    if _room_needed(n_walk, scratch, keys, state[7]):
+        return False
+    _contacts_fuse(here, into, n_walk, labels, width, state, scratch, keys, counts, work)
+    return True
+
+
+@loop_helper
+def _contact_percent(state, keys, counts, zone, other):
     """Integer percentage of compact ``zone``'s contour pixels having ``other`` in their 3x3."""
-    parent, pixels, following, head, tail, keys, counts, meta, slots, total = state
+    parent, _, _, _, _, _, _, meta, slots, total = state
     if total[zone] == 0:
         return 0
     return contact_get(slots, keys, counts, meta, np.int64(len(parent)), zone, other) * 100 // total[zone]
@@ -202,10 +246,14 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
     Contacts are tracked on compact zone ids (the per-zone arrays stay in
     cache) as union-find sets of the labels, relabelled once at the end;
     ``tracking`` is :func:`start_tracking` of the labels (which compacts them).
+    The loop reassigns no array but when one must grow (:func:`_fuse_tracked`):
+    a tuple of arrays reassigned at every fusion made numba count references of
+    each of its arrays at every zone visited (a sixth of the time).
     """
     records, nodes = graph
     original, compact_of, state = tracking
-    scratch = _new_scratch()
+    keys, counts, total = state[5], state[6], state[9]
+    scratch, work = _new_scratch()
     queue = np.empty(max(2 * len(order), 16), np.int32)
     for i in range(len(order)):
         queue[i] = order[i]
@@ -222,8 +270,8 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
         while node != -1:
             other = nodes[node, NEIGHBOUR]
             if (
-                nodes[node | 1, ATTRIBUTE] == 0 and state[9][here] > 0
-                and _contact_percent(state, here, compact_of[other]) >= ripples
+                nodes[node | 1, ATTRIBUTE] == 0 and total[here] > 0
+                and _contact_percent(state, keys, counts, here, compact_of[other]) >= ripples
             ):  # fmt: skip
                 gap = abs(records[other, VALUE] - zone_value)
                 if best == -1 or gap < best_gap:
@@ -239,7 +287,11 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
             queue[end] = nodes[node, NEIGHBOUR]
             end += 1
             node = nodes[node, NEXT]
-        state, scratch = _contacts_fuse(np.int64(here), np.int64(compact_of[best]), labels, width, state, scratch)
+        into = np.int64(compact_of[best])
+        if not _fuse_tracked(np.int64(here), into, labels, width, state, scratch, keys, counts, work):
+            n_walk = _gather(state[3], state[2], state[1], here, scratch[0], scratch[1])
+            scratch, keys, counts = _with_room(n_walk, scratch, keys, counts, state[7])
+            _fuse_tracked(np.int64(here), into, labels, width, state, scratch, keys, counts, work)
         alive[zone] = False
         size[best] += size[zone]
         fuse_edges(np.int64(zone), np.int64(best), graph)
@@ -247,13 +299,13 @@ def merge_ripples(order, ripples, labels, width, size, alive, graph, tracking):
 
 
 @loop_helper
-def _contact_sum(state, zone, here, compact_of, graph):
+def _contact_sum(state, keys, counts, zone, here, compact_of, graph):
     """Sum of contact percentages of ``zone`` (compact id ``here``) over its neighbours."""
     records, nodes = graph
     result = 0
     node = records[zone, HEAD]
     while node != -1:
-        result += _contact_percent(state, here, compact_of[nodes[node, NEIGHBOUR]])
+        result += _contact_percent(state, keys, counts, here, compact_of[nodes[node, NEIGHBOUR]])
         node = nodes[node, NEXT]
     return result
 
@@ -269,11 +321,12 @@ def remove_doors(doors, labels, width, size, alive, graph, tracking):
     """
     records, nodes = graph
     original, compact_of, state = tracking
-    scratch = _new_scratch()
+    keys, counts = state[5], state[6]
+    scratch, work = _new_scratch()
     sums = np.zeros(len(records), np.int64)
     for k in range(len(original)):
         zone = original[k]
-        sums[zone] = _contact_sum(state, np.int64(zone), np.int64(k + 1), compact_of, graph)
+        sums[zone] = _contact_sum(state, keys, counts, np.int64(zone), np.int64(k + 1), compact_of, graph)
     for k in range(len(original)):
         zone = original[k]
         if not alive[zone] or sums[zone] <= doors or records[zone, DEGREE] == 0:
@@ -284,9 +337,13 @@ def remove_doors(doors, labels, width, size, alive, graph, tracking):
             if sums[nodes[node, NEIGHBOUR]] < doors:
                 target = nodes[node, NEIGHBOUR]
             node = nodes[node, NEXT]
-        state, scratch = _contacts_fuse(np.int64(k + 1), np.int64(compact_of[target]), labels, width, state, scratch)
+        here, into = np.int64(k + 1), np.int64(compact_of[target])
+        if not _fuse_tracked(here, into, labels, width, state, scratch, keys, counts, work):
+            n_walk = _gather(state[3], state[2], state[1], here, scratch[0], scratch[1])
+            scratch, keys, counts = _with_room(n_walk, scratch, keys, counts, state[7])
+            _fuse_tracked(here, into, labels, width, state, scratch, keys, counts, work)
         alive[zone] = False
         size[target] += size[zone]
         fuse_edges(np.int64(zone), np.int64(target), graph)
-        sums[target] = _contact_sum(state, np.int64(target), np.int64(compact_of[target]), compact_of, graph)
+        sums[target] = _contact_sum(state, keys, counts, np.int64(target), into, compact_of, graph)
     _restore_labels(labels, state[0], original)

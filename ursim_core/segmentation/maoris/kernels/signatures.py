@@ -18,19 +18,20 @@ __all__ = ["SIGNATURES", "GROUPS", "compile_group"]
 _I32, _I64, _BOOL = types.int32[::1], types.int64[::1], types.bool_[::1]
 _I32_2D, _I64_2D = types.int32[:, ::1], types.int64[:, ::1]
 _F32_2D, _U8_2D, _U32_2D = types.float32[:, ::1], types.uint8[:, ::1], types.uint32[:, ::1]
+_U8_2D_ANY = types.uint8[:, :]
 _INT, _FLOAT = types.int64, types.float64
 # The compact zone graph (records, nodes); the contact counts of count_contacts; the
 # tracking state of start_tracking (original, compact_of, (parent, pixels, ...)).
 _GRAPH = types.UniTuple(_I32_2D, 2)
-_COUNTS = types.Tuple((_I32, _I32, _I32, _I32, _INT, _I64, _I64, _I64, _I64, _I64))
+_COUNTS = types.Tuple((_I32, _INT, _I64, _I64, _I64, _I64, _I64))
 _STATE = types.Tuple((_I32, _I32, _I32, _I32, _I32, _I64, _I64, _I64, _I64, _I64))
 _TRACKING = types.Tuple((_I32, _I32, _STATE))
 
 #: ``(module, kernel name) -> argument types``.
 SIGNATURES: dict[tuple[str, str], tuple] = {
     ("discs", "centre_rectangles"): (_F32_2D, _INT),
-    ("discs", "paint_discs"): (_F32_2D, _I64_2D, _I32_2D),
-    ("flat_zones", "label_flat_zones"): (_U8_2D,),
+    ("discs", "paint_discs"): (_I64_2D, _U8_2D_ANY, _I32_2D),
+    ("flat_zones", "label_flat_zones"): (_U8_2D, _I32_2D),
     ("flat_zones", "zone_values_and_sizes"): (_I32_2D, _U8_2D, _INT),
     ("flat_zones", "first_pixels"): (_I32_2D, _INT),
     ("flat_zones", "resolve_parents"): (_I32, _BOOL),
@@ -42,6 +43,7 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
     ("contacts", "_compact_labels"): (_I32, _BOOL),
     ("contacts", "count_contacts"): (_I32, _INT, _INT, _INT, _INT),
     ("contacts", "join_counts"): (_COUNTS, _COUNTS),
+    ("contacts", "group_candidates"): (_I32, _I32, _INT, _INT),
     ("contacts", "contact_table"): (_I32, _INT, _BOOL),
     ("fusion", "merge_ripples"): (_I32, _FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
     ("fusion", "remove_doors"): (_FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
