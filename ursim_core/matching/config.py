@@ -94,7 +94,8 @@ class MatchConfig:
         Planar matcher with a position term: this many times, lay the sketch's positions on the
         metric map by a scale and shift per axis fitted to the answer's pairs, match again, and
         keep the new answer when its hypothesis score is lower (:mod:`ursim_core.matching.refit`);
-        0 = positions normalised to each map's extent only.
+        0 = positions normalised to each map's extent only. Not applied to graphs of more than 60
+        regions (there its second sweep took seconds to minutes).
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the

@@ -84,3 +84,10 @@ def test_a_refit_never_raises_the_hypothesis_score():
     assert refitted.chosen.normalised_cost <= first.normalised_cost
     # The refitted preparation serves every later m too, with its own positions.
     assert not np.allclose(refitted.c_matrix, plain.c_matrix) or refitted.chosen.pairs == first.pairs
+
+
+def test_the_refitted_answer_records_the_options_it_was_asked_for():
+    metric = _grid_graph()
+    sketch = _grid_graph(((0.5, 7.0), (1.3, 2.0)))
+    config = MatchConfig(orientation="upright")
+    assert prepare(sketch, metric, config).chosen.config.m_grid == config.m_grid
