@@ -121,6 +121,10 @@ def estimate_scale(
     2.0
     """
     sketch, metric = _Side(np.asarray(sketch_free) != 0), _Side(np.asarray(metric_free) != 0)
+    return _estimated_scale(sketch, metric, orientations, scales)
+
+
+def _estimated_scale(sketch: _Side, metric: _Side, orientations, scales) -> float:
     best = (-1.0, 1.0)
     for degrees, mirrored in orientations:
         turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
@@ -170,9 +174,10 @@ def fit_overlay(
     orientations = list(orientations)
     if not sketch_free.any() or not metric_free.any():
         return Alignment.unfitted(*orientations[0])
-    if scale is None:
-        scale = estimate_scale(sketch_free, metric_free, orientations=orientations)
+    # Read once, for the scale estimate and for the search.
     sketch, metric = _Side(sketch_free), _Side(metric_free)
+    if scale is None:
+        scale = _estimated_scale(sketch, metric, orientations, SCALE_SEARCH)
     best: tuple[float, np.ndarray, float, bool] | None = None
     for degrees, mirrored in orientations:
         turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
