@@ -48,16 +48,21 @@ import numpy as np
 
 from ursim_core.matching.config import AUTO_RULE_NAMES
 
-__all__ = ["AUTO_RULES", "choose_m", "sweep"]
+__all__ = ["AUTO_RULES", "choose_m", "chosen_of", "matched_sweep", "sweep"]
 
 
-def sweep(prepared, grid=None, *, progress=None) -> list:
+def sweep(prepared, grid=None, *, progress=None, known=None) -> list:
     """Match at every m of the grid (``config.m_grid`` by default), in grid order.
 
     ``progress(fraction, message)``, when given, is called after each m (for progress bars).
 
     Values of m that select exactly the same pairs as the previous one (same "same" relation)
     reuse its result, with ``m`` updated: the matcher would return the same answer.
+
+    ``known`` maps values of m to results already matched at them for this preparation (the
+    ``matched`` of :func:`matched_sweep` over another grid): an m the sweep would match is taken
+    from it instead. The orientations of a sketch are screened on every second m; the few kept
+    are then swept over the whole grid, and half of it is already known.
 
     Examples
     --------
@@ -70,9 +75,16 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
     >>> [r.m for r in sweep(prepare(g, g.copy()), [0.0, 0.1])]
     [0.0, 0.1]
     """
+    return matched_sweep(prepared, grid, progress=progress, known=known)[0]
+
+
+def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[list, dict]:
+    """:func:`sweep`, and the results it matched (not reused from the previous m), by m."""
     from ursim_core.matching.single import SeedSelector, match_at, seed_cap
 
     grid = prepared.config.m_grid if grid is None else grid
+    known = known or {}
+    matched: dict[float, object] = {}
     c_matrix = prepared.c_matrix
     selector = None
     cap = seed_cap(prepared.config.max_seeds, *c_matrix.shape)
@@ -85,11 +97,19 @@ def sweep(prepared, grid=None, *, progress=None) -> list:
         if previous_mask is not None and np.array_equal(mask, previous_mask) and results:
             results.append(replace(results[-1], m=float(m)))
         else:
-            results.append(match_at(prepared, float(m), seed_selector=selector))
+            earlier = known.get(float(m))
+            # match_at reads no option of the grid: a result found at m under another grid is
+            # this sweep's, but for the options it records.
+            if earlier is not None:
+                result = replace(earlier, config=prepared.config)
+            else:
+                result = match_at(prepared, float(m), seed_selector=selector)
+            matched[float(m)] = result
+            results.append(result)
             previous_mask = mask
         if progress is not None:
             progress(index / len(grid), f"matching at m = {float(m):.3f}")
-    return results
+    return results, matched
 
 
 def _rule_score(prepared, results) -> list[float]:
@@ -119,10 +139,10 @@ AUTO_RULES = {"score": _rule_score, "structure": _rule_structure}
 assert tuple(AUTO_RULES) == AUTO_RULE_NAMES, "config.AUTO_RULE_NAMES must list the rules defined here"
 
 
-def choose_m(prepared, *, progress=None):
+def choose_m(prepared, *, progress=None, known=None):
     """Pick m over ``config.m_grid`` with ``config.auto_rule``; return that m's MatchResult.
 
-    ``progress(fraction, message)`` is passed to :func:`sweep`.
+    ``progress(fraction, message)`` and ``known`` are passed to :func:`sweep`.
 
     The result's ``m_scan`` maps every m of the grid to the rule's statistic (lower is
     better); ties go to the smallest m.
@@ -139,7 +159,11 @@ def choose_m(prepared, *, progress=None):
     >>> result.m in MatchConfig().m_grid, sorted(result.pairs)
     (True, [(0, 0), (1, 1), (2, 2), (3, 3)])
     """
-    results = sweep(prepared, progress=progress)
+    return chosen_of(prepared, sweep(prepared, progress=progress, known=known))
+
+
+def chosen_of(prepared, results):
+    """The result of a sweep that ``config.auto_rule`` picks, with ``m_scan`` (see :func:`choose_m`)."""
     scores = AUTO_RULES[prepared.config.auto_rule](prepared, results)
     lowest = min(scores)
     best = next(k for k, value in enumerate(scores) if value <= lowest + 1e-12)

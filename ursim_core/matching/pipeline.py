@@ -31,7 +31,7 @@ import dataclasses
 
 import networkx as nx
 
-from ursim_core.matching.auto_m import choose_m
+from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph
@@ -139,6 +139,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
         # agree (see ursim_core.matching.alignment). A ratio is scale-free: no weight to tune.
         return cost / overlaps[index] ** config.orientation_overlap if overlaps else cost
 
+    known: dict[int, dict] = {}  # per candidate: the results of its screening, by m
     if (
         len(finalists) > 1
         and config.m == "auto"
@@ -147,15 +148,21 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     ):
         # Screen every orientation on a coarse m grid first; only the best few get the full sweep.
         coarse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: _COARSE_STEP]))
-        screened = [
-            (ranked(match_prepared(dataclasses.replace(prepared, config=coarse)).normalised_cost, index), index)
-            for index, prepared in prepared_candidates.items()
-        ]
+        screened = []
+        for index, prepared in prepared_candidates.items():
+            coarse_prepared = dataclasses.replace(prepared, config=coarse)
+            results, known[index] = matched_sweep(coarse_prepared)
+            screened.append((ranked(chosen_of(coarse_prepared, results).normalised_cost, index), index))
         finalists = sorted(index for _, index in sorted(screened)[:_FINALISTS])
     trials = []
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
-        result = match_prepared(prepared, progress=_share_of(progress, step, len(finalists)))
+        share = _share_of(progress, step, len(finalists))
+        if config.m == "auto":
+            # The full sweep of a screened orientation: half its values of m are matched already.
+            result = choose_m(prepared, progress=share, known=known.get(index))
+        else:
+            result = match_prepared(prepared, progress=share)
         prepared, result = _refitted(prepared, result)
         trials.append((ranked(result.normalised_cost, index), index, prepared, result))
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))

@@ -8,7 +8,7 @@ import pytest
 
 from ursim_core.bench.matching import perturbed_copy, random_region_graph
 from ursim_core.matching import MatchConfig, match, match_prepared, prepare
-from ursim_core.matching.auto_m import choose_m, sweep
+from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep, sweep
 
 
 @pytest.fixture(scope="module")
@@ -46,6 +46,29 @@ def test_sweep_reuses_identical_thresholds(pair):
     assert [r.m for r in results] == [0.0, 0.0001, 0.3]
     for r in results:
         assert r.pairs == match_prepared(prepared, r.m).pairs
+
+
+def test_known_results_stand_in_for_matching_and_change_nothing(pair):
+    graph, copy, _ = pair
+    prepared = prepare(graph, copy, MatchConfig())
+    coarse = replace(prepared, config=prepared.config.replace(m_grid=prepared.config.m_grid[1::2]))
+    _, known = matched_sweep(coarse)
+    # Only results that were matched (not reused from the previous m) are offered.
+    assert known and set(known) <= set(coarse.config.m_grid)
+    plain, reused = sweep(prepared), sweep(prepared, known=known)
+    assert [(r.m, r.pairs, r.cost, r.reason) for r in reused] == [(r.m, r.pairs, r.cost, r.reason) for r in plain]
+    assert all(r.config == prepared.config for r in reused)  # the sweep's own options are recorded
+    assert choose_m(prepared, known=known).pairs == choose_m(prepared).pairs
+    # A known result is taken as it is: a planted one shows where the sweep would have matched.
+    planted = sweep(prepared, known={m: replace(result, pairs=[(-1, -1)]) for m, result in known.items()})
+    assert any(r.pairs == [(-1, -1)] for r in planted)
+
+
+def test_chosen_of_is_what_choose_m_picks(pair):
+    graph, copy, _ = pair
+    prepared = prepare(graph, copy, MatchConfig())
+    chosen, picked = chosen_of(prepared, sweep(prepared)), choose_m(prepared)
+    assert (chosen.m, chosen.pairs, chosen.m_scan) == (picked.m, picked.pairs, picked.m_scan)
 
 
 def test_auto_recovers_a_noisy_copy(pair):
