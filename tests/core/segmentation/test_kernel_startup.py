@@ -83,6 +83,9 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
     for key, types in signatures.SIGNATURES.items():
         compiled = signatures.kernel(key).signatures
         assert compiled == [types], (key, compiled)
+        # The ahead-of-time build exports this return type without typing the kernel.
+        returned = signatures.kernel(key).overloads[types].signature.return_type
+        assert returned == signatures.RETURN_TYPES[key], (key, returned)
 
 
 def test_ahead_of_time_kernels_give_the_jit_labels(monkeypatch):
@@ -137,8 +140,10 @@ def test_stale_or_missing_build_is_not_used(tmp_path, monkeypatch):
 def test_a_broken_build_is_reported_and_left_for_the_jit(tmp_path, monkeypatch):
     from ursim_core.segmentation.maoris import compiled
 
+    for name in compiled.PARTS:  # every part present, the first one broken
+        part = tmp_path / (name + compiled.importlib.machinery.EXTENSION_SUFFIXES[0])
+        part.write_bytes(b"\x7fELF truncated")
     module = tmp_path / (compiled.MODULE_NAME + compiled.importlib.machinery.EXTENSION_SUFFIXES[0])
-    module.write_bytes(b"\x7fELF truncated")
     (tmp_path / compiled.DIGEST_NAME).write_text(compiled.sources_digest() + "\n", encoding="ascii")
     monkeypatch.setattr(compiled, "build_directories", lambda: [tmp_path])
     rebuilds = []
