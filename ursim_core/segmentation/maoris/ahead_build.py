@@ -65,7 +65,7 @@ def build_part(name: str, modules: tuple[str, ...], folder: str | Path) -> Path:
 
     from ursim_core.segmentation.maoris.kernels import signatures
 
-    _skip_helper_machine_code()
+    _skip_helper_machine_code(_kernel_modules())
     cc = CC(name)
     cc.output_dir = str(folder)
     cc.verbose = False
@@ -83,36 +83,48 @@ def build_part(name: str, modules: tuple[str, ...], folder: str | Path) -> Path:
     return Path(folder) / cc.output_file
 
 
-def _skip_helper_machine_code() -> None:
+def _skip_helper_machine_code(kernel_modules) -> None:
     """Make numba compile the helpers as far as LLVM IR (optimised, as before) and no further.
 
     A helper's library is finalised (optimised) and added to numba's JIT engine, which then
     generates its machine code (``_finalize_specific``), and the dispatcher asks for the
     address of its Python wrapper (``get_executable``). Neither is used by pycc, which links
-    the optimised IR; so the IR, and the module built from it, stay the same. A library that
-    numba will write to its cache (an entry kernel called by another, ``cache=True``) needs its
-    object code and keeps both.
+    the optimised IR; so the IR, and the modules built from it, stay the same. numba's cache
+    on disk would need that machine code: it is turned off for the kernels (an entry kernel
+    that another one calls was compiled by the JIT too, and written to the cache, for
+    nothing).
     """
     from numba import _dynfunc
     from numba.core import codegen, cpu
+    from numba.core.caching import NullCache
+    from numba.core.dispatcher import Dispatcher
 
-    finalize_specific = codegen.JITCodeLibrary._finalize_specific
-    get_executable = cpu.CPUContext.get_executable
+    for module in kernel_modules:
+        for value in vars(module).values():
+            if isinstance(value, Dispatcher):
+                value._cache = NullCache()
 
     def _finalize_specific(library):
-        if library._object_caching_enabled:
-            finalize_specific(library)
+        pass
 
     def _get_executable(context, library, fndesc, env):
-        if library._object_caching_enabled:
-            return get_executable(context, library, fndesc, env)
         library._ensure_finalized()
-        # A function at address 0, never called: the build calls no helper from Python.
+        # A function at address 0, never called: the build calls no kernel from Python.
         name = fndesc.qualname.split(".")[-1]
         return _dynfunc.make_function(fndesc.lookup_module(), name, "", 0, env, (library,))
 
     codegen.JITCodeLibrary._finalize_specific = _finalize_specific
     cpu.CPUContext.get_executable = _get_executable
+
+
+def _kernel_modules() -> list:
+    import importlib
+    import pkgutil
+
+    from ursim_core.segmentation.maoris import kernels
+
+    names = [info.name for info in pkgutil.iter_modules(kernels.__path__)]
+    return [importlib.import_module(f"{kernels.__name__}.{name}") for name in names]
 
 
 class _GilReleasingFlags:
