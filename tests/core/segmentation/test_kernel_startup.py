@@ -88,6 +88,22 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
         assert returned == signatures.RETURN_TYPES[key], (key, returned)
 
 
+def test_helpers_once_given_literals_compile_once(tmp_path):
+    """Typed values, not literals, at their call sites: numba types a call with what it knows
+    so far and compiled these helpers for a literal first, in vain (seconds of the first
+    build); and the bodies contact_table shares are not entry kernels compiled twice."""
+    code = (
+        "from ursim_core.segmentation.maoris.kernels import signatures, adjacency, contacts, discs, flooding\n"
+        "for key in [('adjacency', 'build_adjacency'), ('flooding', 'flood_levels'), "
+        "('discs', 'centre_rectangles'), ('contacts', 'contact_table')]:\n"
+        "    signatures.kernel(key).compile(signatures.SIGNATURES[key])\n"
+        "helpers = [adjacency._contacts_in_order, flooding._heap_flood, flooding._bucket_flood, "
+        "flooding._last_tie, discs._load_radii, contacts._counted, contacts._compacted]\n"
+        "print([len(helper.signatures) for helper in helpers], len(contacts.count_contacts.signatures))"
+    )
+    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path)) == "[1, 1, 1, 1, 1, 1, 1] 0"
+
+
 def test_ahead_of_time_kernels_give_the_jit_labels(monkeypatch):
     """The built module and the JIT: the same labels on maps of every step (banded contacts too)."""
     from ursim_core.segmentation.maoris import PRESETS, compile_kernels, compiled, contact_tracking, maoris_labels

@@ -83,13 +83,14 @@ _loaded: SimpleNamespace | None = None
 
 
 def sources_digest() -> str:
-    """SHA-256 of the kernel sources (every ``.py`` of :mod:`.kernels`) and the Python ABI.
+    """SHA-256 of the kernel sources (every ``.py`` of :mod:`.kernels`), of how they are built
+    (:mod:`.ahead_build`) and of the Python ABI.
 
-    The built module is used only while this matches the digest it was built with: an
-    edited kernel falls back to the JIT until the module is built again.
+    The built modules are used only while this matches the digest they were built with: an
+    edited kernel falls back to the JIT until the modules are built again.
     """
     digest = hashlib.sha256(importlib.machinery.EXTENSION_SUFFIXES[0].encode())
-    for source in sorted(_KERNELS_DIR.glob("*.py")):
+    for source in [*sorted(_KERNELS_DIR.glob("*.py")), _KERNELS_DIR.parent / "ahead_build.py"]:
         digest.update(source.name.encode() + b"\0" + source.read_bytes() + b"\0")
     return digest.hexdigest()
 
