@@ -6,21 +6,25 @@ part, in processes at once (``python -m ursim_core.segmentation.maoris.ahead_bui
 FOLDER``): each writes the extension module ``NAME`` into ``FOLDER``. numba compiles on one
 thread, so two parts on two CPUs take about half the time of one module.
 
-What a part costs, and what is left out (measured on the 2-CPU machine of the project,
-numba 0.68, CPU seconds of the whole build): numba typing and lowering the kernels and
-their helpers in Python, and LLVM optimising them, are most of it. Three things were
-wasted and are skipped here:
+What a build costs (measured on the 2-CPU machine of the project, numba 0.68, CPU seconds
+of the one-module build of before): numba typing and lowering the kernels and their helpers
+in Python (about two thirds), and LLVM optimising them. Wasted work is skipped here:
 
 * typing every kernel once more to learn its return type for pycc (about 3 s): the return
   types are declared (:data:`.kernels.signatures.RETURN_TYPES`; a test checks them
   against numba's typing);
-* the machine code of every helper (about 2 s): typing a call to an ``@njit`` helper
-  makes numba compile it as for the JIT, down to machine code in its JIT engine, which a
-  build never runs (pycc links the helpers' LLVM IR into the module and generates the
-  module's machine code once);
-* compiling pycc's C support code at ``-O3 -g``, with numba's typed dict, list and set
-  that no kernel uses (about 1.5 s): it is the module's import function and the allocator
-  of numba's runtime, called once per array, not in the loops of the kernels.
+* the machine code of every helper (2.1 s in numba's JIT engine): typing a call to an
+  ``@njit`` helper makes numba compile it as for the JIT, down to machine code that a
+  build never runs (pycc links the helpers' optimised LLVM IR into the module and
+  generates the module's machine code once), and writes the kernels that other kernels
+  call to numba's cache;
+* pycc's C support code compiled at ``-O3 -g``, with numba's typed dict, list and set
+  that no kernel uses (2.6 s; 0.9 s per part now): it is the module's import function and
+  the allocator of numba's runtime, called once per array, never in the loops of the
+  kernels.
+
+(The kernels themselves pass typed values, not literals, to the helpers that numba
+compiled twice for them, and share the bodies of the two entry kernels that another calls.)
 
 Numba's state in the process is left altered (helpers without machine code), so this runs
 only in a process of its own.

@@ -32,13 +32,15 @@ __all__ = [
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 
 #: Seconds that building the kernels ahead of time on empty caches takes on the 2-CPU machine
-#: of the project, the two parts at once (``ursim bench compile``: 15-17 s wall, 30 s of CPU,
-#: on a machine shared with other work); the wait :func:`compile_notice` gives.
+#: of the project, the two parts at once: 12-15 s when the other CPU is free (23-25 s of CPU),
+#: up to twice that on a busy machine (``ursim bench compile``; 27-35 s before, in one
+#: process); the wait :func:`compile_notice` gives.
 COMPILE_SECONDS = 15
-#: Seconds of CPU of that build (both processes), and of numba's JIT compiling every kernel
-#: (``URSIM_KERNELS=jit``, one process, where the wait is about its CPU time).
-COMPILE_CPU_SECONDS = 30
-JIT_COMPILE_SECONDS = 35
+#: Seconds of CPU of that build (both processes).
+COMPILE_CPU_SECONDS = 25
+#: Seconds of numba's JIT compiling every kernel on an empty cache (``URSIM_KERNELS=jit``,
+#: one process: 15 s quiet, 29 s wall and 21 s of CPU on a busy machine).
+JIT_COMPILE_SECONDS = 20
 
 
 def compile_notice() -> str | None:
