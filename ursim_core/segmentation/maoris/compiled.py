@@ -241,12 +241,17 @@ def build_ahead(directory: str | Path | None = None) -> Path:
 
 def _build_parts(scratch: str) -> None:
     """Run :mod:`.ahead_build` for every part at once, each writing its module to ``scratch``."""
+    # The children import this very package (first on their path), whatever their working
+    # folder holds: they run in the scratch folder.
+    package_root = str(Path(__file__).resolve().parents[3])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [package_root, os.environ.get("PYTHONPATH")]))}
     children = []
     for name in PARTS:
         command = [sys.executable, "-m", "ursim_core.segmentation.maoris.ahead_build", name, scratch]
         # Each child's errors go to a file: a pipe left unread could fill and block it.
         log = open(Path(scratch) / f"{name}.log", "w+b")  # noqa: SIM115 (closed below)
-        children.append((name, subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT), log))
+        child = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, cwd=scratch, env=env)
+        children.append((name, child, log))
     failures = []
     for name, child, log in children:
         code = child.wait()
