@@ -83,6 +83,25 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
     for key, types in signatures.SIGNATURES.items():
         compiled = signatures.kernel(key).signatures
         assert compiled == [types], (key, compiled)
+        # The ahead-of-time build exports this return type without typing the kernel.
+        returned = signatures.kernel(key).overloads[types].signature.return_type
+        assert returned == signatures.RETURN_TYPES[key], (key, returned)
+
+
+def test_helpers_once_given_literals_compile_once(tmp_path):
+    """Typed values, not literals, at their call sites: numba types a call with what it knows
+    so far and compiled these helpers for a literal first, in vain (seconds of the first
+    build); and the bodies contact_table shares are not entry kernels compiled twice."""
+    code = (
+        "from ursim_core.segmentation.maoris.kernels import signatures, adjacency, contacts, discs, flooding\n"
+        "for key in [('adjacency', 'build_adjacency'), ('flooding', 'flood_levels'), "
+        "('discs', 'centre_rectangles'), ('contacts', 'contact_table')]:\n"
+        "    signatures.kernel(key).compile(signatures.SIGNATURES[key])\n"
+        "helpers = [adjacency._contacts_in_order, flooding._heap_flood, flooding._bucket_flood, "
+        "flooding._last_tie, discs._load_radii, contacts._counted, contacts._compacted]\n"
+        "print([len(helper.signatures) for helper in helpers], len(contacts.count_contacts.signatures))"
+    )
+    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path)) == "[1, 1, 1, 1, 1, 1, 1] 0"
 
 
 def test_ahead_of_time_kernels_give_the_jit_labels(monkeypatch):
@@ -137,8 +156,10 @@ def test_stale_or_missing_build_is_not_used(tmp_path, monkeypatch):
 def test_a_broken_build_is_reported_and_left_for_the_jit(tmp_path, monkeypatch):
     from ursim_core.segmentation.maoris import compiled
 
+    for name in compiled.PARTS:  # every part present, the first one broken
+        part = tmp_path / (name + compiled.importlib.machinery.EXTENSION_SUFFIXES[0])
+        part.write_bytes(b"\x7fELF truncated")
     module = tmp_path / (compiled.MODULE_NAME + compiled.importlib.machinery.EXTENSION_SUFFIXES[0])
-    module.write_bytes(b"\x7fELF truncated")
     (tmp_path / compiled.DIGEST_NAME).write_text(compiled.sources_digest() + "\n", encoding="ascii")
     monkeypatch.setattr(compiled, "build_directories", lambda: [tmp_path])
     rebuilds = []

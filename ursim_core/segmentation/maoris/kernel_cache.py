@@ -20,13 +20,27 @@ from pathlib import Path
 
 from ursim_core.segmentation.maoris.compiled import ENTRY_KERNELS, ahead_module_path
 
-__all__ = ["kernels_cached", "compile_notice", "ENTRY_KERNELS", "COMPILE_CPU_SECONDS"]
+__all__ = [
+    "kernels_cached",
+    "compile_notice",
+    "ENTRY_KERNELS",
+    "COMPILE_SECONDS",
+    "COMPILE_CPU_SECONDS",
+    "JIT_COMPILE_SECONDS",
+]
 
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 
-#: Seconds of CPU that compiling every kernel on an empty cache took on the 2-CPU machine
-#: of the project (``ursim bench compile``: 27-34 s); the wait :func:`compile_notice` gives.
-COMPILE_CPU_SECONDS = 30
+#: Seconds that building the kernels ahead of time on empty caches takes on the 2-CPU machine
+#: of the project, the two parts at once: 12-15 s when the other CPU is free (23-25 s of CPU),
+#: up to twice that on a busy machine (``ursim bench compile``; 27-35 s before, in one
+#: process); the wait :func:`compile_notice` gives.
+COMPILE_SECONDS = 15
+#: Seconds of CPU of that build (both processes).
+COMPILE_CPU_SECONDS = 25
+#: Seconds of numba's JIT compiling every kernel on an empty cache (``URSIM_KERNELS=jit``,
+#: one process: 15 s quiet, 29 s wall and 21 s of CPU on a busy machine).
+JIT_COMPILE_SECONDS = 20
 
 
 def compile_notice() -> str | None:
@@ -39,7 +53,9 @@ def compile_notice() -> str | None:
     """
     if kernels_cached():
         return None
-    return f"Compiling the segmentation kernels (first run only, about {COMPILE_CPU_SECONDS} s)..."
+    jit = os.environ.get("URSIM_KERNELS", "auto").strip().lower() == "jit"
+    seconds = JIT_COMPILE_SECONDS if jit else COMPILE_SECONDS
+    return f"Compiling the segmentation kernels (first run only, about {seconds} s)..."
 
 
 def _cache_dirs(source: Path) -> list[Path]:

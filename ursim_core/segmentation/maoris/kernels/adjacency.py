@@ -114,11 +114,12 @@ def build_adjacency(zones, value):
     count = len(value)
     records = _isolated_zones(value)
     last_partner = np.zeros(count, np.int32)
-    bound = _contacts_in_order(zones, last_partner, records, np.empty((2, 4), np.int32), True)
+    # np.bool_, not the literals True and False: one compile of _contacts_in_order, not two.
+    bound = _contacts_in_order(zones, last_partner, records, np.empty((2, 4), np.int32), np.bool_(True))
     for zone in range(count):
         last_partner[zone] = 0
     nodes = np.empty((max(2 * bound, 2), 4), np.int32)
-    _contacts_in_order(zones, last_partner, records, nodes, False)
+    _contacts_in_order(zones, last_partner, records, nodes, np.bool_(False))
     # Not trimmed to the nodes used: a slice would be typed as another array
     # layout, and every kernel taking the graph compiled twice.
     return records, nodes

@@ -186,6 +186,15 @@ def _is_inner(labels, parent, pixel, width, own):
 
 @njit(cache=True)
 def _compact_labels(labels, alive):
+    """Renumber the live zones 1..n - 1 in id order, in place (:func:`_compacted`)."""
+    return _compacted(labels, alive)
+
+
+# The kernels that contact_table calls are compiled as helpers with one body each: an
+# entry kernel called by another is compiled twice by the ahead-of-time build, once for
+# the caller and once for its own export (a second or more of CPU for these two).
+@inner_kernel
+def _compacted(labels, alive):
     """Renumber the live zones 1..n - 1 in id order, in place.
 
     Returns ``(original, compact_of, n)``: ``original[k - 1]`` is the id of
@@ -212,6 +221,13 @@ def _restore_labels(labels, parent, original):
 
 @njit(cache=True, nogil=True)
 def count_contacts(labels, width, n, start, stop):
+    """Contact counts of the pixels ``start..stop - 1`` of a compact, padded, flattened
+    label image (:func:`_counted`)."""
+    return _counted(labels, width, n, start, stop)
+
+
+@inner_kernel
+def _counted(labels, width, n, start, stop):
     """Contact counts of the pixels ``start..stop - 1`` of a compact, padded,
     flattened label image (``n`` zones; every label its own zone).
 
@@ -341,8 +357,8 @@ def contact_table(labels, width, alive):
     """Every contact count of a padded flat label image, as ``(zone, other,
     count)`` rows in original ids (other = 0: the zone's contour size)."""
     work = labels.copy()
-    original, compact_of, n = _compact_labels(work, alive)
-    pixels, used, keys, counts, meta, slots, total = count_contacts(work, width, n, np.int64(0), work.size)
+    original, compact_of, n = _compacted(work, alive)
+    pixels, used, keys, counts, meta, slots, total = _counted(work, width, n, np.int64(0), work.size)
     rows = 0
     for zone in range(1, n):
         if total[zone] > 0:

@@ -76,7 +76,7 @@ def centre_rectangles(dist, max_radius):
     rows, cols = dist.shape
     # Radii of rows y - 1, y, y + 1 at slots (row % 3), with a zero column on each side.
     ring = np.zeros((3, cols + 2), np.int32)
-    _load_radii(dist, 0, max_radius, ring[0])
+    _load_radii(dist, np.int64(0), max_radius, ring[0])  # not a literal: one compile of it
     centre_radius = np.zeros(cols + 1, np.int32)  # 0 = not a centre; one zero past the end
     # The rectangle whose last run starts at this column (it continues only if that run is on the row above).
     open_at = np.empty(cols, np.int64)

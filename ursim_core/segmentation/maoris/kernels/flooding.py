@@ -51,7 +51,9 @@ def flood_levels(levels, labels, mask, connectivity):
     flat_levels = levels.ravel()
     flat_labels = labels.ravel()
     flat_mask = mask.ravel()
-    top_level = 0
+    # Typed, not literals: numba types a call with what it knows so far, and a literal
+    # first compiles the callee for it, in vain.
+    top_level = np.int64(0)
     markers = 0
     for i in range(n):
         if flat_mask[i]:
@@ -66,7 +68,7 @@ def flood_levels(levels, labels, mask, connectivity):
         return -1
     shifts = (np.uint64(pixel_bits), np.uint64(pixel_bits + age_bits))
     heap = np.empty(max(markers, 1024) + 2, np.uint64)  # slots 1..items
-    items = 0
+    items = np.int64(0)
     for i in range(n):
         if flat_labels[i] != 0 and flat_labels[i] != _OUTSIDE:
             items += 1

@@ -142,7 +142,7 @@ def _contacts_fuse(here, into, n_walk, labels, width, state, scratch, keys, coun
     seen_bits = max(_bits(4 * 9 * n_walk), _MIN_BITS)
     for i in range(min(n_walk, _AHEAD)):
         _prefetch_rows(labels, walk_pixels[i], width)
-    n_affected = 0
+    n_affected = np.int64(0)  # typed, not a literal: a literal argument compiles a callee twice
     kept_head, kept_tail = -1, -1
     for i in range(n_walk):
         if i + _AHEAD < n_walk:

@@ -13,7 +13,7 @@ from numba import types
 
 from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, flat_zones, flooding, fusion
 
-__all__ = ["SIGNATURES", "GROUPS", "compile_group"]
+__all__ = ["SIGNATURES", "RETURN_TYPES", "GROUPS", "compile_group"]
 
 _I32, _I64, _BOOL = types.int32[::1], types.int64[::1], types.bool_[::1]
 _I32_2D, _I64_2D = types.int32[:, ::1], types.int64[:, ::1]
@@ -49,6 +49,32 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
     ("fusion", "remove_doors"): (_FLOAT, _I32, _INT, _I64, _BOOL, _GRAPH, _TRACKING),
     ("flooding", "flood_levels"): (_U32_2D, _I32_2D, _U8_2D, _INT),
     ("flooding", "clearance_levels"): (_F32_2D, _U8_2D),
+}
+
+#: ``(module, kernel name) -> return type``, as numba's typing gives it for
+#: :data:`SIGNATURES` (a test checks): the ahead-of-time build needs them, and typing every
+#: kernel to learn them cost seconds of that build.
+RETURN_TYPES: dict[tuple[str, str], types.Type] = {
+    ("discs", "centre_rectangles"): _I64_2D,
+    ("discs", "paint_discs"): types.none,
+    ("flat_zones", "label_flat_zones"): _I32_2D,
+    ("flat_zones", "zone_values_and_sizes"): types.Tuple((_I32, _I64)),
+    ("flat_zones", "first_pixels"): _I64,
+    ("flat_zones", "resolve_parents"): types.none,
+    ("flat_zones", "relabel"): types.none,
+    ("adjacency", "build_adjacency"): _GRAPH,
+    ("adjacency", "adjacency_entries"): _I64_2D,
+    ("adjacency", "_link_entries"): _GRAPH,
+    ("adjacency", "remove_small_zones"): types.none,
+    ("contacts", "_compact_labels"): types.Tuple((_I32, _I32, _INT)),
+    ("contacts", "count_contacts"): _COUNTS,
+    ("contacts", "join_counts"): _COUNTS,
+    ("contacts", "group_candidates"): types.UniTuple(_I32, 4),
+    ("contacts", "contact_table"): _I64_2D,
+    ("fusion", "merge_ripples"): types.none,
+    ("fusion", "remove_doors"): types.none,
+    ("flooding", "flood_levels"): _INT,
+    ("flooding", "clearance_levels"): _U32_2D,
 }
 
 _MODULES = {
