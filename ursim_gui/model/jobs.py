@@ -44,20 +44,27 @@ def _check(cancelled: CancelledCallback, what: str) -> None:
         raise JobCancelled(f"{what} cancelled")
 
 
-#: Shown while the first segmentation of a fresh install compiles the numba kernels.
+#: Shown while the first segmentation of a fresh install compiles the numba kernels, when the
+#: core does not say how long that takes.
 COMPILING_NOTE = "Compiling the segmentation kernels (first run only)…"
 
 
 def compiling_note(job) -> str | None:
-    """:data:`COMPILING_NOTE` when ``job`` is a segmentation that will compile the MAORIS kernels.
+    """The line to show when ``job`` is a segmentation that will compile the MAORIS kernels.
 
-    Asks ``ursim_core.segmentation.maoris.kernels_cached()`` (a few directory listings)
-    when the core has it; without it, or once the kernels are cached, None.
+    The core's own line when it has one (``ursim_core.segmentation.maoris.compile_notice()``,
+    the same as the CLI's, with the expected seconds), else :data:`COMPILING_NOTE` when
+    ``kernels_cached()`` says they are not built (a few directory listings); None once they
+    are, or when the core has neither.
     """
     if not isinstance(job, SegmentJob) or job.method not in ("maoris", "learned"):  # learned runs MAORIS
         return None
     from ursim_core.segmentation import maoris
 
+    notice = getattr(maoris, "compile_notice", None)
+    if notice is not None:
+        text = notice()
+        return None if text is None else text.replace("...", "…")
     cached = getattr(maoris, "kernels_cached", None)
     if cached is None or cached():
         return None
