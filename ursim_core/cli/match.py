@@ -370,6 +370,9 @@ def match_pair(
 
 
 def run(args: argparse.Namespace) -> int:
+    from ursim_core.matching.sweep_helper import keep_freed_memory
+
+    keep_freed_memory()
     record = match_pair(
         args.sketch, args.metric, Path(args.output), options_of(args), reference_path=args.reference, helper=True
     )
