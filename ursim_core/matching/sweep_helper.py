@@ -136,10 +136,15 @@ class Helper:
         # The helper imports this very package, wherever it was imported from.
         root = str(Path(__file__).resolve().parents[2])
         code = f"import sys; sys.path.insert(0, {root!r}); from ursim_core.matching.sweep_helper import serve; serve()"
-        self._process = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
         self._inputs: tuple = ()  # the objects last sent (kept, so that their identity is theirs)
-        self.alive = True
         self.owner = threading.current_thread()
+        try:
+            self._process = subprocess.Popen(
+                [sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE
+            )
+        except OSError:  # no interpreter to start: the sweeps run here alone
+            self._process = None
+        self.alive = self._process is not None
 
     def _send_inputs(self, prepared) -> None:
         inputs = (prepared.sketch_planar, prepared.metric_planar, prepared.c_matrix, prepared.config)
@@ -205,6 +210,8 @@ class Helper:
     def close(self) -> None:
         """Stop the helper (end of its input) and wait for it; kill it if it does not stop."""
         self.alive = False
+        if self._process is None:
+            return
         with contextlib.suppress(OSError):
             self._process.stdin.close()
         try:
