@@ -36,9 +36,11 @@ import numpy as np
 __all__ = ["MIN_REGIONS", "helping", "active", "Helper", "serve", "keep_freed_memory"]
 
 #: Sweeps share their values of m with the helper from this many regions in either map on. The
-#: helper costs about a second of CPU to start and a copy of the c matrix: worth it only when one
-#: planar matching costs about that (8000 px generated buildings: 4250 regions, 0.5-1 s per m).
-MIN_REGIONS = 2000
+#: helper costs about a second of CPU to start and a copy of the c matrix. ``ursim match`` of the
+#: 4000 px generated pair (990 and 1076 regions, about 0.1 s per m), interleaved x3: 6.6-7.1 s
+#: with it, 7.1-7.6 s without (1.3 s more CPU); 8000 px (4250 regions, 0.5-1 s per m): see
+#: ``ursim bench scale``. Sketch-sized pairs never start it.
+MIN_REGIONS = 900
 
 _ACTIVE: Helper | None = None
 _LENGTH = struct.Struct("<Q")
@@ -85,10 +87,11 @@ def keep_freed_memory() -> None:
     allocation, and free memory at the top of the heap is returned to the system: a
     building-sized pair allocates and frees arrays of 10-300 MB over and over (masks of the c
     matrix, the alignment tables, label and distance images), and the kernel zeroes and faults
-    their pages in each time. 8000 px pair (``ursim bench scale``, interleaved): about 1.05
-    million page faults and 9 s of system time without, 0.7 million and 5.7 s with the same
-    setting from the environment, the peak resident size within 2 %. Memory is still given back
-    after the segmentations (:func:`ursim_core.cli.match.load_and_segment` trims explicitly).
+    their pages in each time. 8000 px pair (``ursim match``, interleaved with main's code x2):
+    1.03-1.05 million minor page faults and 8.5-10.5 s of system time for main, 0.72-0.75
+    million and 8.0-8.5 s with this (on a loaded machine), the peak resident size within 2 %.
+    Memory is still given back after the segmentations
+    (:func:`ursim_core.cli.match.load_and_segment` trims explicitly).
     glibc only; elsewhere nothing. ``ursim match`` and its helper process call it.
     """
     import ctypes
