@@ -38,9 +38,13 @@ def test_the_table_blend_gives_the_pixels_of_the_float_blend():
 
     rng = np.random.default_rng(0)
     labels = rng.integers(0, 30, (40, 50)).astype(np.int32)
-    base = _base_image(rng.integers(0, 256, (40, 50)).astype(np.uint8), None, labels.shape)
+    grey = rng.integers(0, 256, (40, 50)).astype(np.uint8)
+    # Half of the pixels white, as free space is in a map (the blend's shortcut for them).
+    grey[rng.random(grey.shape) < 0.5] = 255
+    base = _base_image(grey, None, labels.shape)
     table = label_colors(labels)
     inside = labels > 0
+    assert (inside & (grey == 255)).any() and (inside & (grey != 255)).any()
     for opacity in (0.0, 0.3, 0.55, 0.7, 1.0):
         expected = base.astype(np.float32)
         expected[inside] = (1 - opacity) * expected[inside] + opacity * table.astype(np.float32)[labels[inside]]

@@ -259,16 +259,21 @@ def _return_freed_memory() -> None:
         pass
 
 
-def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None) -> dict[str, Any]:
+def match_pair(
+    sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None, helper: bool = False
+) -> dict[str, Any]:
     """Match one pair and write its outputs into ``out``; a record of what was done.
 
     The record has the counts, m, time and, with ``reference_path``, precision, recall, F1 and
     place accuracy against that ground truth. Errors propagate (the caller decides).
+    ``helper``: a building-sized pair shares the automatic m's sweep with a helper process
+    (:mod:`ursim_core.matching.sweep_helper`; same answers). ``ursim match`` asks for it; the
+    batch commands, which already run one pair per core, do not.
     """
     from types import SimpleNamespace
 
     from ursim_core.correspondences import Correspondences, MapRef, from_pairs, save_correspondences
-    from ursim_core.matching import match
+    from ursim_core.matching import match, sweep_helper
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -285,9 +290,13 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
     )
     # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
     config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
-    started = time.perf_counter()
-    result = match(sketch_seg, metric_seg, config=config)
-    elapsed = time.perf_counter() - started
+    large = max(sketch_seg.n_regions, metric_seg.n_regions) >= sweep_helper.MIN_REGIONS
+    # The images are staged and moved in together; the JSON, which names them, is written last
+    # (atomically, in place, so the paths it stores are relative to its own folder).
+    # The two label images are encoded on two threads while the maps are matched (OpenCV
+    # releases the GIL, the matcher holds it most of the time; 8000 px labels take about half a
+    # second each); errors are raised in the order of the steps (match, labels, figure).
+    from concurrent.futures import ThreadPoolExecutor
 
     def ref(the_map, seg, labels_name):
         return MapRef(
@@ -300,38 +309,37 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
             extra={},
         )
 
-    cliques = from_pairs(
-        result.pairs,
-        sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
-        metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
-        source="auto",
-    )
-    corr = Correspondences(
-        sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
-        metric=ref(metric_map, metric_seg, "metric.labels.png"),
-        cliques=cliques,
-        extra={"matcher": matcher_record(config, result)},
-    )
-    figure = side_by_side_matches(
-        (sketch_seg.labels, sketch_seg.graph, sketch_map.image),
-        (metric_seg.labels, metric_seg.graph, metric_map.image),
-        result.pairs,
-        anchors=result.anchors,
-    )
-    # The images are staged and moved in together; the JSON, which names them, is written last
-    # (atomically, in place, so the paths it stores are relative to its own folder).
-    # The three PNGs are encoded on two threads (OpenCV releases the GIL; 8000 px labels take
-    # about half a second each); an error is raised in this order.
-    from concurrent.futures import ThreadPoolExecutor
-
     with staged_folder(out) as staging, ThreadPoolExecutor(max_workers=2, thread_name_prefix="ursim-save") as pool:
         jobs = [
             pool.submit(save_label_image, sketch_seg, staging / "sketch.labels.png"),
             pool.submit(save_label_image, metric_seg, staging / "metric.labels.png"),
-            pool.submit(save_png, staging / "matches.png", figure),
         ]
+        with sweep_helper.helping(enabled=helper and large):
+            started = time.perf_counter()
+            result = match(sketch_seg, metric_seg, config=config)
+            elapsed = time.perf_counter() - started
         for job in jobs:
             job.result()
+        cliques = from_pairs(
+            result.pairs,
+            sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
+            metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
+            source="auto",
+        )
+        corr = Correspondences(
+            sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
+            metric=ref(metric_map, metric_seg, "metric.labels.png"),
+            cliques=cliques,
+            extra={"matcher": matcher_record(config, result)},
+        )
+        figure = side_by_side_matches(
+            (sketch_seg.labels, sketch_seg.graph, sketch_map.image),
+            (metric_seg.labels, metric_seg.graph, metric_map.image),
+            result.pairs,
+            anchors=result.anchors,
+        )
+        save_png(staging / "matches.png", figure)
+
     save_correspondences(corr, out / "correspondences.json")
     record: dict[str, Any] = {
         "n_matches": len(result.pairs),
@@ -362,7 +370,12 @@ def match_pair(sketch, metric, out: Path, options: dict[str, Any], *, reference_
 
 
 def run(args: argparse.Namespace) -> int:
-    record = match_pair(args.sketch, args.metric, Path(args.output), options_of(args), reference_path=args.reference)
+    from ursim_core.matching.sweep_helper import keep_freed_memory
+
+    keep_freed_memory()
+    record = match_pair(
+        args.sketch, args.metric, Path(args.output), options_of(args), reference_path=args.reference, helper=True
+    )
     out = record["out"]
     m = record["m"]
     m_text = f"{m:.3f}" if isinstance(m, (int, float)) else str(m)

@@ -228,10 +228,11 @@ def _expand_locked(first_order, second_order, matched, second_positions, same, c
     :data:`PACKED_CELLS` cells or more and ``same`` is an array.
     """
     locks = []  # (position in first_order, position in second_order), in first_order order
+    partner_of, position_of = matched.get, second_positions.get  # once, not per neighbour
     for k, vertex in enumerate(first_order):
-        partner = matched.get(vertex)
+        partner = partner_of(vertex)
         if partner is not None:
-            position = second_positions.get(partner)
+            position = position_of(partner)
             if position is not None:
                 locks.append((k, position))
     if not locks:
@@ -395,6 +396,9 @@ def planar_match(
     second_positions = [{vertex: k for k, vertex in enumerate(order)} for order in second.neighbours]
     first_ends, second_ends = _adjacency_ends(first_sets), _adjacency_ends(second_sets)
     reversed_first = [order[::-1] for order in first.neighbours]
+    second_neighbours = second.neighbours
+    branching_first = [len(order) > 1 for order in first.neighbours]
+    branching_second = [len(order) > 1 for order in second.neighbours]
     arc_cache: dict = {}
     packed: dict = {}
     alternatives: list = []
@@ -422,28 +426,35 @@ def planar_match(
             consumed.add(pair)
         matched = {seed_first: seed_second}
         pairs = [seed]
+        # The loop below runs for every pair of every hypothesis (hundreds of thousands per m
+        # on a building map): bound methods and the pair tuples are reused, not looked up or
+        # rebuilt each time.
+        pop, push, keep = queue.popleft, queue.append, pairs.append
+        see_first, see_second, consume = seen_first.add, seen_second.add, consumed.add
+        reflected = alignment.reflected
         while queue:
-            vertex, partner = queue.popleft()
-            pairs.append((vertex, partner))
+            pair = pop()
+            keep(pair)
+            vertex, partner = pair
             matched[vertex] = partner
-            first_order, second_order = first_orders[vertex], second.neighbours[partner]
-            if len(first_order) <= 1 or len(second_order) <= 1:
+            if not branching_first[vertex] or not branching_second[partner]:
                 continue  # one neighbour on either side: every arc between locks is empty
-            for a, b in _expand_locked(
-                first_order,
-                second_order,
+            for candidate in _expand_locked(
+                first_orders[vertex],
+                second_neighbours[partner],
                 matched,
                 second_positions[partner],
                 same,
                 arc_cache,
                 packed,
-                (vertex, partner, alignment.reflected),
+                (vertex, partner, reflected),
             ):
+                a, b = candidate
                 if a not in seen_first and b not in seen_second:
-                    queue.append((a, b))
-                    seen_first.add(a)
-                    seen_second.add(b)
-                    consumed.add((a, b))
+                    push(candidate)
+                    see_first(a)
+                    see_second(b)
+                    consume(candidate)
         hypotheses += 1
         inner_first = _inner_edges(first_ends, n_first, matched.keys())
         inner_second = _inner_edges(second_ends, n_second, matched.values())

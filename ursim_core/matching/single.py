@@ -11,7 +11,7 @@ from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.planar import hypothesis_cost, planar_match
 from ursim_core.matching.results import MatchResult, Prepared
 
-__all__ = ["seed_pairs", "SeedSelector", "seed_cap", "pair_cost_matrix", "match_at"]
+__all__ = ["seed_pairs", "SeedSelector", "seed_cap", "pair_cost_matrix", "planar_seeds", "planar_outcome", "match_at"]
 
 
 def seed_pairs(c_matrix: np.ndarray, m: float, *, max_seeds: int | None = None) -> list[tuple[int, int]]:
@@ -126,11 +126,46 @@ def _cost_of(prepared: Prepared, index_pairs, pair_costs) -> tuple[float, float]
     return cost, (cost / total if total else 0.0)
 
 
-def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None = None) -> MatchResult:
+def planar_seeds(prepared: Prepared, m: float, seed_selector: SeedSelector | None = None) -> list[tuple[int, int]]:
+    """The planar matcher's seeds at m: :func:`seed_pairs` with the configured cap.
+
+    ``seed_selector`` (see :func:`match_at`) gives the same seeds faster when its cap is the
+    configured one.
+    """
+    c_matrix = prepared.c_matrix
+    cap = seed_cap(prepared.config.max_seeds, *c_matrix.shape)
+    if seed_selector is not None and cap is not None and seed_selector._max_seeds == cap:
+        return seed_selector.at(m)
+    return seed_pairs(c_matrix, m, max_seeds=cap)
+
+
+def planar_outcome(sketch_planar, metric_planar, c_matrix: np.ndarray, config: MatchConfig, m: float, seeds):
+    """:func:`~ursim_core.matching.planar.planar_match` at m from these seeds, as :func:`match_at` runs it.
+
+    Everything it reads is passed in (no :class:`Prepared`), so that a helper process of a sweep
+    over m (:mod:`ursim_core.matching.auto_m`) runs exactly what :func:`match_at` would.
+    """
+    # Arrays, not nested lists: converting an n1 x n2 matrix costs seconds for
+    # thousands of regions, and the planar matcher reads only a few of its cells.
+    return planar_match(
+        sketch_planar,
+        metric_planar,
+        np.asarray(c_matrix) <= m,
+        seeds=seeds,
+        rotation_search=config.rotation_search,
+        reflections=config.reflections,
+        pair_costs=pair_cost_matrix(config, c_matrix, m),
+        pair_cost_weight=config.score_weight,
+    )
+
+
+def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None = None, outcome=None) -> MatchResult:
     """Run the configured matcher at one fixed m.
 
     ``seed_selector``: a :class:`SeedSelector` of ``prepared.c_matrix`` and the configured
     seed cap, shared by the calls of a sweep over m (the same seeds, found faster).
+    ``outcome``: the planar matcher's result at m, when it was already computed by
+    :func:`planar_outcome` from the seeds of :func:`planar_seeds` (a sweep's helper process).
 
     Examples
     --------
@@ -162,27 +197,13 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
     pair_costs = pair_cost_matrix(config, c_matrix, m) if descriptors is not None else None
     if descriptors is not None:
         if config.matcher == "planar":
-            cap = seed_cap(config.max_seeds, *c_matrix.shape)
-            if seed_selector is not None and cap is not None and seed_selector._max_seeds == cap:
-                seeds = seed_selector.at(m)
-            else:
-                seeds = seed_pairs(c_matrix, m, max_seeds=cap)
+            seeds = planar_seeds(prepared, m, seed_selector)
             seeds_count = len(seeds)
             if not seeds:
                 reasons.append(f"no seeds: no pair of regions has c <= m = {m:g}")
             else:
-                # Arrays, not nested lists: converting an n1 x n2 matrix costs seconds for
-                # thousands of regions, and the planar matcher reads only a few of its cells.
-                outcome = planar_match(
-                    prepared.sketch_planar,
-                    prepared.metric_planar,
-                    np.asarray(c_matrix) <= m,
-                    seeds=seeds,
-                    rotation_search=config.rotation_search,
-                    reflections=config.reflections,
-                    pair_costs=pair_costs,
-                    pair_cost_weight=config.score_weight,
-                )
+                if outcome is None:
+                    outcome = planar_outcome(prepared.sketch_planar, prepared.metric_planar, c_matrix, config, m, seeds)
                 index_pairs = outcome.pairs
                 hypotheses = outcome.hypotheses
         elif config.matcher == "hungarian":

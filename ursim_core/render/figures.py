@@ -98,10 +98,18 @@ def _blended(base: np.ndarray, labels: np.ndarray, inside: np.ndarray, table: np
         return canvas.astype(np.uint8)
     levels = np.arange(256, dtype=np.float32)
     lookup = ((1 - opacity) * levels[:, None] + opacity * levels[None, :]).astype(np.uint8)
-    where = np.flatnonzero(inside)
-    grey = base[..., 0].ravel()[where]
-    regions = labels.ravel()[where]
+    grey = base[..., 0]
     canvas = base.copy()
+    # Most labelled pixels are free space, white in the map: their colour depends on the label
+    # alone, one gather per pixel from a per-label row of the table (a 4000 x 4000 side of a
+    # building figure: about 0.1 s instead of 1 s). The others, grey near the walls, go through
+    # the whole table.
+    white = inside & (grey == 255)
+    # (OpenCV's masked copy: NumPy's copyto with a broadcast mask takes ten times as long.)
+    cv2.copyTo(np.take(lookup[255][table], labels, axis=0), white.view(np.uint8), canvas)
+    where = np.flatnonzero(inside & ~white)
+    regions = labels.ravel()[where]
+    grey = grey.ravel()[where]
     pixels = canvas.reshape(-1, 3)
     for channel in range(3):
         pixels[where, channel] = lookup[grey, table[regions, channel]]
