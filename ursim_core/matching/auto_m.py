@@ -93,7 +93,8 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
         selector = SeedSelector(c_matrix, cap)
     helper = sweep_helper.active(prepared, len(grid))
     if helper is not None:
-        return _sweep_shared(prepared, grid, selector, helper, progress)
+        # Building-sized pairs (never screened by sweeps, see pipeline.prepare): nothing is known.
+        return _sweep_shared(prepared, grid, selector, helper, progress), {}
     results = []
     previous_mask = None
     for index, m in enumerate(grid, start=1):
