@@ -305,6 +305,11 @@ def _inner_edges(ends, n_vertices: int, vertices) -> int:
     return int(np.count_nonzero(inside[sources] & inside[targets])) // 2
 
 
+#: Pair-cost matrices of at most this many cells are read as nested lists by :func:`planar_match`
+#: (a KTH pair has about a hundred); larger ones are indexed as arrays (no n1 x n2 lists).
+_LISTED_COSTS = 4096
+
+
 def planar_match(
     first: PlanarGraph,
     second: PlanarGraph,
@@ -366,7 +371,7 @@ def planar_match(
     edges_first, edges_second = len(first.edges), len(second.edges)
     weighted = pair_costs is not None and pair_cost_weight != 0
 
-    if weighted and isinstance(pair_costs, np.ndarray):
+    if weighted and isinstance(pair_costs, np.ndarray) and pair_costs.size > _LISTED_COSTS:
         cost_array = pair_costs
 
         def pair_costs_of(pairs):
@@ -374,6 +379,10 @@ def planar_match(
             return cost_array[[a for a, _ in pairs], [b for _, b in pairs]].tolist()
 
     else:
+        if weighted and isinstance(pair_costs, np.ndarray):
+            # A sketch-sized matrix read as lists: every seed and hypothesis is scored, and
+            # indexing lists costs a fraction of NumPy's per-call overhead (the same floats).
+            pair_costs = pair_costs.tolist()
 
         def pair_costs_of(pairs):
             return [pair_costs[a][b] for a, b in pairs]
