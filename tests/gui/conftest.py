@@ -129,6 +129,20 @@ def region_point(view, region: int):
     return view.mapFromScene(view.region_scene_point(region))
 
 
+def hover(qtbot, widget, pos) -> None:
+    """Move the mouse onto ``pos`` of ``widget`` so that the widget sees a move event.
+
+    Qt drops a move to the global position the cursor already has, and tests in one worker
+    share that position: a window placed where an earlier test's was, hovered at the same
+    pixel, would get no event at all (a test failed in CI that way). A step beside the
+    target first makes the last move a real one.
+    """
+    from PySide6.QtCore import QPoint
+
+    qtbot.mouseMove(widget, pos + QPoint(3, 3))
+    qtbot.mouseMove(widget, pos)
+
+
 def error_boxes(parent):
     """Visible error dialogs of a window."""
     from PySide6.QtWidgets import QMessageBox

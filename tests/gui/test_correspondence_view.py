@@ -3,7 +3,7 @@ the partners, connector lines, and the table is synced with the views both ways.
 
 from __future__ import annotations
 
-from conftest import region_point
+from conftest import hover, region_point
 from PySide6.QtCore import QPointF, Qt
 
 
@@ -30,11 +30,11 @@ def test_matched_regions_share_the_clique_colour(window):
 def test_hover_highlights_partners_in_the_other_view(window, qtbot):
     window.session.link([1], [2, 3])
     sketch, metric = window.views["sketch"], window.views["metric"]
-    qtbot.mouseMove(sketch.viewport(), region_point(sketch, 1))
+    hover(qtbot, sketch.viewport(), region_point(sketch, 1))
     assert metric.marked_regions("highlight") == {2, 3}
-    qtbot.mouseMove(sketch.viewport(), region_point(sketch, 2))
+    hover(qtbot, sketch.viewport(), region_point(sketch, 2))
     assert metric.marked_regions("highlight") == set()
-    qtbot.mouseMove(metric.viewport(), region_point(metric, 3))
+    hover(qtbot, metric.viewport(), region_point(metric, 3))
     assert sketch.marked_regions("highlight") == {1}
     window.session.unlink("sketch", 1)  # an edit updates the hovered highlight
     assert sketch.marked_regions("highlight") == set()

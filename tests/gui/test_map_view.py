@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import hover
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QPainter, QWheelEvent
 from PySide6.QtWidgets import QApplication
@@ -91,7 +92,7 @@ def test_click_hover_and_cursor_report_map_pixels(qtbot, view):
     view.region_hovered.connect(hovers.append)
     view.cursor_moved.connect(lambda row, col: cursors.append((row, col)))
     room3 = view.mapFromScene(QPointF(120.5, 30.5))
-    qtbot.mouseMove(view.viewport(), room3)
+    hover(qtbot, view.viewport(), room3)
     assert hovers[-1] == 3 and cursors[-1] == (30, 120)
     qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.ControlModifier, room3)
     assert clicks == [(3, True)]

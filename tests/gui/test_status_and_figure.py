@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import error_boxes
+from conftest import error_boxes, hover
 from PySide6.QtCore import QPointF
 from PySide6.QtGui import QImage
 
@@ -15,7 +15,7 @@ from ursim_gui.views.status_bar import format_cursor, format_zoom
 
 def test_status_bar_shows_pixel_region_and_zoom(window, qtbot):
     view = window.views["sketch"]
-    qtbot.mouseMove(view.viewport(), view.mapFromScene(QPointF(75.5, 30.5)))
+    hover(qtbot, view.viewport(), view.mapFromScene(QPointF(75.5, 30.5)))
     text = window.status.cursor_label.text()
     assert text.startswith("sketch  px (30, 75)") and "region 2" in text and "world" not in text
     view.set_zoom(4)
@@ -29,7 +29,7 @@ def test_status_bar_shows_world_coordinates_of_ros_maps(window, map_files, tmp_p
     )
     window.documents.open_map("metric", yaml_path)
     view = window.views["metric"]
-    qtbot.mouseMove(view.viewport(), view.mapFromScene(QPointF(0.5, 119.5)))  # the lower-left pixel
+    hover(qtbot, view.viewport(), view.mapFromScene(QPointF(0.5, 119.5)))  # the lower-left pixel
     text = window.status.cursor_label.text()
     assert "px (119, 0)" in text and "world (10.25, 20.25) m" in text
 
