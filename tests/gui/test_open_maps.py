@@ -37,7 +37,7 @@ def test_file_menu_opens_each_map(empty_window, map_files, monkeypatch):
     assert win.session.map("sketch").shape == (60, 150)
     assert win.session.map("metric").shape == (120, 300)
     assert win.views["metric"].sceneRect().width() == 300
-    assert "120×300" in win.view_titles["metric"].text()
+    assert "300 × 120 px" in win.view_titles["metric"].text()  # width x height
     assert win.segmentation_panel.boxes["metric"].segment_button.isEnabled()
 
 

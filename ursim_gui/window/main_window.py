@@ -357,7 +357,8 @@ class MainWindow(QMainWindow):
         text = (
             side.capitalize()
             if map_ is None
-            else f"{side.capitalize()}: {map_.name}  ({map_.shape[0]}×{map_.shape[1]} px)"
+            # Width x height, as image tools say it (the status bar gives pixels as (row, col)).
+            else f"{side.capitalize()}: {map_.name}  ({map_.shape[1]} × {map_.shape[0]} px)"
         )
         self.view_titles[side].setText(text)
         self._update_ready()
