@@ -60,7 +60,14 @@ __all__ = [
 ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
     "discs": ("centre_rectangles", "paint_discs"),
     "flat_zones": ("label_flat_zones", "zone_values_and_sizes", "first_pixels", "resolve_parents", "relabel"),
-    "adjacency": ("build_adjacency", "adjacency_entries", "_link_entries", "remove_small_zones"),
+    "adjacency": (
+        "build_adjacency",
+        "adjacency_entries",
+        "_link_entries",
+        "remove_small_zones",
+        "compact_graph",
+        "expand_graph",
+    ),
     "contacts": ("_compact_labels", "count_contacts", "join_counts", "group_candidates", "contact_table"),
     "fusion": ("merge_ripples", "remove_doors"),
     "flooding": ("flood_levels", "clearance_levels"),

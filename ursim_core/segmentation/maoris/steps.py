@@ -71,8 +71,23 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
     zones = np.flatnonzero(graph._alive)
     order = zones[np.lexsort((graph._size[zones], -graph._value_array[zones]))].astype(np.int32)
     labels, width = graph._labels.ravel(), graph._labels.shape[1]
-    tracking = start_tracking(labels, width, graph._alive)
-    kernels().merge_ripples(order, float(ripples), labels, width, graph._size, graph._alive, compact, tracking)
+    original, compact_of, state = start_tracking(labels, width, graph._alive)
+    # The kernel runs on the live zones renumbered in id order (the same order, ties and
+    # lists): their records and nodes in a few MB rather than scattered through the graph's
+    # (kernels' compact_graph). So the tracking's compact ids are the zones' own.
+    small = kernels().compact_graph(original, compact_of, compact)
+    size = np.zeros(len(original) + 1, np.int64)
+    size[1:] = graph._size[original]
+    alive = np.ones(len(original) + 1, bool)
+    alive[0] = False
+    identity = np.arange(len(original) + 1, dtype=np.int32)
+    kernels().merge_ripples(
+        compact_of[order], float(ripples), labels, width, size, alive, small, (original, identity, state)
+    )
+    kernels().expand_graph(original, small, compact[0])
+    graph._compact = (compact[0], small[1])
+    graph._size[original] = size[1:]
+    graph._alive[original] = alive[1:]
     return graph
 
 

@@ -133,3 +133,44 @@ def _contact_add(slots, keys, counts, meta, base, a, b, delta):
         return
     slots[start] = 1
     _table_add(keys, counts, meta, a * base + b, delta)
+
+
+@loop_helper
+def _contact_add_live(slots, keys, counts, meta, base, a, b, delta, parent):
+    """:func:`_contact_add` while zones fuse: an entry of a's row whose partner is a
+    fused zone (not its own union-find root in ``parent``) counts as free.
+
+    The fusions leave the counts having a fused zone as the partner as they are (never
+    queried again, :func:`~.contacts._recount`): their entries are reused here, when
+    the row has no free one, so that they do not push live partners into the shared
+    table. Every pair still has at most one entry, so the counts read are the same.
+    """
+    start = a * _SLOTS
+    free = -1
+    for k in range(start + 1, start + _SLOTS):
+        entry = slots[k]
+        if entry >= 0:
+            if (entry >> 32) == b:
+                entry += delta
+                slots[k] = entry if entry & _COUNT else -1
+                return
+        elif free == -1:
+            free = k
+    if slots[start] != 0:
+        key = a * base + b
+        slot = _slot(keys, meta, key)
+        if keys[slot] == key:
+            counts[slot] += delta
+            return
+    if free == -1:
+        for k in range(start + 1, start + _SLOTS):
+            partner = slots[k] >> 32
+            if parent[partner] != partner:
+                free = k
+                break
+    if free != -1:
+        # A new contact only ever starts with a positive count.
+        slots[free] = (np.int64(b) << 32) + delta
+        return
+    slots[start] = 1
+    _table_add(keys, counts, meta, a * base + b, delta)

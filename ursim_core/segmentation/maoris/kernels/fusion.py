@@ -14,7 +14,7 @@ from numba import njit
 from ursim_core.segmentation.maoris.kernels.adjacency import ATTRIBUTE, DEGREE, HEAD, NEIGHBOUR, NEXT, VALUE, fuse_edges
 from ursim_core.segmentation.maoris.kernels.contact_table import (
     _EMPTY,
-    _contact_add,
+    _contact_add_live,
     _probe,
     _table_reserve,
     contact_get,
@@ -187,7 +187,7 @@ def _contacts_fuse(here, into, n_walk, labels, width, state, scratch, keys, coun
         slot = changed[k]
         if change_counts[slot] != 0:
             key = change_keys[slot]
-            _contact_add(slots, keys, counts, meta, base, key // base, key % base, change_counts[slot])
+            _contact_add_live(slots, keys, counts, meta, base, key // base, key % base, change_counts[slot], parent)
         change_keys[slot] = _EMPTY
     parent[here] = into
     if kept_head != -1:
