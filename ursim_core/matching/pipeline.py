@@ -201,13 +201,22 @@ def _refitted(prepared: Prepared, result: MatchResult, starts: dict | None = Non
         starts = {} if starts is None else starts
         mirrored = bool(first.orientation[1])
         if mirrored not in starts:
-            starts[mirrored] = signature_start(first, _match_coarsely)
+            starts[mirrored] = signature_start(first, _match_sparsely)
         start = starts[mirrored]
         if start is not None and set(start.pairs) != set(first_answer.pairs):
             refitted = refit_from(first, start.pairs, _match_coarsely)
             if refitted is not None and refitted[1].normalised_cost < result.normalised_cost:
                 prepared, result = refitted
     return prepared, result
+
+
+def _match_sparsely(prepared: Prepared) -> MatchResult:
+    """:func:`_match_coarsely` over every second m of its grid (every fourth of the full grid)."""
+    config = prepared.config
+    if config.m == "auto" and len(config.m_grid) > 4 * _COARSE_STEP:
+        sparse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: 2 * _COARSE_STEP]))
+        return dataclasses.replace(match_prepared(dataclasses.replace(prepared, config=sparse)), config=config)
+    return _match_coarsely(prepared)
 
 
 def _match_coarsely(prepared: Prepared) -> MatchResult:
