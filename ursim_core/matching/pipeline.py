@@ -74,7 +74,8 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     only the position term and the neighbour orders depend on the orientation. With
     ``config.position_refits`` (the planar matcher), the answer in each orientation is matched
     again with the sketch's positions laid on the metric map by its own pairs
-    (:mod:`ursim_core.matching.refit`); the answer found is kept in ``Prepared.chosen``.
+    (:mod:`ursim_core.matching.refit`), and with ``config.signature_refit`` also laid by the answer
+    matched without the position term; the answer found is kept in ``Prepared.chosen``.
     ``config.matcher='auto'`` is resolved first (:meth:`MatchConfig.resolved`).
 
     Parameters
