@@ -103,7 +103,9 @@ class MatchConfig:
         (:func:`ursim_core.matching.refit.signature_start`). A start that does not depend on the
         sketch covering the metric map in proportion. Costs a sweep of every fourth m per mirror
         flag and one of every second m per finalist orientation (about 15 % more planar matches
-        per KTH pair); on the KTH sketches it changes no answer.
+        per KTH pair, 15-40 % more prepare time measured on a loaded machine, which would take
+        the 41 ms median of ``ursim bench match`` past its 50 ms budget: off by default); on the KTH
+        sketches it changes no answer.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -159,7 +161,7 @@ class MatchConfig:
     signature_method: str = "auto"
     position_weight: float = 2.0
     position_refits: int = 1
-    signature_refit: bool = True
+    signature_refit: bool = False
     hypothesis_score: str = "signature"
     score_weight: float = 8.0
     orientation: Any = "any"
