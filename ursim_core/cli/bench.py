@@ -10,6 +10,7 @@ EXAMPLES = """examples:
   ursim bench startup --repeats 7
   ursim bench scale --sizes 1000 2000 4000
   ursim bench invariance --seeds 12
+  ursim bench invariance --seeds 8 --first-seed 8
   ursim bench all --datasets ../shared/datasets"""
 
 #: Benchmarks by name; "all" runs segment, scale and match (the others on request).
@@ -24,6 +25,17 @@ def _count(text: str) -> int:
         value = 0
     if value < 1:
         raise argparse.ArgumentTypeError(f"expects a whole number of at least 1, got '{text}'")
+    return value
+
+
+def _start(text: str) -> int:
+    """``--first-seed``: a whole number, at least 0 (else a usage error)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expects a whole number of at least 0, got '{text}'")
     return value
 
 
@@ -43,6 +55,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--csv", metavar="FILE", help="quality: also write every row to FILE")
     parser.add_argument("--seeds", type=_count, default=8, help="invariance: generated pairs (default 8)")
     parser.add_argument(
+        "--first-seed",
+        type=_start,
+        default=0,
+        metavar="N",
+        help="invariance: the first pair's seed (default 0; 8 with --seeds 8 holds out seeds 8-15)",
+    )
+    parser.add_argument(
         "--sizes",
         type=int,
         nargs="+",
@@ -55,5 +74,11 @@ def run(args: argparse.Namespace) -> int:
     from ursim_core.bench.runner import run_bench
 
     return run_bench(
-        args.what, datasets=args.datasets, repeats=args.repeats, sizes=args.sizes, csv=args.csv, seeds=args.seeds
+        args.what,
+        datasets=args.datasets,
+        repeats=args.repeats,
+        sizes=args.sizes,
+        csv=args.csv,
+        seeds=args.seeds,
+        first_seed=args.first_seed,
     )

@@ -96,6 +96,16 @@ class MatchConfig:
         keep the new answer when its hypothesis score is lower (:mod:`ursim_core.matching.refit`);
         0 = positions normalised to each map's extent only. Not applied to graphs of more than 60
         regions (there its second sweep took seconds to minutes).
+    signature_refit : bool
+        With position refits: also match once without the position term (signatures and
+        structure alone), lay the sketch on the metric map by that answer's pairs, match again
+        and keep that answer when its hypothesis score is lower than the refitted one's
+        (:func:`ursim_core.matching.refit.signature_start`). A start that does not depend on the
+        sketch covering the metric map in proportion. Costs a sweep of every fourth m per mirror
+        flag and one of every second m per finalist orientation (about 15 % more planar matches
+        per KTH pair, 15-40 % more prepare time measured on a loaded machine, which would take
+        the 41 ms median of ``ursim bench match`` past its 50 ms budget: off by default); on the KTH
+        sketches it changes no answer.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -151,6 +161,7 @@ class MatchConfig:
     signature_method: str = "auto"
     position_weight: float = 2.0
     position_refits: int = 1
+    signature_refit: bool = False
     hypothesis_score: str = "signature"
     score_weight: float = 8.0
     orientation: Any = "any"
@@ -225,6 +236,8 @@ class MatchConfig:
             raise ParameterError(
                 f"must be a non-negative integer, not {self.position_refits!r}", field="position_refits"
             )
+        if not isinstance(self.signature_refit, bool):
+            raise ParameterError(f"must be true or false, not {self.signature_refit!r}", field="signature_refit")
         if not self.times:
             raise ParameterError("needs at least one time", field="times")
         if not self.m_grid:
@@ -257,6 +270,7 @@ class MatchConfig:
             reflections=False,
             position_weight=0.0,
             position_refits=0,
+            signature_refit=False,
             hypothesis_score="structure",
             score_weight=0.0,
             orientation="upright",
@@ -290,6 +304,7 @@ class MatchConfig:
             reflections=False,
             position_weight=0.0,
             position_refits=0,
+            signature_refit=False,
             hypothesis_score="substitutions",
             score_weight=1.0,
             orientation="upright",

@@ -36,7 +36,7 @@ from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchCon
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph
 from ursim_core.matching.planar import planar_graph
-from ursim_core.matching.refit import refit_positions
+from ursim_core.matching.refit import refit_from, refit_positions, signature_start
 from ursim_core.matching.results import MatchResult, Prepared
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
 from ursim_core.segmentation.canonical import wall_angle
@@ -74,7 +74,8 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     only the position term and the neighbour orders depend on the orientation. With
     ``config.position_refits`` (the planar matcher), the answer in each orientation is matched
     again with the sketch's positions laid on the metric map by its own pairs
-    (:mod:`ursim_core.matching.refit`); the answer found is kept in ``Prepared.chosen``.
+    (:mod:`ursim_core.matching.refit`), and with ``config.signature_refit`` also laid by the answer
+    matched without the position term; the answer found is kept in ``Prepared.chosen``.
     ``config.matcher='auto'`` is resolved first (:meth:`MatchConfig.resolved`).
 
     Parameters
@@ -155,6 +156,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
             screened.append((ranked(chosen_of(coarse_prepared, results).normalised_cost, index), index))
         finalists = sorted(index for _, index in sorted(screened)[:_FINALISTS])
     trials = []
+    starts: dict = {}  # the signature starts of the refit, by mirror flag (see _refitted)
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
         share = _share_of(progress, step, len(finalists))
@@ -163,7 +165,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
             result = choose_m(prepared, progress=share, known=known.get(index))
         else:
             result = match_prepared(prepared, progress=share)
-        prepared, result = _refitted(prepared, result)
+        prepared, result = _refitted(prepared, result, starts)
         trials.append((ranked(result.normalised_cost, index), index, prepared, result))
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
@@ -177,17 +179,45 @@ def _refits(config: MatchConfig) -> int:
     return config.position_refits if config.matcher == "planar" and config.position_weight else 0
 
 
-def _refitted(prepared: Prepared, result: MatchResult) -> tuple[Prepared, MatchResult]:
+def _refitted(prepared: Prepared, result: MatchResult, starts: dict | None = None) -> tuple[Prepared, MatchResult]:
+    """The answer after the position refits (:mod:`ursim_core.matching.refit`), or as given.
+
+    With ``signature_refit``, the sketch is also laid on the metric map by the pairs of the answer
+    matched without the position term, a start that does not depend on the sketch covering the
+    metric map in proportion. That answer depends on the orientation only through the mirror
+    (a turn keeps every neighbour order), so ``starts`` keeps it per mirror flag for the other
+    orientations of the same pair.
+    """
     if max(prepared.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
         # Sketch-sized graphs only, where it was measured: two generated 1000-region buildings
         # took 83 s to prepare with it against 2.8 s without (`ursim bench scale`, 4000 px).
         return prepared, result
+    first, first_answer = prepared, result
     for _ in range(_refits(prepared.config)):
         refitted, answer = refit_positions(prepared, result, _match_coarsely)
         if answer is result:
             break
         prepared, result = refitted, answer
+    if _refits(first.config) and first.config.signature_refit:
+        starts = {} if starts is None else starts
+        mirrored = bool(first.orientation[1])
+        if mirrored not in starts:
+            starts[mirrored] = signature_start(first, _match_sparsely)
+        start = starts[mirrored]
+        if start is not None and set(start.pairs) != set(first_answer.pairs):
+            refitted = refit_from(first, start.pairs, _match_coarsely)
+            if refitted is not None and refitted[1].normalised_cost < result.normalised_cost:
+                prepared, result = refitted
     return prepared, result
+
+
+def _match_sparsely(prepared: Prepared) -> MatchResult:
+    """:func:`_match_coarsely` over every second m of its grid (every fourth of the full grid)."""
+    config = prepared.config
+    if config.m == "auto" and len(config.m_grid) > 4 * _COARSE_STEP:
+        sparse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: 2 * _COARSE_STEP]))
+        return dataclasses.replace(match_prepared(dataclasses.replace(prepared, config=sparse)), config=config)
+    return _match_coarsely(prepared)
 
 
 def _match_coarsely(prepared: Prepared) -> MatchResult:
