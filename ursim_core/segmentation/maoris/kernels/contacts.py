@@ -107,7 +107,7 @@ def _recount(around, here, into, partners, signs, total):
     Only the counts of live zones with live partners change: those of ``here``
     itself, and every count with ``here`` as the partner, are left as they are,
     since a fused zone is never queried again (its partner entries are reused
-    by :func:`~.fusion._contact_add_live`). Two thirds of the changes a fusion
+    by :func:`~.contact_table._contact_add_live`). Two thirds of the changes a fusion
     made were the removal of such counts.
     """
     own = around[4]
