@@ -130,17 +130,29 @@ def region_point(view, region: int):
 
 
 def hover(qtbot, widget, pos) -> None:
-    """Move the mouse onto ``pos`` of ``widget`` so that the widget sees a move event.
+    """Deliver a mouse move onto ``pos`` of ``widget``, as the window system would.
 
-    Qt drops a move to the global position the cursor already has, and tests in one worker
-    share that position: a window placed where an earlier test's was, hovered at the same
-    pixel, would get no event at all (a test failed in CI that way). A step beside the
-    target first makes the last move a real one.
+    The event is sent straight to the widget instead of moving the shared cursor. Through the
+    cursor, Qt drops a move to the position it already has (tests in one worker share it), and
+    the offscreen platform may deliver a late enter/leave of an earlier window after the move;
+    either left the status bar empty in CI twice. Pending events are flushed first so that such
+    a late leave cannot land after this move.
     """
-    from PySide6.QtCore import QPoint
+    from PySide6.QtCore import QEvent, QPointF, Qt
+    from PySide6.QtGui import QMouseEvent
+    from PySide6.QtWidgets import QApplication
 
-    qtbot.mouseMove(widget, pos + QPoint(3, 3))
-    qtbot.mouseMove(widget, pos)
+    QApplication.processEvents()
+    local = QPointF(pos)
+    event = QMouseEvent(
+        QEvent.Type.MouseMove,
+        local,
+        QPointF(widget.mapToGlobal(local)),
+        Qt.MouseButton.NoButton,
+        Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+    )
+    QApplication.sendEvent(widget, event)
 
 
 def error_boxes(parent):
