@@ -36,6 +36,20 @@ def test_segment_loads_none_of_the_libraries_it_does_not_need(tmp_path):
     assert run_python(code) == [0, []]
 
 
+def test_match_writes_and_reads_valid_files_without_importing_jsonschema(tmp_path):
+    # The schema's validator is built only to describe a file that the direct checks refuse.
+    source = two_rooms(tmp_path / "rooms.png")
+    out = tmp_path / "out"
+    code = (
+        "import json, sys; from ursim_core.cli import main; "
+        "from ursim_core.correspondences import load_correspondences; "
+        f"code = main(['match', {str(source)!r}, {str(source)!r}, '-o', {str(out)!r}]); "
+        f"load_correspondences({str(out / 'correspondences.json')!r}); "
+        "print(json.dumps([code, 'jsonschema' in sys.modules]))"
+    )
+    assert run_python(code) == [0, False]
+
+
 def test_the_command_line_freezes_the_heap_before_exit_and_a_caller_keeps_collecting(tmp_path):
     source = two_rooms(tmp_path / "rooms.png")
     args = ["segment", str(source), "--preset", "default", "-o", str(tmp_path / "out")]

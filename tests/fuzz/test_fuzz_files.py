@@ -174,6 +174,91 @@ def test_fast_clique_check_agrees_with_the_schema_validator(item):
     assert schema._clique_is_valid(item) == schema.compiled_validator().is_valid(document)
 
 
+_map_fields = {
+    "path": st.one_of(st.text(min_size=1, max_size=2), st.none(), st.just(""), st.integers()),
+    "sha256": st.one_of(
+        st.none(),
+        st.just("ab" * 32),
+        st.text("0123456789abcdefABCDEFg", min_size=63, max_size=65),
+        st.just("a" * 64 + "\n"),
+        st.integers(),
+    ),
+    "size": st.one_of(
+        st.none(), st.just([3, 4]), st.lists(st.one_of(st.integers(0, 3), st.floats(1, 2), st.booleans()), max_size=3)
+    ),
+    "segmentation": st.one_of(
+        st.none(),
+        st.just({"method": "maoris", "params": {}, "labels": "l.png"}),
+        st.integers(),
+        st.fixed_dictionaries(
+            {},
+            optional={
+                "method": st.one_of(st.none(), st.text(max_size=2), st.integers()),
+                "params": st.one_of(
+                    st.dictionaries(st.text(max_size=2), st.integers(), max_size=2), st.lists(st.integers())
+                ),
+                "labels": st.one_of(st.none(), st.text(max_size=2), st.booleans()),
+            },
+        ),
+    ),
+    "other": json_values,
+}
+# Mostly with a path (as every written map has), so that valid maps are common.
+map_like = st.fixed_dictionaries(
+    {"path": _map_fields["path"]}, optional={key: value for key, value in _map_fields.items() if key != "path"}
+) | st.fixed_dictionaries({}, optional=_map_fields)
+stamps = st.one_of(
+    st.sampled_from(
+        ["", "2024-05-01", "2024-05-01T12:00:00Z", "2024-05-01T12:00:00.5+02:00", "2024-05-01\n", "x", "2024"]
+    ),
+    st.text(max_size=4),
+    st.integers(),
+)
+_head_fields = {
+    "annotator": st.one_of(st.text(max_size=2), st.integers(), st.none()),
+    "created": stamps,
+    "modified": stamps,
+    "other": json_values,
+}
+# The required keys present and nearly right, or anything missing.
+head_like = st.fixed_dictionaries(
+    {
+        "format": st.sampled_from(["ursim-correspondences"] * 4 + ["other", 1]),
+        "version": st.sampled_from([1, 1, 1, 1.0, True, 2, "1"]),
+        "maps": st.fixed_dictionaries({"sketch": map_like, "metric": map_like}, optional={"other": json_values})
+        | st.integers(),
+        "cliques": st.one_of(st.just([]), st.just([]), st.integers()),
+    },
+    optional=_head_fields,
+) | st.fixed_dictionaries(
+    {"cliques": st.just([])},
+    optional={
+        "format": st.just("ursim-correspondences"),
+        "version": st.just(1),
+        "maps": st.fixed_dictionaries({}, optional={"sketch": map_like, "metric": map_like}),
+        **_head_fields,
+    },
+)
+
+
+@settings(max_examples=600, deadline=None)
+@given(document=head_like | json_values)
+def test_fast_head_check_never_passes_what_the_schema_validator_refuses(document):
+    # The fast check may refuse more (the validator then decides), never less; on every
+    # document outside the few JSON-equal-but-other-type values it agrees exactly.
+    fast, slow = schema._head_is_valid(document), schema.compiled_validator().is_valid(document)
+    assert slow or not fast
+    if isinstance(document, dict) and type(document.get("version")) in (int, str, type(None)):
+        assert fast == slow
+
+
+def test_fast_head_check_accepts_a_saved_file(tmp_path):
+    target = tmp_path / "pair.json"
+    corr = Correspondences(annotator="ana", cliques=(Clique(id=1, sketch_points=((1, 2),), metric_points=((3, 4),)),))
+    save_correspondences(corr, target, now=NOW)
+    assert schema._head_is_valid(json.loads(target.read_text()))
+
+
 # --------------------------------------------------------------------------- mutated files
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import json
 import os
+import re
 from collections.abc import Sequence
 from importlib import resources
 from typing import Any
@@ -137,6 +138,74 @@ def _clique_is_valid(item: Any) -> bool:
     return True
 
 
+@functools.cache
+def _pattern(*keys: str) -> re.Pattern:
+    """The schema's ``pattern`` at ``$defs`` / ``keys``, compiled; matched as jsonschema does (``search``)."""
+    node = correspondences_schema()["$defs"]
+    for key in keys:
+        node = node[key]
+    return re.compile(node["pattern"])
+
+
+def _is_text_or_none(value: Any, *, non_empty: bool = False) -> bool:
+    return value is None or (type(value) is str and (len(value) >= 1 or not non_empty))
+
+
+def _map_is_valid(item: Any) -> bool:
+    """The schema's ``map`` definition, checked directly (see :func:`_head_is_valid`)."""
+    if type(item) is not dict or "path" not in item or not _is_text_or_none(item["path"], non_empty=True):
+        return False
+    digest = item.get("sha256")
+    if digest is not None and (
+        type(digest) is not str or _pattern("map", "properties", "sha256").search(digest) is None
+    ):
+        return False
+    size = item.get("size")
+    if size is not None:
+        if type(size) is not list or len(size) != 2:
+            return False
+        if not all(type(side) is int and side >= 1 for side in size):
+            return False
+    segmentation = item.get("segmentation")
+    if segmentation is not None:
+        if type(segmentation) is not dict:
+            return False
+        if "method" in segmentation and not _is_text_or_none(segmentation["method"]):
+            return False
+        if "params" in segmentation and type(segmentation["params"]) is not dict:
+            return False
+        if "labels" in segmentation and not _is_text_or_none(segmentation["labels"], non_empty=True):
+            return False
+    return True
+
+
+def _head_is_valid(document: Any) -> bool:
+    """Everything of the schema but the cliques, checked directly: no jsonschema import.
+
+    Importing jsonschema and building its validator is about a tenth of a whole ``ursim match``
+    process, and a valid file (nearly every one) needs neither. May refuse more than the
+    validator (a refused document is then checked by the validator itself), never less; a
+    test compares them on random input.
+    """
+    if type(document) is not dict:
+        return False
+    if document.get("format") != FORMAT_NAME or type(document.get("version")) is not int:
+        return False
+    if document["version"] != CURRENT_VERSION or type(document.get("cliques")) is not list:
+        return False
+    if "annotator" in document and type(document["annotator"]) is not str:
+        return False
+    for name in ("created", "modified"):
+        if name in document:
+            stamp = document[name]
+            if type(stamp) is not str or _pattern("timestamp").search(stamp) is None:
+                return False
+    maps = document.get("maps")
+    if type(maps) is not dict or "sketch" not in maps or "metric" not in maps:
+        return False
+    return _map_is_valid(maps["sketch"]) and _map_is_valid(maps["metric"])
+
+
 def validate(document: Any, path: str | os.PathLike | None) -> None:
     """Check ``document`` against the schema; a FormatError describing the best-matching problem.
 
@@ -144,10 +213,8 @@ def validate(document: Any, path: str | os.PathLike | None) -> None:
     and everything else by the schema validator; only an invalid document goes through the
     validator whole, to describe its problems exactly.
     """
-    if isinstance(document, dict) and type(document.get("cliques")) is list:
-        head = {**document, "cliques": []}
-        if compiled_validator().is_valid(head) and all(map(_clique_is_valid, document["cliques"])):
-            return
+    if _head_is_valid(document) and all(map(_clique_is_valid, document["cliques"])):
+        return
     _validate_slowly(document, path)
 
 
