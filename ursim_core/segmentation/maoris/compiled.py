@@ -31,7 +31,6 @@ import hashlib
 import importlib.machinery
 import importlib.util
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -43,8 +42,7 @@ from ursim_core.errors import SegmentationError
 
 __all__ = [
     "ENTRY_KERNELS",
-    "PARTS",
-    "MODULE_NAME",
+        "MODULE_NAME",
     "DIGEST_NAME",
     "kernels",
     "ahead_module_path",
@@ -73,17 +71,10 @@ ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
     "flooding": ("flood_levels", "clearance_levels"),
 }
 
-#: The extension modules built ahead of time, each with the kernels of these modules of
-#: :mod:`.kernels`: two parts of about equal compile time (measured: 13-14 s of CPU each),
-#: built in two processes at once. The helpers the two share are compiled in both.
-PARTS: dict[str, tuple[str, ...]] = {
-    "_maoris_kernels_a": ("fusion", "contacts"),
-    "_maoris_kernels_b": ("discs", "flat_zones", "adjacency", "flooding"),
-}
-MODULE_NAME = "_maoris_kernels_a"
-"""Name of the first of :data:`PARTS` (:func:`ahead_module_path` gives its path)."""
+MODULE_NAME = "_maoris_kernels"
+"""Name of the extension module built from :file:`csrc` (:func:`ahead_module_path` gives its path)."""
 DIGEST_NAME = "_maoris_kernels.digest"
-"""The file beside them that names the sources they were built from (:func:`sources_digest`)."""
+"""The file beside it that names the sources it was built from (:func:`sources_digest`)."""
 
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 _loaded: SimpleNamespace | None = None
@@ -96,8 +87,10 @@ def sources_digest() -> str:
     The built modules are used only while this matches the digest they were built with: an
     edited kernel falls back to the JIT until the modules are built again.
     """
+    from ursim_core.segmentation.maoris.c_build import source_files
+
     digest = hashlib.sha256(importlib.machinery.EXTENSION_SUFFIXES[0].encode())
-    for source in [*sorted(_KERNELS_DIR.glob("*.py")), _KERNELS_DIR.parent / "ahead_build.py"]:
+    for source in [*source_files(), _KERNELS_DIR.parent / "c_build.py"]:
         digest.update(source.name.encode() + b"\0" + source.read_bytes() + b"\0")
     return digest.hexdigest()
 
@@ -126,19 +119,21 @@ def ahead_module_path() -> Path | None:
         except OSError:
             continue
         wanted = wanted or sources_digest()
-        if recorded == wanted and all(_part_path(folder, name).is_file() for name in PARTS):
+        if recorded == wanted and _part_path(folder, MODULE_NAME).is_file():
             return _part_path(folder, MODULE_NAME)
     return None
 
 
 def _load_ahead(path: Path) -> SimpleNamespace:
-    """Every kernel, from the parts beside ``path`` (:func:`ahead_module_path`)."""
-    found = {}
-    for name, modules in PARTS.items():
-        spec = importlib.util.spec_from_file_location(name, _part_path(path.parent, name))
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        found.update({kernel: getattr(module, kernel) for group in modules for kernel in ENTRY_KERNELS[group]})
+    """Every kernel, from the module at ``path`` (:func:`ahead_module_path`)."""
+    spec = importlib.util.spec_from_file_location(MODULE_NAME, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    wanted = [kernel for names in ENTRY_KERNELS.values() for kernel in names]
+    found = {kernel: getattr(module, kernel) for kernel in wanted if hasattr(module, kernel)}
+    if len(found) < len(wanted):  # PORT IN PROGRESS: numba's JIT for the kernels not yet in C
+        jit = _load_jit()
+        found.update({kernel: getattr(jit, kernel) for kernel in wanted if kernel not in found})
     return SimpleNamespace(source="ahead", path=path, **found)
 
 
@@ -219,56 +214,31 @@ def forget() -> None:
 
 
 def build_ahead(directory: str | Path | None = None) -> Path:
-    """Compile every kernel into the extension modules loaded here; return the first's path.
+    """Compile the kernels in C (:mod:`.c_build`) into the module loaded here; return its path.
 
-    Each of :data:`PARTS` is compiled by a process of its own (:mod:`.ahead_build`), all at
-    once. The modules and their digest file are written to ``directory`` (default: the first
-    writable of :func:`build_directories`): the old digest is removed first, then each module
-    and the new digest are put in place by a rename, so a reader never sees a digest without
-    its modules. Takes about 15 s on two CPUs (``ursim bench compile`` measures it).
+    The module and its digest file are written to ``directory`` (default: the first writable
+    of :func:`build_directories`): the old digest is removed first, then the module and the
+    new digest are put in place by a rename, so a reader never sees a digest without its
+    module. ``ursim bench compile`` measures how long it takes.
 
     Raises
     ------
     RuntimeError
-        When a part fails to build (with the end of its error output).
+        When there is no C compiler or it fails (with the end of its messages).
     """
+    from ursim_core.segmentation.maoris.c_build import build_module
+
     target = Path(directory) if directory is not None else build_directories()[0]
     target.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="ursim-kernels-", dir=target) as scratch:
-        _build_parts(scratch)
+        built = build_module(_part_path(Path(scratch), MODULE_NAME))
         (target / DIGEST_NAME).unlink(missing_ok=True)
-        for name in PARTS:
-            os.replace(_part_path(Path(scratch), name), _part_path(target, name))
+        os.replace(built, _part_path(target, MODULE_NAME))
         digest_path = Path(scratch) / "digest"
         digest_path.write_text(sources_digest() + "\n", encoding="ascii")
         os.replace(digest_path, target / DIGEST_NAME)
     forget()
     return _part_path(target, MODULE_NAME)
-
-
-def _build_parts(scratch: str) -> None:
-    """Run :mod:`.ahead_build` for every part at once, each writing its module to ``scratch``."""
-    # The children import this very package (first on their path), whatever their working
-    # folder holds: they run in the scratch folder.
-    package_root = str(Path(__file__).resolve().parents[3])
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [package_root, os.environ.get("PYTHONPATH")]))}
-    children = []
-    for name in PARTS:
-        command = [sys.executable, "-m", "ursim_core.segmentation.maoris.ahead_build", name, scratch]
-        # Each child's errors go to a file: a pipe left unread could fill and block it.
-        log = open(Path(scratch) / f"{name}.log", "w+b")  # noqa: SIM115 (closed below)
-        child = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, cwd=scratch, env=env)
-        children.append((name, child, log))
-    failures = []
-    for name, child, log in children:
-        code = child.wait()
-        log.seek(0)
-        output = log.read().decode(errors="replace").strip()
-        log.close()
-        if code != 0 or not _part_path(Path(scratch), name).is_file():
-            failures.append(f"{name} (exit {code}): {output[-800:]}")
-    if failures:
-        raise RuntimeError("building the kernels failed: " + "; ".join(failures))
 
 
 def _main() -> None:  # ``python -m ursim_core.segmentation.maoris.compiled``

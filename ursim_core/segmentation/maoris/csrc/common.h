@@ -1,0 +1,241 @@
+/* What every MAORIS kernel in C shares: the Python and numpy headers, reading the arguments
+ * of a kernel (arrays, tuples, integers) with the checks numba's typed signatures made,
+ * making the arrays it returns, and the small helpers of ../kernels/helpers.py.
+ *
+ * The C kernels are a port of the numba kernels of ../kernels (the reference: a test checks
+ * that both give the same label images). The semantics that differ between numba and C are
+ * spelled out where they matter: numba's // and % floor (C truncates: use floor_div and
+ * floor_mod on values that can be negative), a negative index wraps around in numba (C reads
+ * before the array), and numba computes integer expressions in 64 bits.
+ */
+#ifndef URSIM_MAORIS_COMMON_H
+#define URSIM_MAORIS_COMMON_H
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_22_API_VERSION
+#define PY_ARRAY_UNIQUE_SYMBOL ursim_maoris_ARRAY_API
+#ifndef URSIM_MAORIS_MODULE_C
+#define NO_IMPORT_ARRAY
+/* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts). */
+static inline void relabel_in_place(int32_t *labels, int64_t n, const int32_t *lookup)
+{
+    for (int64_t i = 0; i < n; i++) {
+        labels[i] = lookup[labels[i]];
+    }
+}
+
+#endif
+#include <numpy/arrayobject.h>
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A C-contiguous array argument: its data, length (all elements) and shape. */
+typedef struct {
+    PyArrayObject *array; /* borrowed */
+    void *data;
+    npy_intp size;        /* number of elements */
+    npy_intp rows, cols;  /* shape of a 2-D array (rows = size, cols = 1 for 1-D) */
+    npy_intp row_stride, col_stride; /* in elements, for the one strided argument type */
+} Array;
+
+/* Read argument ``obj`` (named ``what`` in errors) as a writeable array of ``typenum`` with
+ * ``ndim`` dimensions; C-contiguous unless ``any_layout``. Returns 0, or -1 with a TypeError
+ * set, as a call of the numba kernel with another type would have raised. */
+static inline int array_arg(PyObject *obj, int typenum, int ndim, int any_layout, const char *what, Array *out)
+{
+    if (!PyArray_Check(obj)) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a numpy array, got %s", what, Py_TYPE(obj)->tp_name);
+        return -1;
+    }
+    PyArrayObject *array = (PyArrayObject *)obj;
+    if (PyArray_TYPE(array) != typenum || PyArray_NDIM(array) != ndim) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a %d-D array of type %d, got %d-D of type %d", what, ndim,
+                     typenum, PyArray_NDIM(array), PyArray_TYPE(array));
+        return -1;
+    }
+    if (!PyArray_ISWRITEABLE(array) || !PyArray_ISALIGNED(array) || PyArray_ISBYTESWAPPED(array)) {
+        PyErr_Format(PyExc_TypeError, "%s: the array must be writeable, aligned and in native byte order", what);
+        return -1;
+    }
+    if (!any_layout && !PyArray_IS_C_CONTIGUOUS(array)) {
+        PyErr_Format(PyExc_TypeError, "%s: the array must be C-contiguous", what);
+        return -1;
+    }
+    npy_intp item = PyArray_ITEMSIZE(array);
+    out->array = array;
+    out->data = PyArray_DATA(array);
+    out->size = PyArray_SIZE(array);
+    out->rows = ndim >= 1 ? PyArray_DIM(array, 0) : 1;
+    out->cols = ndim >= 2 ? PyArray_DIM(array, 1) : 1;
+    out->row_stride = ndim >= 1 ? PyArray_STRIDE(array, 0) / item : 1;
+    out->col_stride = ndim >= 2 ? PyArray_STRIDE(array, 1) / item : 1;
+    return 0;
+}
+
+/* The items of tuple argument ``obj`` of exactly ``n`` items (borrowed), or NULL with a TypeError. */
+static inline PyObject *const *tuple_arg(PyObject *obj, Py_ssize_t n, const char *what)
+{
+    if (!PyTuple_Check(obj) || PyTuple_GET_SIZE(obj) != n) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a tuple of %zd items", what, n);
+        return NULL;
+    }
+    return &PyTuple_GET_ITEM(obj, 0);
+}
+
+/* An int64 argument (a Python or numpy integer); -1 with an error set when it is none. */
+static inline int int_arg(PyObject *obj, const char *what, int64_t *out)
+{
+    if (PyFloat_Check(obj)) {
+        PyErr_Format(PyExc_TypeError, "%s: expected an integer, got a float", what);
+        return -1;
+    }
+    long long value = PyLong_AsLongLong(obj);
+    if (value == -1 && PyErr_Occurred()) {
+        return -1;
+    }
+    *out = (int64_t)value;
+    return 0;
+}
+
+/* A float64 argument (any real number). */
+static inline int float_arg(PyObject *obj, const char *what, double *out)
+{
+    double value = PyFloat_AsDouble(obj);
+    if (value == -1.0 && PyErr_Occurred()) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a real number", what);
+        return -1;
+    }
+    *out = value;
+    return 0;
+}
+
+/* Check a fast call's argument count. */
+static inline int check_nargs(const char *kernel, Py_ssize_t nargs, Py_ssize_t wanted)
+{
+    if (nargs != wanted) {
+        PyErr_Format(PyExc_TypeError, "%s() takes %zd arguments (%zd given)", kernel, wanted, nargs);
+        return -1;
+    }
+    return 0;
+}
+
+/* A new C-contiguous 1-D or 2-D array (uninitialised; NULL with MemoryError). Call with the GIL. */
+static inline PyArrayObject *new_array_1d(npy_intp n, int typenum)
+{
+    npy_intp dims[1] = {n};
+    return (PyArrayObject *)PyArray_SimpleNew(1, dims, typenum);
+}
+
+static inline PyArrayObject *new_array_2d(npy_intp rows, npy_intp cols, int typenum)
+{
+    npy_intp dims[2] = {rows, cols};
+    return (PyArrayObject *)PyArray_SimpleNew(2, dims, typenum);
+}
+
+static void free_capsule(PyObject *capsule)
+{
+    free(PyCapsule_GetPointer(capsule, "ursim_maoris_buffer"));
+}
+
+/* A numpy array that owns ``buffer`` (from malloc/realloc; freed with the array), for results
+ * whose size is known only at the end of a kernel run without the GIL. On failure the buffer
+ * is freed and NULL returned with an error set. ``buffer`` may be NULL when the size is 0. */
+static inline PyObject *array_owning(void *buffer, int ndim, const npy_intp *dims, int typenum)
+{
+    if (buffer == NULL) {
+        buffer = malloc(1);
+        if (buffer == NULL) {
+            return PyErr_NoMemory();
+        }
+    }
+    PyObject *array = PyArray_SimpleNewFromData(ndim, (npy_intp *)dims, typenum, buffer);
+    if (array == NULL) {
+        free(buffer);
+        return NULL;
+    }
+    PyObject *capsule = PyCapsule_New(buffer, "ursim_maoris_buffer", free_capsule);
+    if (capsule == NULL) {
+        Py_DECREF(array); /* the array does not own the buffer yet */
+        free(buffer);
+        return NULL;
+    }
+    if (PyArray_SetBaseObject((PyArrayObject *)array, capsule) < 0) {
+        Py_DECREF(array);
+        return NULL; /* the capsule was released, and freed the buffer */
+    }
+    return array;
+}
+
+/* numba's // and % on signed integers (Python's: rounded towards minus infinity). */
+static inline int64_t floor_div(int64_t a, int64_t b)
+{
+    int64_t q = a / b;
+    return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
+}
+
+static inline int64_t floor_mod(int64_t a, int64_t b)
+{
+    int64_t r = a % b;
+    return (r != 0 && ((r < 0) != (b < 0))) ? r + b : r;
+}
+
+/* Ask the CPU to start loading the cache line of ``address`` (helpers._prefetch: read, keep in
+ * every level). A hint only: never faults. */
+#define PREFETCH(address) __builtin_prefetch((const void *)(address), 0, 3)
+
+/* helpers._zone_of: the current zone of an original label (union-find root, path halving). */
+static inline int64_t zone_of(int64_t label, int32_t *parent)
+{
+    while (parent[label] != label) {
+        parent[label] = parent[parent[label]];
+        label = parent[label];
+    }
+    return label;
+}
+
+/* helpers._bits: log2 of a power of two. */
+static inline int64_t bits_of(int64_t size)
+{
+    int64_t bits = 0;
+    while (((int64_t)1 << bits) < size) {
+        bits += 1;
+    }
+    return bits;
+}
+
+/* helpers._filled / _grown for the arrays a kernel keeps to itself: malloc'd, NULL when out of
+ * memory (the kernel then returns a MemoryError once it holds the GIL again). */
+static inline int64_t *filled_i64(int64_t size, int64_t fill)
+{
+    int64_t *array = malloc((size_t)(size > 0 ? size : 1) * sizeof(int64_t));
+    if (array != NULL) {
+        for (int64_t i = 0; i < size; i++) {
+            array[i] = fill;
+        }
+    }
+    return array;
+}
+
+static inline int32_t *filled_i32(int64_t size, int32_t fill)
+{
+    int32_t *array = malloc((size_t)(size > 0 ? size : 1) * sizeof(int32_t));
+    if (array != NULL) {
+        for (int64_t i = 0; i < size; i++) {
+            array[i] = fill;
+        }
+    }
+    return array;
+}
+
+/* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts). */
+static inline void relabel_in_place(int32_t *labels, int64_t n, const int32_t *lookup)
+{
+    for (int64_t i = 0; i < n; i++) {
+        labels[i] = lookup[labels[i]];
+    }
+}
+
+#endif
