@@ -24,8 +24,9 @@ tested on its own:
 * :mod:`.zone_graph`: step 3, :func:`flat_zones` and :class:`ZoneGraph`;
 * :mod:`.steps`: steps 4-7, the graph operations;
 * :mod:`.pipeline`: :func:`maoris_labels`, :func:`compile_kernels`, :func:`kernels_cached`;
-* :mod:`.kernels`: the compiled (numba) loops, one module per family;
-* :mod:`.compiled`: the kernels as the steps call them (built ahead of time, or the JIT);
+* :mod:`.kernels`: the compiled loops in numba, one module per family (the reference);
+* :file:`csrc` and :mod:`.c_build`: the same loops in C, and compiling them;
+* :mod:`.compiled`: the kernels as the steps call them (the C module, or numba's JIT);
 * :mod:`.contact_tracking`: counting contacts in bands of rows on threads.
 
 Importing this package imports none of them (nor numba): each name loads its module on
@@ -33,15 +34,17 @@ first use.
 
 Speed: a 4000 x 4000 map starts with about 1.5 million flat zones, visited
 one by one in an order that decides ties, so the graph steps cannot be
-vectorised; steps 3, 4 and 6 run as compiled code (numba, :mod:`.kernels`)
-on an array form of the zone graph, and step 1 paints its discs with compiled
-code too (:mod:`.kernels.discs`). The contacts of large maps are counted in bands
-of rows on one thread per CPU. :func:`compile_kernels` builds the kernels once ahead of
-time into extension modules (numba's ``pycc``, about 15 s on two CPUs; ``make`` runs it, and
-the first segmentation does if nothing did), which later processes load in milliseconds
-without importing numba; ``URSIM_KERNELS=jit`` uses numba's JIT and its cache instead
-(``ursim bench compile`` measures both). :func:`kernels_cached` tells, without importing
-numba, whether that is done.
+vectorised; steps 3, 4 and 6 run as compiled code on an array form of the
+zone graph, and step 1 paints its discs with compiled code too. The kernels are
+written twice: in numba (:mod:`.kernels`, the reference, readable beside the
+steps) and in C (:file:`csrc`, a line-by-line port), and the tests check that
+both give the same labels. The contacts of large maps are counted in bands of
+rows on one thread per CPU. :func:`compile_kernels` compiles the C kernels once
+into an extension module (:mod:`.c_build`, seconds; ``make`` runs it, and the
+first segmentation does if nothing did), which processes load in milliseconds
+without importing numba; ``URSIM_KERNELS=jit`` uses numba's JIT and its cache
+instead, as does a machine with no C compiler (``ursim bench compile`` measures
+both). :func:`kernels_cached` tells, without importing numba, whether that is done.
 
 Faithfulness notes (see ../shared/design/original_code.md, section 2):
 

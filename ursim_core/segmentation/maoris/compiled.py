@@ -1,28 +1,24 @@
-"""The MAORIS kernels as the steps call them: built ahead of time when fresh, else numba's JIT.
+"""The MAORIS kernels as the steps call them: the C module when it is built, else numba's JIT.
 
 :func:`kernels` gives one namespace with every kernel called from Python (the names of
-:data:`ENTRY_KERNELS`). It is the extension modules that
-:func:`build_ahead` wrote (``make`` builds them)
-when they were built from the kernel sources of this install, which takes milliseconds
-and no numba. When there are none, the first call builds them (about 15 s on two CPUs, once, half
-the JIT's own first compile); when that fails (pycc needs a C compiler), numba's JIT
-dispatchers of :mod:`.kernels`, which import numba and load (or compile) their cache. Both run the same compiled Python source for the same
-signatures; a test checks that their label images agree.
+:data:`ENTRY_KERNELS`). It is the extension module ``_maoris_kernels`` that :func:`build_ahead`
+compiled from the C sources of :file:`csrc` (``make`` builds it; :mod:`.c_build`), when it was
+built from the sources of this install: it loads in milliseconds and needs no numba. When
+there is none, the first call builds it (seconds, once); when that fails (no C compiler),
+numba's JIT dispatchers of :mod:`.kernels`, which import numba and load (or compile) their
+cache. The C kernels are a port of the numba ones, which stay the reference: the tests check
+that both give the same label images.
 
 ``URSIM_KERNELS`` chooses: ``auto`` (default), ``jit`` (always the JIT) or ``ahead`` (the
 built module, or a :class:`~ursim_core.errors.SegmentationError` saying how to build it).
-This module imports neither numba nor the kernels, but to build.
+This module imports neither numba nor the kernels.
 
-The build: numba's JIT costs every new process about a second before the first segmentation,
-importing numba and its typing registries (0.4-0.6 s) and loading the cached machine code of
-each kernel (0.3-0.7 s). The same kernels, compiled once with :mod:`numba.pycc` for the one
-signature each has (:data:`.kernels.signatures.SIGNATURES`), form ordinary extension modules
-that import in milliseconds and need neither numba nor llvmlite at run time: two of them
-(:data:`PARTS`), each compiled in a process of its own at the same time
-(:mod:`.ahead_build`), as numba compiles on one thread. Every exported
-kernel releases the GIL, as the JIT's ``count_contacts`` does (``nogil=True``): the contacts of
-large maps are counted in bands on threads. The kernels touch only the arrays they are given,
-never a Python object, so releasing it is safe for all of them.
+Why C: numba's JIT costs every new process about a second before the first segmentation
+(importing numba, loading each kernel's cached machine code), and building the same kernels
+ahead of time with numba's ``pycc`` (deprecated by numba) took 16.6 s of a fresh install on
+two CPUs, most of it numba typing and lowering in Python. The C compiler builds the port in a
+few seconds (``ursim bench compile``). Every kernel releases the GIL: the contacts of large
+maps are counted in bands on threads.
 """
 
 from __future__ import annotations
@@ -81,11 +77,11 @@ _loaded: SimpleNamespace | None = None
 
 
 def sources_digest() -> str:
-    """SHA-256 of the kernel sources (every ``.py`` of :mod:`.kernels`), of how they are built
-    (:mod:`.ahead_build`) and of the Python ABI.
+    """SHA-256 of the C sources (:file:`csrc`), of how they are built (:mod:`.c_build`) and of
+    the Python ABI.
 
-    The built modules are used only while this matches the digest they were built with: an
-    edited kernel falls back to the JIT until the modules are built again.
+    The built module is used only while this matches the digest it was built with: an edited
+    source is built again on the next :func:`kernels`.
     """
     from ursim_core.segmentation.maoris.c_build import source_files
 
@@ -105,13 +101,13 @@ def build_directories() -> list[Path]:
     return [own, user] if os.access(_KERNELS_DIR, os.W_OK) else [user, own]
 
 
-def _part_path(folder: Path, name: str) -> Path:
+def _module_path(folder: Path, name: str) -> Path:
     return folder / (name + importlib.machinery.EXTENSION_SUFFIXES[0])
 
 
 def ahead_module_path() -> Path | None:
-    """The first built module (:data:`MODULE_NAME`) of these kernel sources, or None when
-    any of :data:`PARTS` is missing or they are stale."""
+    """The built module (:data:`MODULE_NAME`) of these kernel sources, or None when it is
+    missing or stale."""
     wanted = None
     for folder in build_directories():
         try:
@@ -119,8 +115,8 @@ def ahead_module_path() -> Path | None:
         except OSError:
             continue
         wanted = wanted or sources_digest()
-        if recorded == wanted and _part_path(folder, MODULE_NAME).is_file():
-            return _part_path(folder, MODULE_NAME)
+        if recorded == wanted and _module_path(folder, MODULE_NAME).is_file():
+            return _module_path(folder, MODULE_NAME)
     return None
 
 
@@ -129,11 +125,8 @@ def _load_ahead(path: Path) -> SimpleNamespace:
     spec = importlib.util.spec_from_file_location(MODULE_NAME, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    wanted = [kernel for names in ENTRY_KERNELS.values() for kernel in names]
-    found = {kernel: getattr(module, kernel) for kernel in wanted if hasattr(module, kernel)}
-    if len(found) < len(wanted):  # PORT IN PROGRESS: numba's JIT for the kernels not yet in C
-        jit = _load_jit()
-        found.update({kernel: getattr(jit, kernel) for kernel in wanted if kernel not in found})
+    # A kernel missing (a module of other sources) is an AttributeError: the module is broken.
+    found = {kernel: getattr(module, kernel) for names in ENTRY_KERNELS.values() for kernel in names}
     return SimpleNamespace(source="ahead", path=path, **found)
 
 
@@ -231,14 +224,14 @@ def build_ahead(directory: str | Path | None = None) -> Path:
     target = Path(directory) if directory is not None else build_directories()[0]
     target.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="ursim-kernels-", dir=target) as scratch:
-        built = build_module(_part_path(Path(scratch), MODULE_NAME))
+        built = build_module(_module_path(Path(scratch), MODULE_NAME))
         (target / DIGEST_NAME).unlink(missing_ok=True)
-        os.replace(built, _part_path(target, MODULE_NAME))
+        os.replace(built, _module_path(target, MODULE_NAME))
         digest_path = Path(scratch) / "digest"
         digest_path.write_text(sources_digest() + "\n", encoding="ascii")
         os.replace(digest_path, target / DIGEST_NAME)
     forget()
-    return _part_path(target, MODULE_NAME)
+    return _module_path(target, MODULE_NAME)
 
 
 def _main() -> None:  # ``python -m ursim_core.segmentation.maoris.compiled``

@@ -94,11 +94,11 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
 def compile_kernels(*, processes: int = 1, jit: bool = False) -> float:
     """Make the MAORIS kernels ready for use; return the seconds it took.
 
-    By default this builds the kernels ahead of time into extension modules
-    (:func:`ursim_core.segmentation.maoris.compiled.build_ahead`, about 15 s on two CPUs,
-    once per install and kernel source) unless a fresh one exists, and loads it: later
-    processes then start without numba (:mod:`ursim_core.segmentation.maoris.compiled`).
-    When that build fails (pycc needs a C compiler) or ``jit`` is true, numba's JIT
+    By default this compiles the C kernels into an extension module
+    (:func:`ursim_core.segmentation.maoris.compiled.build_ahead`, seconds, once per install
+    and kernel source) unless a fresh one exists, and loads it: processes start without
+    numba (:mod:`ursim_core.segmentation.maoris.compiled`).
+    When that build fails (no C compiler) or ``jit`` is true, numba's JIT
     compiles the kernels into its cache instead. The first segmentation in a new
     environment otherwise pays this; benchmarks call it so that their timings exclude it.
     Prints nothing (callers say what is happening:
@@ -115,8 +115,7 @@ def compile_kernels(*, processes: int = 1, jit: bool = False) -> float:
         (66 s wall, 42 s CPU) than one (53 s, 34 s); on idle CPUs they may be faster
         (not measured).
     jit : bool, keyword-only
-        Compile numba's JIT cache (what ``URSIM_KERNELS=jit`` uses) rather than the
-        ahead-of-time module.
+        Compile numba's JIT cache (what ``URSIM_KERNELS=jit`` uses) rather than the C module.
 
     Examples
     --------

@@ -1,0 +1,127 @@
+"""The MAORIS kernels in C: the module holds every kernel, refuses wrong arguments, builds or says why."""
+
+from __future__ import annotations
+
+import importlib.machinery
+import shlex
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope="module")
+def c_module():
+    """The built C module, loaded on its own (not through the kernels' fallbacks)."""
+    import importlib.util
+
+    from ursim_core.segmentation.maoris import compile_kernels, compiled
+
+    compile_kernels()
+    path = compiled.ahead_module_path()
+    if path is None:
+        pytest.skip("the C kernels could not be built here (no C compiler?)")
+    spec = importlib.util.spec_from_file_location(compiled.MODULE_NAME, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_c_module_holds_every_kernel(c_module):
+    from ursim_core.segmentation.maoris.compiled import ENTRY_KERNELS
+
+    wanted = {kernel for names in ENTRY_KERNELS.values() for kernel in names}
+    assert wanted <= set(dir(c_module))
+
+
+def _value_of(numba_type):
+    """A small argument of ``numba_type`` (arrays are empty-ish: no kernel may run on them)."""
+    from numba import types
+
+    if isinstance(numba_type, types.BaseTuple):
+        return tuple(_value_of(item) for item in numba_type.types)
+    if isinstance(numba_type, types.Array):
+        return np.zeros((2,) * numba_type.ndim, dtype=numba_type.dtype.name if numba_type.dtype.name != "bool" else bool)
+    if isinstance(numba_type, types.Float):
+        return 0.5
+    return 1
+
+
+def _arrays_in(value, path=()):
+    """Paths (indices into nested tuples) of the arrays of an argument list."""
+    if isinstance(value, np.ndarray):
+        yield path
+    elif isinstance(value, tuple | list):
+        for index, item in enumerate(value):
+            yield from _arrays_in(item, (*path, index))
+
+
+def _replaced(value, path, new):
+    if not path:
+        return new
+    items = list(value)
+    items[path[0]] = _replaced(items[path[0]], path[1:], new)
+    return tuple(items) if isinstance(value, tuple) else items
+
+
+def _get(value, path):
+    for index in path:
+        value = value[index]
+    return value
+
+
+def test_every_c_kernel_refuses_arrays_of_another_type_layout_or_writeability(c_module):
+    """Each wrong argument is a TypeError before any work (numba's typed signatures refused
+    them too); a C kernel trusting it would read out of bounds."""
+    from ursim_core.segmentation.maoris.kernels import signatures
+
+    checked = 0
+    for (_, name), numba_types in signatures.SIGNATURES.items():
+        kernel = getattr(c_module, name)
+        good = [_value_of(numba_type) for numba_type in numba_types]
+        with pytest.raises(TypeError):
+            kernel(*good[:-1])
+        for path in _arrays_in(good):
+            original = _get(good, path)
+            wrong_dtype = original.astype(np.float64 if original.dtype != np.float64 else np.int32)
+            readonly = original.copy()
+            readonly.flags.writeable = False
+            wrongs = [wrong_dtype, readonly, original.reshape(-1), "not an array"]
+            if original.ndim == 2 and name != "paint_discs":  # paint_discs takes any layout
+                wrongs.append(np.zeros((2, 4), original.dtype)[:, ::2])
+            for wrong in wrongs:
+                with pytest.raises(TypeError):
+                    kernel(*_replaced(good, path, wrong))
+                checked += 1
+    assert checked > 100
+
+
+def test_a_failing_compiler_is_reported_with_its_messages(tmp_path, monkeypatch):
+    from ursim_core.segmentation.maoris import compiled
+
+    script = "echo 'csrc/fusion.c:1: error: broken on purpose' >&2; exit 3"
+    monkeypatch.setenv("CC", f"sh -c {shlex.quote(script)} sh")
+    with pytest.raises(RuntimeError, match="(?s)exit 3.*broken on purpose"):
+        compiled.build_ahead(tmp_path)
+    assert not (tmp_path / compiled.DIGEST_NAME).exists()
+    assert not list(tmp_path.glob("*" + importlib.machinery.EXTENSION_SUFFIXES[0]))
+
+
+def test_no_compiler_is_reported_as_such(tmp_path, monkeypatch):
+    from ursim_core.segmentation.maoris import compiled
+
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
+    with pytest.raises(RuntimeError, match="no C compiler"):
+        compiled.build_ahead(tmp_path)
+    with monkeypatch.context() as failing:
+        failing.setattr(compiled, "build_directories", lambda: [tmp_path / "empty"])
+        with pytest.warns(RuntimeWarning, match="no C compiler.*numba's JIT"):
+            assert compiled.build_or_warn() is None
+
+
+def test_a_built_module_missing_a_kernel_is_not_used(tmp_path, monkeypatch, c_module):
+    """A module built from other sources (or cut short) counts as broken: built again or the JIT."""
+    from ursim_core.segmentation.maoris import compiled
+
+    monkeypatch.setattr(compiled, "ENTRY_KERNELS", {**compiled.ENTRY_KERNELS, "extra": ("no_such_kernel",)})
+    with pytest.raises(AttributeError, match="no_such_kernel"):
+        compiled._load_ahead(compiled.ahead_module_path())
