@@ -8,7 +8,6 @@ from __future__ import annotations
 import colorsys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-
 from typing import TYPE_CHECKING
 
 import cv2

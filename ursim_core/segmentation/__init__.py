@@ -24,7 +24,17 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["interface", "regions", "graph", "scoring", "maoris", "watershed", "presets_cv", "learned", "learned_cv"],
+    submodules=[
+        "interface",
+        "regions",
+        "graph",
+        "scoring",
+        "maoris",
+        "watershed",
+        "presets_cv",
+        "learned",
+        "learned_cv",
+    ],
     submod_attrs={
         "interface": [
             "Segmentation",

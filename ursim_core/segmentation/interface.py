@@ -63,7 +63,7 @@ class Segmentation:
     (2, 2, 1)
     """
 
-    __slots__ = ("labels", "method", "params", "source", "_graph", "_regions")
+    __slots__ = ("_graph", "_regions", "labels", "method", "params", "source")
 
     def __init__(
         self,

@@ -40,7 +40,9 @@ def _value_of(numba_type):
     if isinstance(numba_type, types.BaseTuple):
         return tuple(_value_of(item) for item in numba_type.types)
     if isinstance(numba_type, types.Array):
-        return np.zeros((2,) * numba_type.ndim, dtype=numba_type.dtype.name if numba_type.dtype.name != "bool" else bool)
+        return np.zeros(
+            (2,) * numba_type.ndim, dtype=numba_type.dtype.name if numba_type.dtype.name != "bool" else bool
+        )
     if isinstance(numba_type, types.Float):
         return 0.5
     return 1

@@ -38,7 +38,7 @@ from ursim_core.errors import SegmentationError
 
 __all__ = [
     "ENTRY_KERNELS",
-        "MODULE_NAME",
+    "MODULE_NAME",
     "DIGEST_NAME",
     "kernels",
     "ahead_module_path",
