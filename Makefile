@@ -22,10 +22,11 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 	$(PIP) install -q -e ".[dev]"
 	touch $@
 
-# numba compiles the segmentation kernels on first use and caches them beside the module: do it
-# once here rather than inside the first segmentation (or in both test workers at once).
-$(VENV)/.kernels: $(shell find ursim_core/segmentation -name '*.py') | $(VENV)/.installed-core
-	@echo "Building the segmentation kernels ahead of time (once; about 15 s on two CPUs)..."
+# The segmentation kernels are C (ursim_core/segmentation/maoris/csrc), compiled into an extension
+# module on first use: do it once here rather than inside the first segmentation (or in both test
+# workers at once).
+$(VENV)/.kernels: $(shell find ursim_core/segmentation/maoris -name '*.py' -o -name '*.c' -o -name '*.h') | $(VENV)/.installed-core
+	@echo "Compiling the segmentation kernels (once; a few seconds)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; print(f'{compile_kernels():.1f} s')"
 	touch $@
 

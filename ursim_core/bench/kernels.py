@@ -1,13 +1,12 @@
 """First-run preparation of the segmentation kernels, as a fresh install pays it.
 
 ``bench_compile()`` prepares the MAORIS kernels in a new process on empty caches, both ways
-:mod:`ursim_core.segmentation.maoris.compiled` knows: the ahead-of-time build (the default,
-into an empty temporary folder) and numba's JIT (``URSIM_KERNELS=jit``, into an empty
-``NUMBA_CACHE_DIR``). It prints the seconds: wall clock (what the user waits) and CPU (less
-sensitive to a busy machine; it counts the processes that build the parts of the
-ahead-of-time modules at once, so it is about twice the wall clock on two idle CPUs), and
-the kernels' load time in a later process (what every later command pays before its first
-segmentation).
+:mod:`ursim_core.segmentation.maoris.compiled` knows: compiling the C kernels (the default,
+into an empty temporary folder; the C compiler runs once per source file, as many at once as
+there are CPUs) and numba's JIT (``URSIM_KERNELS=jit``, into an empty ``NUMBA_CACHE_DIR``). It
+prints the seconds: wall clock (what the user waits) and CPU (less sensitive to a busy
+machine; it counts the compiler processes), and the kernels' load time in a later process
+(what every later command pays before its first segmentation).
 """
 
 from __future__ import annotations
