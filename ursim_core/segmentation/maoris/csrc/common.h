@@ -17,14 +17,6 @@
 #define PY_ARRAY_UNIQUE_SYMBOL ursim_maoris_ARRAY_API
 #ifndef URSIM_MAORIS_MODULE_C
 #define NO_IMPORT_ARRAY
-/* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts). */
-static inline void relabel_in_place(int32_t *labels, int64_t n, const int32_t *lookup)
-{
-    for (int64_t i = 0; i < n; i++) {
-        labels[i] = lookup[labels[i]];
-    }
-}
-
 #endif
 #include <numpy/arrayobject.h>
 
