@@ -1,0 +1,284 @@
+/* Painting the inscribed discs of MAORIS step 1 in C (port of ../kernels/discs.py, whose
+ * docstrings explain the method: non-dominated centres grouped into rectangles, then each
+ * rectangle's disc rows painted, one-pixel shapes only where their neighbours leave gaps). */
+#include "kernels.h"
+
+enum { TOP = 0, BOTTOM = 1, LEFT = 2, RIGHT = 3, RADIUS = 4, DIAGONALS = 5 };
+enum { UP_LEFT = 1, UP_RIGHT = 2, DOWN_LEFT = 4, DOWN_RIGHT = 8 };
+#define ABOVE (UP_LEFT | UP_RIGHT)
+#define BELOW (DOWN_LEFT | DOWN_RIGHT)
+/* One-pixel shapes up to this reach paint only what their diagonal neighbours leave uncovered. */
+#define TRIMMED_REACH_LIMIT 512
+
+static inline int32_t max32(int32_t a, int32_t b) { return a > b ? a : b; }
+
+static void load_radii(const float *dist_row, int64_t cols, int64_t max_radius, int32_t *into)
+{
+    for (int64_t col = 0; col < cols; col++) {
+        float value = dist_row[col];
+        /* numba compares a float32 with an int64 in float64 */
+        into[col + 1] = (double)value >= (double)max_radius ? (int32_t)max_radius : (int32_t)value;
+    }
+}
+
+/* discs.centre_rectangles; returns the malloc'd (count, 6) table, or NULL when out of memory. */
+static int64_t *centre_rectangles(const float *dist, int64_t rows, int64_t cols, int64_t max_radius, int64_t *count_out)
+{
+    int32_t *ring = calloc((size_t)(3 * (cols + 2)), sizeof(int32_t));
+    int32_t *centre_radius = calloc((size_t)(cols + 1), sizeof(int32_t));
+    int64_t *open_at = malloc((size_t)(cols > 0 ? cols : 1) * sizeof(int64_t));
+    int64_t capacity = rows * cols / 64 > 16 ? rows * cols / 64 : 16;
+    int64_t *shapes = malloc((size_t)capacity * 6 * sizeof(int64_t));
+    int64_t count = 0;
+    if (ring == NULL || centre_radius == NULL || open_at == NULL || shapes == NULL) {
+        goto fail;
+    }
+    if (rows > 0) {
+        load_radii(dist, cols, max_radius, ring);
+    }
+    for (int64_t col = 0; col < cols; col++) {
+        open_at[col] = -1;
+    }
+    for (int64_t row = 0; row < rows; row++) {
+        int32_t *up = ring + ((row + 2) % 3) * (cols + 2), *here = ring + (row % 3) * (cols + 2);
+        int32_t *down = ring + ((row + 1) % 3) * (cols + 2);
+        if (row + 1 < rows) {
+            load_radii(dist + (row + 1) * cols, cols, max_radius, down);
+        } else {
+            memset(down, 0, (size_t)(cols + 2) * sizeof(int32_t));
+        }
+        for (int64_t col = 0; col < cols; col++) {
+            int64_t radius = here[col + 1];
+            int64_t side = max32(max32(here[col], here[col + 2]), max32(up[col + 1], down[col + 1]));
+            int64_t corner = max32(max32(up[col], up[col + 2]), max32(down[col], down[col + 2]));
+            centre_radius[col] = (radius > 0) & (side <= radius) & (corner <= radius + 1) ? (int32_t)radius : 0;
+        }
+        if (count + cols > capacity) {
+            int64_t grown_capacity = 2 * capacity + cols;
+            int64_t *grown = realloc(shapes, (size_t)grown_capacity * 6 * sizeof(int64_t));
+            if (grown == NULL) {
+                goto fail;
+            }
+            shapes = grown;
+            capacity = grown_capacity;
+        }
+        int64_t col = 0;
+        while (col < cols) {
+            int64_t radius = centre_radius[col];
+            if (radius == 0) {
+                col += 1;
+                continue;
+            }
+            int64_t last = col;
+            while (centre_radius[last + 1] == radius) {
+                last += 1;
+            }
+            int64_t shape = open_at[col];
+            if (shape >= 0 && shapes[6 * shape + BOTTOM] == row - 1 && shapes[6 * shape + RIGHT] == last
+                && shapes[6 * shape + RADIUS] == radius) {
+                shapes[6 * shape + BOTTOM] = row;
+                shapes[6 * shape + DIAGONALS] = 0;
+            } else {
+                int64_t *entry = shapes + 6 * count;
+                entry[TOP] = row;
+                entry[BOTTOM] = row;
+                entry[LEFT] = col;
+                entry[RIGHT] = last;
+                entry[RADIUS] = radius;
+                int64_t diagonals = 0;
+                if (last == col) {
+                    int64_t larger = radius + 1;
+                    diagonals = (up[col] == larger) * UP_LEFT + (up[col + 2] == larger) * UP_RIGHT
+                                + (down[col] == larger) * DOWN_LEFT + (down[col + 2] == larger) * DOWN_RIGHT;
+                }
+                entry[DIAGONALS] = diagonals;
+                open_at[col] = count;
+                count += 1;
+            }
+            col = last + 1;
+        }
+    }
+    free(ring);
+    free(centre_radius);
+    free(open_at);
+    *count_out = count;
+    return shapes;
+fail:
+    free(ring);
+    free(centre_radius);
+    free(open_at);
+    free(shapes);
+    return NULL;
+}
+
+KERNEL(centre_rectangles)
+{
+    Array dist;
+    int64_t max_radius, count = 0;
+    if (check_nargs("centre_rectangles", nargs, 2) || array_arg(args[0], NPY_FLOAT32, 2, 0, "dist", &dist)
+        || int_arg(args[1], "max_radius", &max_radius)) {
+        return NULL;
+    }
+    int64_t *shapes;
+    Py_BEGIN_ALLOW_THREADS
+    shapes = centre_rectangles(dist.data, dist.rows, dist.cols, max_radius, &count);
+    Py_END_ALLOW_THREADS
+    if (shapes == NULL) {
+        return PyErr_NoMemory();
+    }
+    npy_intp dims[2] = {count, 6};
+    return array_owning(shapes, 2, dims, NPY_INT64);
+}
+
+/* discs._uncovered_pieces: the pieces of a one-pixel shape's disc that its diagonal neighbours
+ * leave uncovered, for every reach up to largest_reach. Returns 0, or -1 when out of memory. */
+typedef struct {
+    int64_t *start;
+    int32_t *distance, *from, *to;
+} Pieces;
+
+static int uncovered_pieces(int64_t largest_reach, Pieces *pieces)
+{
+    int64_t *half_width = malloc((size_t)((largest_reach + 2) * (largest_reach + 3) / 2) * sizeof(int64_t));
+    int64_t capacity = 6 * (largest_reach + 1) * (largest_reach + 2) / 2;
+    pieces->start = calloc((size_t)(3 * (largest_reach + 1) + 1), sizeof(int64_t));
+    pieces->distance = malloc((size_t)(capacity > 0 ? capacity : 1) * sizeof(int32_t));
+    pieces->from = malloc((size_t)(capacity > 0 ? capacity : 1) * sizeof(int32_t));
+    pieces->to = malloc((size_t)(capacity > 0 ? capacity : 1) * sizeof(int32_t));
+    if (half_width == NULL || pieces->start == NULL || pieces->distance == NULL || pieces->from == NULL
+        || pieces->to == NULL) {
+        free(half_width);
+        return -1;
+    }
+    for (int64_t reach = 0; reach < largest_reach + 2; reach++) {
+        int64_t width = reach;
+        for (int64_t d = 0; d <= reach; d++) {
+            while (width * width + d * d > reach * reach) {
+                width -= 1;
+            }
+            half_width[reach * (reach + 1) / 2 + d] = width;
+        }
+    }
+    int64_t count = 0;
+    for (int64_t reach = 0; reach <= largest_reach; reach++) {
+        for (int64_t neighbours = 1; neighbours < 4; neighbours++) {
+            for (int64_t d = 0; d <= reach; d++) {
+                int64_t width = half_width[reach * (reach + 1) / 2 + d];
+                int64_t covering = half_width[(reach + 1) * (reach + 2) / 2 + d + 1];
+                int64_t covered_from = ((neighbours & 1) ? -1 : 1) - covering;
+                int64_t covered_to = ((neighbours & 2) ? 1 : -1) + covering;
+                int64_t firsts[2] = {-width, -width > covered_to + 1 ? -width : covered_to + 1};
+                int64_t lasts[2] = {width < covered_from - 1 ? width : covered_from - 1, width};
+                for (int k = 0; k < 2; k++) {
+                    if (firsts[k] <= lasts[k]) {
+                        pieces->distance[count] = (int32_t)d;
+                        pieces->from[count] = (int32_t)firsts[k];
+                        pieces->to[count] = (int32_t)lasts[k];
+                        count += 1;
+                    }
+                }
+            }
+            pieces->start[3 * reach + neighbours] = count;
+        }
+    }
+    free(half_width);
+    return 0;
+}
+
+static inline void raise_span(int32_t *out_row, int64_t cols, int64_t first_col, int64_t last_col, int64_t radius)
+{
+    int64_t from = first_col > 0 ? first_col : 0, to = last_col < cols - 1 ? last_col : cols - 1;
+    for (int64_t col = from; col <= to; col++) {
+        out_row[col] = out_row[col] > radius ? out_row[col] : (int32_t)radius;
+    }
+}
+
+static int paint(const int64_t *shapes, int64_t n, const Array *free_mask, int32_t *out, int64_t rows, int64_t cols)
+{
+    const uint8_t *free_data = free_mask->data;
+    int64_t reach_cap = rows + cols;
+    int64_t trimmed_reach_limit = TRIMMED_REACH_LIMIT < reach_cap ? TRIMMED_REACH_LIMIT : reach_cap;
+    int64_t largest_trimmed = -1;
+    for (int64_t i = 0; i < n; i++) {
+        const int64_t *shape = shapes + 6 * i;
+        if (shape[DIAGONALS] != 0 && shape[RADIUS] - 1 < trimmed_reach_limit && shape[RADIUS] - 1 > largest_trimmed) {
+            largest_trimmed = shape[RADIUS] - 1;
+        }
+    }
+    Pieces pieces = {0};
+    int failed = uncovered_pieces(largest_trimmed, &pieces);
+    for (int64_t i = 0; i < n && !failed; i++) {
+        const int64_t *shape = shapes + 6 * i;
+        int64_t radius = shape[RADIUS];
+        int64_t reach = radius - 1 < reach_cap ? radius - 1 : reach_cap;
+        int64_t top = shape[TOP] - 1, bottom = shape[BOTTOM] - 1, left = shape[LEFT] - 1, right = shape[RIGHT] - 1;
+        int64_t diagonals = reach < trimmed_reach_limit ? shape[DIAGONALS] : 0;
+        if (diagonals == 0) {
+            int64_t width = 0;
+            for (int64_t row = top - reach; row <= bottom + reach; row++) {
+                int64_t d = top - row > row - bottom ? top - row : row - bottom;
+                d = d > 0 ? d : 0;
+                while ((width + 1) * (width + 1) + d * d <= reach * reach) {
+                    width += 1;
+                }
+                while (width * width + d * d > reach * reach) {
+                    width -= 1;
+                }
+                if (0 <= row && row < rows) {
+                    raise_span(out + row * cols, cols, left - width, right + width, radius);
+                }
+            }
+            continue;
+        }
+        int below = (diagonals & BELOW) != 0;
+        int64_t step = below ? -1 : 1;
+        int64_t neighbours = below ? diagonals >> 2 : diagonals & ABOVE;
+        int64_t farthest = ((diagonals & ABOVE) && below) ? 0 : reach;
+        int64_t key = reach * 3 + neighbours;
+        for (int64_t piece = pieces.start[key - 1]; piece < pieces.start[key]; piece++) {
+            if (pieces.distance[piece] > farthest) {
+                break;
+            }
+            int64_t row = top + step * pieces.distance[piece];
+            if (0 <= row && row < rows) {
+                raise_span(out + row * cols, cols, left + pieces.from[piece], left + pieces.to[piece], radius);
+            }
+        }
+    }
+    if (!failed) {
+        for (int64_t row = 0; row < rows; row++) {
+            const uint8_t *free_row = free_data + row * free_mask->row_stride;
+            for (int64_t col = 0; col < cols; col++) {
+                if (free_row[col * free_mask->col_stride] == 0) {
+                    out[row * cols + col] = 0;
+                }
+            }
+        }
+    }
+    free(pieces.start);
+    free(pieces.distance);
+    free(pieces.from);
+    free(pieces.to);
+    return failed;
+}
+
+KERNEL(paint_discs)
+{
+    Array shapes, free_mask, out;
+    if (check_nargs("paint_discs", nargs, 3) || array_arg(args[0], NPY_INT64, 2, 0, "shapes", &shapes)
+        || array_arg(args[1], NPY_UINT8, 2, 1, "free", &free_mask) || array_arg(args[2], NPY_INT32, 2, 0, "out", &out)) {
+        return NULL;
+    }
+    if (shapes.cols != 6 || free_mask.rows != out.rows || free_mask.cols != out.cols) {
+        PyErr_SetString(PyExc_ValueError, "paint_discs: shapes must have 6 columns, free and out one shape");
+        return NULL;
+    }
+    int failed;
+    Py_BEGIN_ALLOW_THREADS
+    failed = paint(shapes.data, shapes.rows, &free_mask, out.data, out.rows, out.cols);
+    Py_END_ALLOW_THREADS
+    if (failed) {
+        return PyErr_NoMemory();
+    }
+    Py_RETURN_NONE;
+}
