@@ -6,26 +6,6 @@
 #include "graph.h"
 #include "kernels.h"
 
-/* A graph argument: the tuple (records, nodes) of two (n, 4) int32 arrays. */
-static int graph_arg(PyObject *obj, const char *what, Graph *graph)
-{
-    PyObject *const *items = tuple_arg(obj, 2, what);
-    Array records, nodes;
-    if (items == NULL || array_arg(items[0], NPY_INT32, 2, 0, what, &records)
-        || array_arg(items[1], NPY_INT32, 2, 0, what, &nodes)) {
-        return -1;
-    }
-    if (records.cols != 4 || nodes.cols != 4) {
-        PyErr_Format(PyExc_TypeError, "%s: records and nodes must have 4 columns", what);
-        return -1;
-    }
-    graph->records = records.data;
-    graph->n_records = records.rows;
-    graph->nodes = nodes.data;
-    graph->n_nodes = nodes.rows;
-    return 0;
-}
-
 /* Records of isolated zones, zone z of value value[z]. */
 static void isolated_zones(int32_t *records, const int32_t *value, int64_t count)
 {

@@ -11,6 +11,8 @@
 
 #include <stdint.h>
 
+#include "common.h"
+
 enum { HEAD = 0, TAIL = 1, DEGREE = 2, VALUE = 3 };
 enum { NEIGHBOUR = 0, NEXT = 1, PREVIOUS = 2, ATTRIBUTE = 3 };
 /* constants.NO_MINIMUM: an edge's "lowest value met along fused paths" before any fusion. */
@@ -110,6 +112,26 @@ static inline void graph_fuse_edges(int64_t zone, int64_t into, int32_t *records
     }
     REC(records, zone, HEAD) = REC(records, zone, TAIL) = -1;
     REC(records, zone, DEGREE) = 0;
+}
+
+/* A graph argument: the tuple (records, nodes) of two (n, 4) int32 arrays. */
+static int graph_arg(PyObject *obj, const char *what, Graph *graph)
+{
+    PyObject *const *items = tuple_arg(obj, 2, what);
+    Array records, nodes;
+    if (items == NULL || array_arg(items[0], NPY_INT32, 2, 0, what, &records)
+        || array_arg(items[1], NPY_INT32, 2, 0, what, &nodes)) {
+        return -1;
+    }
+    if (records.cols != 4 || nodes.cols != 4) {
+        PyErr_Format(PyExc_TypeError, "%s: records and nodes must have 4 columns", what);
+        return -1;
+    }
+    graph->records = records.data;
+    graph->n_records = records.rows;
+    graph->nodes = nodes.data;
+    graph->n_nodes = nodes.rows;
+    return 0;
 }
 
 #endif
