@@ -16,8 +16,10 @@ from ursim_core.cli.common import progress_bar, staged_folder
 from ursim_core.io import atomic
 
 # Modules the segment path has no use for (numba is left out: it compiles the kernels when
-# they are not built yet).
-NOT_ON_THE_SEGMENT_PATH = ("PIL", "tqdm", "scipy", "skimage", "matplotlib", "jsonschema", "multiprocessing")
+# they are not built yet). networkx: the regions are written from their table.
+NOT_ON_THE_SEGMENT_PATH = (
+    "PIL", "tqdm", "scipy", "skimage", "matplotlib", "jsonschema", "multiprocessing", "networkx",
+)  # fmt: skip
 
 
 def run_python(code: str, **environment: str) -> dict:

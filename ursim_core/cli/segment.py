@@ -77,7 +77,8 @@ def output_names(paths: list[str]) -> list[str]:
 
 
 def region_records(segmentation) -> list[dict[str, Any]]:
-    graph = segmentation.graph
+    regions = segmentation.regions
+    neighbours = regions.neighbours()
     return [
         {
             "id": int(region),
@@ -86,9 +87,9 @@ def region_records(segmentation) -> list[dict[str, Any]]:
             "interior": [int(v) for v in data["interior"]],
             "bbox": [int(v) for v in data["bbox"]],
             "pca_shape": round(float(data["pca_shape"]), 6),
-            "neighbours": sorted(int(n) for n in graph.neighbors(region)),
+            "neighbours": [int(n) for n in neighbours[region]],
         }
-        for region, data in sorted(graph.nodes(data=True))
+        for region, data in sorted(regions.nodes.items())
     ]
 
 
@@ -100,7 +101,7 @@ def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, p
     save_label_image(segmentation, out / f"{name}.labels.png")
     save_png(
         out / f"{name}.overlay.png",
-        overlay_segmentation(segmentation.labels, segmentation.graph, image=the_map.image, free=the_map.free),
+        overlay_segmentation(segmentation.labels, segmentation.regions, image=the_map.image, free=the_map.free),
     )
     document = {
         "map": str(the_map.path) if the_map.path else None,
@@ -194,7 +195,7 @@ def run(args: argparse.Namespace) -> int:
             segmentation = segment_checked(the_map, method=method, preset=preset, params=params)
             with staged_folder(out) as staging:
                 write_segmentation_outputs(the_map, segmentation, staging, name=name, preset=preset)
-            print(f"{path}: {segmentation.n_regions} regions, {segmentation.graph.number_of_edges()} edges")
+            print(f"{path}: {segmentation.n_regions} regions, {segmentation.regions.number_of_edges()} edges")
         except UrsimError as error:
             failures += 1
             print(f"error: {error}", file=sys.stderr)

@@ -8,13 +8,16 @@ from __future__ import annotations
 import colorsys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cv2
-import networkx as nx
 import numpy as np
 
 from ursim_core.errors import UrsimError
 from ursim_core.io.atomic import atomic_write_bytes
+
+if TYPE_CHECKING:  # networkx is imported where a graph is made (_shrunk), not to draw one
+    import networkx as nx
 
 __all__ = [
     "FIGURE_MAX_SIDE",
@@ -142,8 +145,9 @@ def overlay_segmentation(
     Parameters
     ----------
     labels : ndarray of int, shape (rows, cols)
-    graph : networkx.Graph
-        Region graph with node attribute ``interior`` (row, col).
+    graph : networkx.Graph or RegionTable
+        Region graph with node attribute ``interior`` (row, col), or the same as a
+        :class:`~ursim_core.segmentation.regions.RegionTable`.
     image, free : ndarray, optional
         The map's grey image (preferred) or free mask, drawn underneath.
     opacity : float
@@ -178,7 +182,8 @@ def overlay_segmentation(
                 canvas, (int(col), int(row)), int(14 * scale + 6), (220, 20, 60), max(2, int(scale * 3)), cv2.LINE_AA
             )
     if show_ids:
-        for region, (row, col) in graph.nodes(data="interior"):
+        for region in graph.nodes:
+            row, col = graph.nodes[region]["interior"]
             _put_label(canvas, str(region), row, col, scale)
     return canvas
 
@@ -255,6 +260,8 @@ def _shrunk(labels: np.ndarray, graph: nx.Graph, image: np.ndarray | None, max_s
     small_image = None
     if image is not None:
         small_image = cv2.resize(np.asarray(image, np.uint8), size, interpolation=cv2.INTER_AREA)
+    import networkx as nx
+
     small_graph = nx.Graph()
     for region, (row, col) in graph.nodes(data="interior"):
         small_graph.add_node(region, interior=(row * factor, col * factor))

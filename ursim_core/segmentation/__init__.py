@@ -1,7 +1,8 @@
 """Segmentation of a map into regions, behind one small interface.
 
 Owns: :class:`Segmentation` (label image + region adjacency graph), :func:`segment` and the
-``SEGMENTERS`` registry, label-image files, the region graph (:func:`region_graph`), MAORIS
+``SEGMENTERS`` registry, label-image files, the regions (:func:`region_table`, no networkx) and their graph
+(:func:`region_graph`), MAORIS
 (:mod:`ursim_core.segmentation.maoris`), the clearance watershed
 (:mod:`ursim_core.segmentation.watershed`), learned merging of candidate pieces
 (:mod:`ursim_core.segmentation.learned`, its figures :mod:`ursim_core.segmentation.learned_cv`), leave-one-map-out figures of the presets
@@ -23,7 +24,17 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["interface", "graph", "scoring", "maoris", "watershed", "presets_cv", "learned", "learned_cv"],
+    submodules=[
+        "interface",
+        "regions",
+        "graph",
+        "scoring",
+        "maoris",
+        "watershed",
+        "presets_cv",
+        "learned",
+        "learned_cv",
+    ],
     submod_attrs={
         "interface": [
             "Segmentation",
@@ -37,7 +48,8 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "load_label_image",
             "save_label_image",
         ],
-        "graph": ["region_graph", "adjacent_pairs", "contour_pca_shape"],
+        "regions": ["RegionTable", "region_table", "adjacent_pairs", "contour_pca_shape"],
+        "graph": ["region_graph"],
         "watershed": ["watershed_labels"],
         "presets_cv": ["cross_validate"],
         "learned": ["learned_labels"],

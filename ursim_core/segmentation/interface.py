@@ -2,13 +2,12 @@
 
 A segmenter is any callable ``segmenter(free: ndarray[bool], **params) -> ndarray[int32]``
 returning a label image (0 = no region, regions 1..N). :func:`segment` wraps it into a
-:class:`Segmentation` with the region adjacency graph built by
-:func:`ursim_core.segmentation.graph.region_graph`.
+:class:`Segmentation` with its regions (:func:`ursim_core.segmentation.regions.region_table`),
+and their adjacency graph (:func:`ursim_core.segmentation.graph.region_graph`) when asked for.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -16,6 +15,8 @@ import numpy as np
 
 if TYPE_CHECKING:  # networkx loads with the region graph, not with this module
     import networkx as nx
+
+    from ursim_core.segmentation.regions import RegionTable
 
 __all__ = [
     "Segmentation",
@@ -30,9 +31,12 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True, eq=False)
 class Segmentation:
     """A segmented map.
+
+    Immutable (attributes cannot be set); equal only to itself. Give the region graph or the
+    region table (:func:`ursim_core.segmentation.regions.region_table`): the other is made
+    from it on first use, so that code reading only regions never imports networkx.
 
     Attributes
     ----------
@@ -41,23 +45,73 @@ class Segmentation:
     graph : networkx.Graph
         Region adjacency graph; nodes are region ids with the attributes of
         :func:`ursim_core.segmentation.graph.region_graph`.
+    regions : RegionTable
+        The same regions and boundaries as plain dicts.
     method : str
         'maoris' or 'label-image' (or another registered segmenter).
     params : dict
         Parameters used (JSON-serialisable).
     source : Path or None
         Label image path when loaded from a file.
+
+    Examples
+    --------
+    >>> from ursim_core.segmentation.regions import region_table
+    >>> labels = np.array([[1, 1, 2], [1, 0, 2]], np.int32)
+    >>> seg = Segmentation(labels=labels, regions=region_table(labels))
+    >>> seg.n_regions, seg.region_at(0, 2), seg.graph.number_of_edges()
+    (2, 2, 1)
     """
 
-    labels: np.ndarray
-    graph: nx.Graph
-    method: str = "maoris"
-    params: dict[str, Any] = field(default_factory=dict)
-    source: Path | None = None
+    __slots__ = ("_graph", "_regions", "labels", "method", "params", "source")
+
+    def __init__(
+        self,
+        labels: np.ndarray,
+        graph: nx.Graph | None = None,
+        method: str = "maoris",
+        params: dict[str, Any] | None = None,
+        source: Path | None = None,
+        *,
+        regions: RegionTable | None = None,
+    ) -> None:
+        if graph is None and regions is None:
+            raise TypeError("Segmentation needs the region graph or the region table of its labels")
+        for name, value in (
+            ("labels", labels), ("method", method), ("params", {} if params is None else params), ("source", source),
+            ("_graph", graph), ("_regions", regions),
+        ):  # fmt: skip
+            object.__setattr__(self, name, value)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"Segmentation is immutable: cannot set {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"Segmentation is immutable: cannot delete {name!r}")
+
+    def __reduce__(self):
+        return (_rebuilt, (self.labels, self._graph, self.method, self.params, self.source, self._regions))
+
+    def __repr__(self) -> str:
+        return f"Segmentation(method={self.method!r}, n_regions={self.n_regions}, shape={tuple(self.labels.shape)})"
+
+    @property
+    def graph(self) -> nx.Graph:
+        if self._graph is None:
+            object.__setattr__(self, "_graph", self._regions.to_graph())
+        return self._graph
+
+    @property
+    def regions(self) -> RegionTable:
+        if self._regions is None:
+            from ursim_core.segmentation.regions import RegionTable
+
+            object.__setattr__(self, "_regions", RegionTable.from_graph(self._graph))
+        return self._regions
 
     @property
     def n_regions(self) -> int:
-        return self.graph.number_of_nodes()
+        return self._graph.number_of_nodes() if self._graph is not None else len(self._regions)
 
     def region_at(self, row: int, col: int) -> int:
         """Region id under pixel (row, col), 0 when none or outside the image."""
@@ -65,6 +119,10 @@ class Segmentation:
         if 0 <= r < self.labels.shape[0] and 0 <= c < self.labels.shape[1]:
             return int(self.labels[r, c])
         return 0
+
+
+def _rebuilt(labels, graph, method, params, source, regions) -> Segmentation:
+    return Segmentation(labels, graph, method, params, source, regions=regions)
 
 
 def _maoris(free: np.ndarray, **params: Any) -> np.ndarray:
@@ -210,7 +268,7 @@ def segment(
     >>> seg.n_regions, seg.graph.number_of_edges()
     (2, 1)
     """
-    from ursim_core.segmentation.graph import region_graph
+    from ursim_core.segmentation.regions import region_table
 
     free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
     resolved = resolve_params(method, preset, params)
@@ -221,7 +279,7 @@ def segment(
         labels = canonical_labels(free, lambda pose: SEGMENTERS[method](pose, **settings))
     else:
         labels = np.asarray(SEGMENTERS[method](free, **settings), dtype=np.int32)
-    return Segmentation(labels=labels, graph=region_graph(labels), method=method, params=resolved)
+    return Segmentation(labels=labels, regions=region_table(labels), method=method, params=resolved)
 
 
 def segment_canonical(
@@ -293,7 +351,7 @@ def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) 
     """
 
     from ursim_core.errors import SegmentationError
-    from ursim_core.segmentation.graph import region_graph
+    from ursim_core.segmentation.regions import region_table
 
     path = Path(path)
     labels = read_label_array(path)
@@ -302,7 +360,7 @@ def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) 
             f"label image is {labels.shape[0]}x{labels.shape[1]} (rows x cols) but the map is {shape[0]}x{shape[1]}",
             path=path,
         )
-    return Segmentation(labels=labels, graph=region_graph(labels), method="label-image", params={}, source=path)
+    return Segmentation(labels=labels, regions=region_table(labels), method="label-image", params={}, source=path)
 
 
 def save_label_image(segmentation: Segmentation, path: str | Path) -> None:
