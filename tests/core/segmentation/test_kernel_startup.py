@@ -217,7 +217,7 @@ def test_kernels_cached_is_true_after_compiling_and_false_on_an_empty_cache(tmp_
 def test_region_graph_boxes_are_those_of_scipy_find_objects():
     from scipy import ndimage
 
-    from ursim_core.segmentation.graph import _bounding_boxes
+    from ursim_core.segmentation.regions import _bounding_boxes
 
     rng = np.random.default_rng(0)
     for shape in ((1, 1), (7, 1), (1, 9), (40, 33)):
