@@ -25,7 +25,7 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 # numba compiles the segmentation kernels on first use and caches them beside the module: do it
 # once here rather than inside the first segmentation (or in both test workers at once).
 $(VENV)/.kernels: $(shell find ursim_core/segmentation -name '*.py') | $(VENV)/.installed-core
-	@echo "Building the segmentation kernels ahead of time (once; about 15 s on two CPUs)..."
+	@echo "Building the segmentation kernels ahead of time (once; about 17 s on two CPUs)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; print(f'{compile_kernels():.1f} s')"
 	touch $@
 

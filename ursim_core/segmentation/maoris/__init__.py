@@ -37,7 +37,7 @@ vectorised; steps 3, 4 and 6 run as compiled code (numba, :mod:`.kernels`)
 on an array form of the zone graph, and step 1 paints its discs with compiled
 code too (:mod:`.kernels.discs`). The contacts of large maps are counted in bands
 of rows on one thread per CPU. :func:`compile_kernels` builds the kernels once ahead of
-time into extension modules (numba's ``pycc``, about 15 s on two CPUs; ``make`` runs it, and
+time into extension modules (numba's ``pycc``, about 17 s on two CPUs; ``make`` runs it, and
 the first segmentation does if nothing did), which later processes load in milliseconds
 without importing numba; ``URSIM_KERNELS=jit`` uses numba's JIT and its cache instead
 (``ursim bench compile`` measures both). :func:`kernels_cached` tells, without importing

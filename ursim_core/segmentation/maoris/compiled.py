@@ -4,7 +4,7 @@
 :data:`ENTRY_KERNELS`). It is the extension modules that
 :func:`build_ahead` wrote (``make`` builds them)
 when they were built from the kernel sources of this install, which takes milliseconds
-and no numba. When there are none, the first call builds them (about 15 s on two CPUs, once, half
+and no numba. When there are none, the first call builds them (about 17 s on two CPUs, once, half
 the JIT's own first compile); when that fails (pycc needs a C compiler), numba's JIT
 dispatchers of :mod:`.kernels`, which import numba and load (or compile) their cache. Both run the same compiled Python source for the same
 signatures; a test checks that their label images agree.
@@ -225,7 +225,7 @@ def build_ahead(directory: str | Path | None = None) -> Path:
     once. The modules and their digest file are written to ``directory`` (default: the first
     writable of :func:`build_directories`): the old digest is removed first, then each module
     and the new digest are put in place by a rename, so a reader never sees a digest without
-    its modules. Takes about 15 s on two CPUs (``ursim bench compile`` measures it).
+    its modules. Takes about 17 s on two CPUs (``ursim bench compile`` measures it).
 
     Raises
     ------

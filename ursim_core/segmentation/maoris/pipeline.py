@@ -95,7 +95,7 @@ def compile_kernels(*, processes: int = 1, jit: bool = False) -> float:
     """Make the MAORIS kernels ready for use; return the seconds it took.
 
     By default this builds the kernels ahead of time into extension modules
-    (:func:`ursim_core.segmentation.maoris.compiled.build_ahead`, about 15 s on two CPUs,
+    (:func:`ursim_core.segmentation.maoris.compiled.build_ahead`, about 17 s on two CPUs,
     once per install and kernel source) unless a fresh one exists, and loads it: later
     processes then start without numba (:mod:`ursim_core.segmentation.maoris.compiled`).
     When that build fails (pycc needs a C compiler) or ``jit`` is true, numba's JIT
