@@ -137,7 +137,7 @@ def _disk_cache_path(cache_dir: Path, job: SegmentationJob) -> Path:
 
 def _read_disk_cache(path: Path, job: SegmentationJob):
     from ursim_core.segmentation import Segmentation, resolve_params
-    from ursim_core.segmentation.graph import region_graph
+    from ursim_core.segmentation.regions import region_table
 
     try:
         with np.load(path) as stored:
@@ -146,7 +146,7 @@ def _read_disk_cache(path: Path, job: SegmentationJob):
         # A missing, damaged or foreign cache file is only a cache miss.
         return None
     return Segmentation(
-        labels=labels, graph=region_graph(labels), method="maoris", params=resolve_params("maoris", job.preset)
+        labels=labels, regions=region_table(labels), method="maoris", params=resolve_params("maoris", job.preset)
     )
 
 

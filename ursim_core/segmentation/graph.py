@@ -15,22 +15,12 @@ __all__ = ["region_graph", "adjacent_pairs", "contour_pca_shape"]
 
 
 def region_graph(labels: np.ndarray) -> nx.Graph:
-    """Build the region adjacency graph of a label image.
+    """Build the region adjacency graph of a label image (0 = no region).
 
-    Parameters
-    ----------
-    labels : ndarray of int, shape (rows, cols)
-        0 = no region, regions are positive integers.
-
-    Returns
-    -------
-    networkx.Graph
-        One node per region id with attributes ``size`` (pixels), ``centroid``
-        (row, col), ``interior`` (row, col: the pixel farthest from the region's
-        border, a point safely inside even for non-convex regions), ``bbox``
-        (min_row, min_col, max_row, max_col; max exclusive) and ``pca_shape``
-        (see :func:`contour_pca_shape`). Edges join regions with 4-adjacent pixels;
-        edge attribute ``boundary`` is the number of such pixel pairs.
+    One node per region of :func:`~ursim_core.segmentation.regions.region_table`, with its
+    attributes ``size``, ``centroid``, ``interior``, ``bbox`` and ``pca_shape``; an edge per pair
+    of regions with 4-adjacent pixels, with attribute ``boundary``, the number of such pixel
+    pairs. Nodes and edges are inserted in ascending order.
 
     Examples
     --------

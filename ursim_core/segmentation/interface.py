@@ -8,6 +8,7 @@ and their adjacency graph (:func:`ursim_core.segmentation.graph.region_graph`) w
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -29,6 +30,9 @@ __all__ = [
     "load_label_image",
     "save_label_image",
 ]
+
+
+_GRAPH_LOCK = threading.Lock()
 
 
 class Segmentation:
@@ -98,7 +102,11 @@ class Segmentation:
     @property
     def graph(self) -> nx.Graph:
         if self._graph is None:
-            object.__setattr__(self, "_graph", self._regions.to_graph())
+            # One graph per segmentation, also when two threads ask at once (the app's views
+            # and its jobs): a caller that annotates the graph must see the others' graph.
+            with _GRAPH_LOCK:
+                if self._graph is None:
+                    object.__setattr__(self, "_graph", self._regions.to_graph())
         return self._graph
 
     @property

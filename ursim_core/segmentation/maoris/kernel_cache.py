@@ -32,10 +32,10 @@ __all__ = [
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 
 #: Seconds that building the kernels ahead of time on empty caches takes on the 2-CPU machine
-#: of the project, the two parts at once: 12-15 s when the other CPU is free (23-25 s of CPU),
-#: up to twice that on a busy machine (``ursim bench compile``; 27-35 s before, in one
-#: process); the wait :func:`compile_notice` gives.
-COMPILE_SECONDS = 15
+#: of the project, the two parts at once: 16.6 s by ``make`` with the other CPU free (round 12),
+#: 20.3 s at light load (round 11), up to twice that on a busy machine (``ursim bench compile``);
+#: the wait :func:`compile_notice` gives.
+COMPILE_SECONDS = 17
 #: Seconds of CPU of that build (both processes).
 COMPILE_CPU_SECONDS = 25
 #: Seconds of numba's JIT compiling every kernel on an empty cache (``URSIM_KERNELS=jit``,
