@@ -87,7 +87,8 @@ def test_every_c_kernel_refuses_arrays_of_another_type_layout_or_writeability(c_
             wrong_dtype = original.astype(np.float64 if original.dtype != np.float64 else np.int32)
             readonly = original.copy()
             readonly.flags.writeable = False
-            wrongs = [wrong_dtype, readonly, original.reshape(-1), "not an array"]
+            other_ndim = original.reshape(-1) if original.ndim > 1 else original.reshape(1, -1)
+            wrongs = [wrong_dtype, readonly, other_ndim, "not an array"]
             if original.ndim == 2 and name != "paint_discs":  # paint_discs takes any layout
                 wrongs.append(np.zeros((2, 4), original.dtype)[:, ::2])
             for wrong in wrongs:
@@ -127,3 +128,85 @@ def test_a_built_module_missing_a_kernel_is_not_used(tmp_path, monkeypatch, c_mo
     monkeypatch.setattr(compiled, "ENTRY_KERNELS", {**compiled.ENTRY_KERNELS, "extra": ("no_such_kernel",)})
     with pytest.raises(AttributeError, match="no_such_kernel"):
         compiled._load_ahead(compiled.ahead_module_path())
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, np.ndarray):
+        return isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+    if isinstance(a, tuple):
+        return isinstance(b, tuple) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if a is None or b is None:
+        return a is b
+    return int(a) == int(b)
+
+
+def _used_part(name, value):
+    """What of a kernel's result numba defines: count_contacts and join_counts leave the
+    candidate array past ``used`` uninitialised (np.empty), group_candidates its one slot when
+    there is no candidate."""
+    if name in ("count_contacts", "join_counts") and isinstance(value, tuple):
+        return (value[0][: value[1]], *value[1:])
+    if name == "group_candidates" and value[0].size == 1:
+        return value[2:]
+    return value
+
+
+def test_every_c_kernel_gives_numba_results_and_leaves_its_arguments_alike(c_module, monkeypatch):
+    """Each C kernel, called on copies of what numba's got during segmentations (every preset,
+    contacts counted in bands, the watershed), returns the same and changes its arguments alike.
+
+    adjacency's node arrays are allocated zeroed where numba's are np.empty (rows never read),
+    so build_adjacency and _link_entries are compared on the labels they lead to (the end of
+    the test) rather than on their raw arrays."""
+    import copy
+
+    from ursim_core.segmentation.maoris import PRESETS, compiled, contact_tracking, maoris_labels
+    from ursim_core.segmentation.watershed import watershed_labels
+    from ursim_core.synth import make_large_building
+
+    monkeypatch.setenv("URSIM_KERNELS", "jit")
+    compiled.forget()
+    namespace = compiled.kernels()
+    calls: dict[str, int] = {}
+    differing: list[str] = []
+    raw_arrays = {"build_adjacency", "_link_entries"}
+
+    def checked(name, numba_kernel, c_kernel):
+        def run(*args):
+            c_args = copy.deepcopy(args)
+            wanted, got = numba_kernel(*args), c_kernel(*c_args)
+            if name not in raw_arrays and not _same(_used_part(name, wanted), _used_part(name, got)):
+                differing.append(f"{name}: result")
+            join = name == "join_counts"
+            if not _same(
+                tuple(_used_part(name, a) if join else a for a in args),
+                tuple(_used_part(name, a) if join else a for a in c_args),
+            ):
+                differing.append(f"{name}: arguments")
+            calls[name] = calls.get(name, 0) + 1
+            return wanted
+
+        return run
+
+    try:
+        for names in compiled.ENTRY_KERNELS.values():
+            for name in names:
+                monkeypatch.setattr(namespace, name, checked(name, getattr(namespace, name), getattr(c_module, name)))
+        maps = [make_large_building(size, seed=seed).free for size, seed in ((300, 1), (500, 4))]
+        for free in maps:
+            for preset in ("default", "sketch", "robot"):
+                maoris_labels(free, PRESETS[preset])
+            watershed_labels(free, min_size=0, door_ratio=1.0)
+        monkeypatch.setattr(contact_tracking, "_BAND_PIXELS", 0)
+        monkeypatch.setattr(contact_tracking, "_usable_cpus", lambda: 3)
+        labels = maoris_labels(maps[1], PRESETS["robot"])
+        padded = np.pad(labels.astype(np.int32), 2)
+        alive = np.zeros(int(padded.max()) + 1, bool)
+        alive[np.unique(padded)[1:]] = True
+        namespace.contact_table(padded.ravel(), padded.shape[1], alive)
+    finally:
+        compiled.forget()
+    assert not differing, differing[:10]
+    every = {name for names in compiled.ENTRY_KERNELS.values() for name in names}
+    assert set(calls) == every, every - set(calls)
+    assert calls["join_counts"] >= 2

@@ -214,6 +214,12 @@ static int counts_arg(PyObject *obj, const char *what, CountsArg *out)
         || array_arg(items[6], NPY_INT64, 1, 0, what, &out->total)) {
         return -1;
     }
+    return 0;
+}
+
+/* Whether the arrays of a counts tuple fit together (after every argument's type was checked). */
+static int counts_fit(const CountsArg *out, const char *what)
+{
     if (out->meta.size != META_SIZE || out->keys.size != out->counts.size || out->used > out->pixels.size
         || out->slots.size != out->total.size * SLOTS) {
         PyErr_Format(PyExc_ValueError, "%s: not a tuple of contact counts", what);
@@ -226,7 +232,7 @@ KERNEL(join_counts)
 {
     CountsArg first, second;
     if (check_nargs("join_counts", nargs, 2) || counts_arg(args[0], "first", &first)
-        || counts_arg(args[1], "second", &second)) {
+        || counts_arg(args[1], "second", &second) || counts_fit(&first, "first") || counts_fit(&second, "second")) {
         return NULL;
     }
     if (first.total.size != second.total.size) {

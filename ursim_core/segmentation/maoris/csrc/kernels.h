@@ -7,10 +7,7 @@
 
 #include "common.h"
 
-/* Weak while the port is under way: a kernel not yet written in C is left out of the module,
- * and compiled.kernels() takes numba's for it. */
-#define KERNEL(name) \
-    __attribute__((weak)) PyObject *kernel_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+#define KERNEL(name) PyObject *kernel_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 
 /* discs.c */
 KERNEL(centre_rectangles);

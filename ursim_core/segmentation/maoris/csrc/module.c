@@ -4,7 +4,7 @@
 
 #define ENTRY(name) {#name, (PyCFunction)(void (*)(void))kernel_##name, METH_FASTCALL, NULL}
 
-static PyMethodDef all_methods[] = {
+static PyMethodDef methods[] = {
     ENTRY(centre_rectangles), ENTRY(paint_discs),
     ENTRY(label_flat_zones), ENTRY(zone_values_and_sizes), ENTRY(first_pixels), ENTRY(resolve_parents), ENTRY(relabel),
     ENTRY(build_adjacency), ENTRY(adjacency_entries), ENTRY(_link_entries), ENTRY(remove_small_zones),
@@ -14,7 +14,6 @@ static PyMethodDef all_methods[] = {
     ENTRY(flood_levels), ENTRY(clearance_levels),
     {NULL, NULL, 0, NULL},
 };
-static PyMethodDef methods[sizeof(all_methods) / sizeof(all_methods[0])];
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_maoris_kernels",
@@ -24,12 +23,5 @@ static struct PyModuleDef module = {
 PyMODINIT_FUNC PyInit__maoris_kernels(void)
 {
     import_array();
-    size_t n = 0;
-    for (size_t i = 0; all_methods[i].ml_name != NULL; i++) {
-        if (all_methods[i].ml_meth != NULL) {
-            methods[n++] = all_methods[i];
-        }
-    }
-    methods[n] = (PyMethodDef){NULL, NULL, 0, NULL};
     return PyModule_Create(&module);
 }
