@@ -1,6 +1,6 @@
 """Whether this install's MAORIS kernels are compiled on disk, without importing numba.
 
-By default the kernels come from the module built ahead of time
+By default the kernels come from the module compiled from their C sources
 (:mod:`ursim_core.segmentation.maoris.compiled`): :func:`kernels_cached` is true when it is
 built for these sources. With ``URSIM_KERNELS=jit`` it asks numba's cache instead:
 numba compiles a ``cache=True`` function on its first call and writes it to a cache
@@ -31,16 +31,16 @@ __all__ = [
 
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 
-#: Seconds that building the kernels ahead of time on empty caches takes on the 2-CPU machine
-#: of the project, the two parts at once: 16.6 s by ``make`` with the other CPU free (round 12),
-#: 20.3 s at light load (round 11), up to twice that on a busy machine (``ursim bench compile``);
-#: the wait :func:`compile_notice` gives.
-COMPILE_SECONDS = 17
-#: Seconds of CPU of that build (both processes).
-COMPILE_CPU_SECONDS = 25
-#: Seconds of numba's JIT compiling every kernel on an empty cache (``URSIM_KERNELS=jit``,
-#: one process: 15 s quiet, 29 s wall and 21 s of CPU on a busy machine).
-JIT_COMPILE_SECONDS = 20
+#: Seconds that compiling the C kernels on empty caches takes on the 2-CPU machine of the
+#: project (one compiler per source file, two at once): 1.0-1.4 s in round 13's
+#: ``ursim bench compile`` (16.6 s for numba's pycc build it replaced); the wait
+#: :func:`compile_notice` gives, rounded up for a busy machine.
+COMPILE_SECONDS = 2
+#: Seconds of CPU of that build (every compiler process): 1.7-2.3 s.
+COMPILE_CPU_SECONDS = 3
+#: Seconds of numba's JIT compiling every kernel on an empty cache (``URSIM_KERNELS=jit``, or
+#: no C compiler; one process): 22.4-23.2 s in round 13's ``ursim bench compile``.
+JIT_COMPILE_SECONDS = 23
 
 
 def compile_notice() -> str | None:
