@@ -72,6 +72,10 @@ def bench_compile(*, processes: int = 1, repeats: int = 1) -> list[dict]:
         interpreter's start), ``cpu_s`` (user + system, with its helper processes) and
         ``load_s`` (a later process: import, load the kernels, segment a 40 x 40 map).
     """
+    from ursim_core.segmentation.maoris import compile_kernels
+
+    # The later processes load the install's own build: made first if the sources changed.
+    compile_kernels()
     rows = []
     for _ in range(repeats):
         with tempfile.TemporaryDirectory(prefix="ursim-kernels-bench-") as scratch:

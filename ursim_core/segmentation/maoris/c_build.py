@@ -24,7 +24,7 @@ SOURCE_DIR = Path(__file__).resolve().parent / "csrc"
 """Where the C sources of the kernels live."""
 
 #: Compiler flags of every source (after Python's own ``CCSHARED``, e.g. ``-fPIC``).
-CFLAGS = ("-O2", "-std=gnu11", "-ffp-contract=off", "-fno-strict-aliasing", "-Wall", "-Wno-unused-function")
+CFLAGS = ("-O3", "-std=gnu11", "-pthread", "-ffp-contract=off", "-fno-strict-aliasing", "-Wall", "-Wno-unused-function")
 
 
 def source_files() -> list[Path]:
@@ -82,7 +82,7 @@ def build_module(output: str | Path, *, jobs: int | None = None) -> Path:
             ]
             for future in compiles:
                 future.result()
-        _run([*link_command, *map(str, objects), "-o", str(output)], output.parent)
+        _run([*link_command, *map(str, objects), "-pthread", "-o", str(output)], output.parent)
     except FileNotFoundError as error:
         raise RuntimeError(f"no C compiler to build the segmentation kernels: {error}") from error
     finally:

@@ -25,10 +25,12 @@ def _usable_cpus() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
-def start_tracking(labels, width, alive, *, bands=None):
+def start_tracking(labels, width, alive, *, bands=None, compacted=None):
     """Compact the labels of a padded, flattened label image in place
     (``_compact_labels``) and count their contacts: ``(original,
     compact_of, state)`` for the compiled steps that track contacts.
+    ``compacted``: what ``_compact_labels(labels, alive)`` returned when the caller
+    already compacted the labels.
 
     The state is ``(parent, pixels, following, head, tail, keys, counts,
     meta, slots, total)``: union-find parents of the labels, each zone's
@@ -38,7 +40,7 @@ def start_tracking(labels, width, alive, *, bands=None):
     each on a thread.
     """
     compiled = kernels()
-    original, compact_of, n = compiled._compact_labels(labels, alive)
+    original, compact_of, n = compiled._compact_labels(labels, alive) if compacted is None else compacted
     if bands is None:
         bands = min(_usable_cpus(), 4) if labels.size >= _BAND_PIXELS else 1
     rows = labels.size // width

@@ -71,11 +71,15 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
     zones = np.flatnonzero(graph._alive)
     order = zones[np.lexsort((graph._size[zones], -graph._value_array[zones]))].astype(np.int32)
     labels, width = graph._labels.ravel(), graph._labels.shape[1]
-    original, compact_of, state = start_tracking(labels, width, graph._alive)
+    original, compact_of, n = kernels()._compact_labels(labels, graph._alive)
     # The kernel runs on the live zones renumbered in id order (the same order, ties and
     # lists): their records and nodes in a few MB rather than scattered through the graph's
     # (kernels' compact_graph). So the tracking's compact ids are the zones' own.
     small = kernels().compact_graph(original, compact_of, compact)
+    # The graph's own nodes (435 MB at 8000 px, most of them the edges of zones merged away as
+    # small) are not read again: dropped before the contacts are counted, the peak memory's step.
+    graph._compact = compact = (compact[0], small[1])
+    original, compact_of, state = start_tracking(labels, width, graph._alive, compacted=(original, compact_of, n))
     size = np.zeros(len(original) + 1, np.int64)
     size[1:] = graph._size[original]
     alive = np.ones(len(original) + 1, bool)
@@ -85,7 +89,6 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40) -> ZoneGraph:
         compact_of[order], float(ripples), labels, width, size, alive, small, (original, identity, state)
     )
     kernels().expand_graph(original, small, compact[0])
-    graph._compact = (compact[0], small[1])
     graph._size[original] = size[1:]
     graph._alive[original] = alive[1:]
     return graph

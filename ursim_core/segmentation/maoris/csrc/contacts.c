@@ -343,13 +343,19 @@ KERNEL(group_candidates)
     const int32_t *label = labels.data, *candidates = pixels.data;
     int32_t *grouped = PyArray_DATA(grouped_arr), *following = PyArray_DATA(following_arr);
     int32_t *head = PyArray_DATA(head_arr), *tail = PyArray_DATA(tail_arr);
+    Prefault prefault_grouped, prefault_following;
     Py_BEGIN_ALLOW_THREADS
+    /* Both outputs are written whole: they fault in while the candidates are counted. */
+    prefault_start(&prefault_grouped, grouped, (size_t)used * sizeof(int32_t));
+    prefault_start(&prefault_following, following, (size_t)used * sizeof(int32_t));
     /* Each zone's candidates stored contiguously, in raster order: a fusion walks the list of
      * the zone it absorbs, and candidates in raster order of the whole image cost a cache
      * miss per row of a zone on large maps. */
     for (int64_t k = 0; k < used; k++) {
         start[label[candidates[k]] + 1] += 1;
     }
+    prefault_join(&prefault_grouped);
+    prefault_join(&prefault_following);
     for (int64_t zone = 0; zone < n; zone++) {
         start[zone + 1] += start[zone];
     }
