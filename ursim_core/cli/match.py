@@ -45,8 +45,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def add_pair_options(parser: argparse.ArgumentParser) -> None:
     """The matching, segmentation and map-loading options of a pair (``match`` and ``match-batch``)."""
-    # The presets' defaults come from the matching pipeline, imported only for these subcommands.
-    from ursim_core.matching.pipeline import MATCH_PRESETS
+    # The presets' defaults come from the matcher's options (which import no networkx).
+    from ursim_core.matching.config import MATCH_PRESETS
 
     parser.add_argument("--m", default="auto", help="threshold m on the signature difference, or 'auto' (default)")
     parser.add_argument(

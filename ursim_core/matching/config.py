@@ -15,10 +15,30 @@ from dataclasses import dataclass
 from typing import Any
 
 from ursim_core.errors import ParameterError
-from ursim_core.matching.descriptors import DEFAULT_TIMES, SIZE_WEIGHT_FLOOR, VARIANTS
-from ursim_core.matching.orientation import ORIENTATIONS
 
-__all__ = ["MATCH_PRESETS", "M_GRID", "MATCHERS", "AUTO_RULE_NAMES", "MatchConfig"]
+__all__ = [
+    "MATCH_PRESETS",
+    "M_GRID",
+    "MATCHERS",
+    "AUTO_RULE_NAMES",
+    "DEFAULT_TIMES",
+    "SIZE_WEIGHT_FLOOR",
+    "VARIANTS",
+    "ORIENTATIONS",
+    "MatchConfig",
+]
+
+# The constants the options name live here, not in the modules that use them (descriptors,
+# signatures, orientation), which import networkx: ``ursim match`` builds its parser and its
+# MatchConfig without it, and imports the matcher while it loads and segments the maps.
+
+#: t = i * 0.2 for i = 0..14, as the paper and the released driver (15 samples, 0 .. 2.8).
+DEFAULT_TIMES = tuple(round(0.2 * i, 10) for i in range(15))
+#: Added to ``z_size - min(z_size)`` so that no vertex gets weight 0 (see :mod:`.descriptors`).
+SIZE_WEIGHT_FLOOR = 0.1
+VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
+#: The values of ``MatchConfig.orientation`` other than a number of degrees.
+ORIENTATIONS = ("any", "upright")
 
 #: Rules of ``m='auto'`` (implemented in :mod:`ursim_core.matching.auto_m`).
 AUTO_RULE_NAMES = ("score", "structure")

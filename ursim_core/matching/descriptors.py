@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
+from ursim_core.matching.config import SIZE_WEIGHT_FLOOR, VARIANTS
 from ursim_core.matching.positions import blend_positions, position_distance, region_positions, region_types
 from ursim_core.matching.signatures import (
     DEFAULT_TIMES,
@@ -92,9 +93,6 @@ __all__ = [
 ]
 
 ATTRIBUTES = ("size", "pca_shape")
-#: Added to ``z_size - min(z_size)`` so that no vertex gets weight 0 (see module docstring).
-SIZE_WEIGHT_FLOOR = 0.1
-VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
 
 
 def region_attributes(graph: nx.Graph, *, attributes: Sequence[str] = ATTRIBUTES) -> tuple[list, np.ndarray]:

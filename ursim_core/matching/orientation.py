@@ -28,12 +28,10 @@ from collections.abc import Sequence
 import networkx as nx
 import numpy as np
 
+from ursim_core.matching.config import ORIENTATIONS
 from ursim_core.segmentation.canonical import wall_angle
 
 __all__ = ["ORIENTATIONS", "SNAP_DEGREES", "wall_angle", "orientation_candidates", "oriented_graph", "transform_points"]
-
-#: The values of ``MatchConfig.orientation`` other than a number of degrees.
-ORIENTATIONS = ("any", "upright")
 
 
 #: Wall-angle differences below this many degrees are taken as none: the candidates are then the

@@ -12,10 +12,10 @@ from collections.abc import Sequence
 import networkx as nx
 import numpy as np
 
+from ursim_core.matching.config import DEFAULT_TIMES
+
 __all__ = ["DEFAULT_TIMES", "DENSE_LIMIT", "weighted_laplacian", "heat_kernel_signatures", "signature_distance"]
 
-#: t = i * 0.2 for i = 0..14, as the paper and the released driver (15 samples, 0 .. 2.8).
-DEFAULT_TIMES = tuple(round(0.2 * i, 10) for i in range(15))
 #: Largest graph handled by dense eigendecomposition; larger graphs use expm_multiply.
 DENSE_LIMIT = 100
 
