@@ -32,7 +32,7 @@ __all__ = [
 _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 
 #: Seconds that compiling the C kernels on empty caches takes on the 2-CPU machine of the
-#: project (one compiler per source file, two at once): 1.0-1.4 s in round 13's
+#: project (one compiler per source file, two at once): 1.6 s with -O3 in round 13's
 #: ``ursim bench compile`` (16.6 s for numba's pycc build it replaced); the wait
 #: :func:`compile_notice` gives, rounded up for a busy machine.
 COMPILE_SECONDS = 2
