@@ -91,3 +91,16 @@ def test_the_refitted_answer_records_the_options_it_was_asked_for():
     sketch = _grid_graph(((0.5, 7.0), (1.3, 2.0)))
     config = MatchConfig(orientation="upright")
     assert prepare(sketch, metric, config).chosen.config.m_grid == config.m_grid
+
+
+def test_the_fits_median_is_numpys_bit_for_bit():
+    """The fit's median avoids np.median's numpy.ma import; it must give the same floats."""
+    import numpy as np
+
+    from ursim_core.matching.refit import _median
+
+    rng = np.random.default_rng(7)
+    for _ in range(2000):
+        values = np.abs(rng.standard_normal(int(rng.integers(1, 40)))) * 10.0 ** int(rng.integers(-3, 4))
+        assert _median(values) == float(np.median(values))
+    assert _median(np.array([1.0, 3.0])) == 2.0 and _median(np.array([5.0])) == 5.0
