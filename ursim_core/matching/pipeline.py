@@ -34,7 +34,7 @@ import networkx as nx
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
-from ursim_core.matching.orientation import orientation_candidates, oriented_graph
+from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines
 from ursim_core.matching.planar import planar_graph
 from ursim_core.matching.refit import refit_from, refit_positions, signature_start
 from ursim_core.matching.results import MatchResult, Prepared
@@ -100,7 +100,8 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     if config.matcher == "overlay":
         return _prepare_overlay(sketch_seg, metric_seg, config)
     candidates = _orientations(config, sketch_seg, metric_seg)
-    base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0])
+    outlines = _outlines(sketch_seg, sketch_graph, candidates)
+    base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
     if len(candidates) == 1:
         if not _refits(config):
             return base
@@ -108,7 +109,7 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
         return dataclasses.replace(base, chosen=result)
 
     def candidate(index: int) -> Prepared:
-        return base if index == 0 else _reoriented(base, sketch_graph, candidates[index])
+        return base if index == 0 else _reoriented(base, sketch_graph, candidates[index], outlines)
 
     if max(base.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
         # Large graphs: one planar sweep costs seconds, so the orientation is chosen by how well
@@ -260,7 +261,9 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig) -> Prepared:
     candidates = _orientations(config, sketch_seg, metric_seg)
     fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
     orientation = (fit.degrees, fit.mirrored)
-    base = _prepare_oriented(_graph_of(sketch_seg), _graph_of(metric_seg), config, orientation)
+    sketch_graph = _graph_of(sketch_seg)
+    outlines = _outlines(sketch_seg, sketch_graph, [orientation])
+    base = _prepare_oriented(sketch_graph, _graph_of(metric_seg), config, orientation, outlines)
     pairs = overlay_pairs(sketch_labels, metric_labels, fit.matrix, min_iou=config.overlay_min_iou)
     descriptors = base.descriptors
     reasons = list(base.notes)
@@ -334,9 +337,20 @@ def _orientations(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[flo
     )
 
 
-def _reoriented(base: Prepared, sketch_graph: nx.Graph, orientation: tuple[float, bool]) -> Prepared:
+def _outlines(sketch_seg, sketch_graph: nx.Graph, candidates) -> dict | None:
+    """The sketch's region outlines (:func:`~ursim_core.matching.orientation.region_outlines`)
+    when a candidate is not a quarter turn and the label image is at hand; else None."""
+    labels = getattr(sketch_seg, "labels", None)
+    if labels is None or all(degrees % 90.0 == 0.0 for degrees, _ in candidates):
+        return None
+    return region_outlines(sketch_graph, labels)
+
+
+def _reoriented(
+    base: Prepared, sketch_graph: nx.Graph, orientation: tuple[float, bool], outlines: dict | None = None
+) -> Prepared:
     """``base`` for another orientation of the sketch: new positions, same signatures."""
-    turned = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1])
+    turned = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
     descriptors = base.descriptors
     if descriptors is not None and descriptors.signature_c is not None:
         c_matrix = blend_positions(
@@ -353,8 +367,10 @@ def _reoriented(base: Prepared, sketch_graph: nx.Graph, orientation: tuple[float
     )
 
 
-def _prepare_oriented(sketch_graph, metric_graph, config: MatchConfig, orientation: tuple[float, bool]) -> Prepared:
-    sketch_graph = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1])
+def _prepare_oriented(
+    sketch_graph, metric_graph, config: MatchConfig, orientation: tuple[float, bool], outlines: dict | None = None
+) -> Prepared:
+    sketch_graph = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
     notes = []
     for name, graph in (("sketch", sketch_graph), ("metric map", metric_graph)):
         count = graph.number_of_nodes()

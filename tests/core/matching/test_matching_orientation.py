@@ -13,8 +13,9 @@ from ursim_core.errors import ParameterError
 from ursim_core.evaluation import augment
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match, prepare
-from ursim_core.matching.orientation import orientation_candidates, oriented_graph, transform_points
-from ursim_core.segmentation import segment_canonical
+from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines, transform_points
+from ursim_core.matching.positions import region_positions
+from ursim_core.segmentation import region_graph, segment_canonical
 from ursim_core.segmentation.canonical import _turned, canonical_pose, dihedral, wall_angle
 from ursim_core.synth import ground_truth_correspondences, make_pair
 
@@ -63,6 +64,59 @@ def test_oriented_graph_moves_positions_and_keeps_everything_else():
     expected = transform_points(np.array([[10.0, 20.0]]), degrees=90, mirrored=False)[0]
     assert turned.nodes[1]["centroid"] == pytest.approx(tuple(expected))
     assert oriented_graph(graph, degrees=0, mirrored=False) is graph
+
+
+def _three_rooms() -> np.ndarray:
+    labels = np.zeros((120, 200), np.int32)
+    labels[10:110, 10:80] = 1  # a room
+    labels[40:60, 80:150] = 2  # a corridor
+    labels[20:100, 150:190] = 3  # another room
+    labels[20:40, 120:150] = 3  # with a wing: not a rectangle
+    return labels
+
+
+def test_region_outlines_span_each_region_box():
+    labels = _three_rooms()
+    graph = region_graph(labels)
+    outlines = region_outlines(graph, labels)
+    assert sorted(outlines) == [1, 2, 3]
+    for node, box in graph.nodes(data="bbox"):
+        assert outlines[node].min(axis=0).tolist() == [box[0], box[1]]
+        assert outlines[node].max(axis=0).tolist() == [box[2], box[3]]
+
+
+def _span(graph) -> np.ndarray:
+    """(rows, cols) of the union of a graph's region boxes: what the positions are normalised to."""
+    boxes = np.array([box for _, box in graph.nodes(data="bbox")], float)
+    return boxes[:, 2:].max(axis=0) - boxes[:, :2].min(axis=0)
+
+
+@pytest.mark.parametrize("degrees", [30.0, 45.0, 160.0])
+def test_a_map_drawn_at_an_angle_turned_back_gets_its_upright_positions(degrees):
+    # Drawn at an angle, each region's box (in the drawn frame) already holds the turned room; the
+    # box around that box turned back grows again. The positions are normalised to the union of
+    # the boxes, so they shrank towards the middle; from the outlines they are the upright ones.
+    labels = _three_rooms()
+    upright = region_graph(labels)
+    drawn = augment.transform_image(labels, augment.Orientation(degrees), fill=0)
+    graph = region_graph(drawn)
+    back = (-degrees) % 360.0
+    loose = oriented_graph(graph, degrees=back, mirrored=False)
+    tight = oriented_graph(graph, degrees=back, mirrored=False, outlines=region_outlines(graph, drawn))
+    expected = region_positions(upright)
+    assert np.abs(region_positions(tight) - expected).max() < 0.02
+    assert np.abs(region_positions(loose) - expected).max() > 0.05
+    assert np.allclose(_span(tight), _span(upright), atol=3)
+
+
+def test_outlines_leave_quarter_turns_and_mirrors_alone():
+    labels = _three_rooms()
+    graph = region_graph(labels)
+    outlines = region_outlines(graph, labels)
+    for degrees, mirrored in [(90.0, False), (180.0, True), (270.0, False), (0.0, True)]:
+        plain = oriented_graph(graph, degrees=degrees, mirrored=mirrored)
+        given = oriented_graph(graph, degrees=degrees, mirrored=mirrored, outlines=outlines)
+        assert dict(plain.nodes(data="bbox")) == dict(given.nodes(data="bbox"))
 
 
 def test_config_validates_orientation_and_mirrored():
