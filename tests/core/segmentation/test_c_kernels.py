@@ -210,3 +210,56 @@ def test_every_c_kernel_gives_numba_results_and_leaves_its_arguments_alike(c_mod
     every = {name for names in compiled.ENTRY_KERNELS.values() for name in names}
     assert set(calls) == every, every - set(calls)
     assert calls["join_counts"] >= 2
+
+
+def _brick_zones(rows: int, cols: int) -> np.ndarray:
+    """Zones laid as bricks (2 px wide, each row shifted by one): six neighbours each, more
+    than the 4.5 node records per zone build_adjacency first makes room for."""
+    row, col = np.indices((rows, cols))
+    brick = (col + row % 2) // 2
+    return (1 + (brick % 3) + 3 * (row % 2)).astype(np.uint8)
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 7), (40, 60), (333, 201)])
+def test_build_adjacency_grows_its_nodes_and_links_numbas_edges(c_module, shape):
+    """The C kernel scans once and grows its node records (numba's scans twice, sizing them
+    first): the records and every node it uses are numba's, and no unused node is returned."""
+    from ursim_core.segmentation.maoris.kernels import adjacency
+    from ursim_core.segmentation.maoris.zone_graph import flat_zones
+
+    values = _brick_zones(*shape)
+    zones = flat_zones(values)
+    value, _ = c_module.zone_values_and_sizes(zones, values, int(zones.max()) + 1)
+    records, nodes = c_module.build_adjacency(zones, value)
+    want_records, want_nodes = adjacency.build_adjacency(zones, value)
+    used = int(records[:, 2].sum())
+    assert np.array_equal(records, want_records)
+    assert len(nodes) == max(used, 2)
+    assert np.array_equal(nodes[:used], want_nodes[:used])
+    if shape[0] > 2:
+        assert used > 5 * (len(value) - 1), "the bricks must need more room than the first guess"
+
+
+def test_discs_painted_in_bands_are_numbas(c_module):
+    """Images of 2**21 px and more are painted in bands of rows, one thread each: the radii
+    are numba's (painted whole) to the pixel, obstacles included."""
+    import cv2
+
+    from ursim_core.segmentation.maoris.kernels import discs
+    from ursim_core.synth import make_large_building
+
+    free = make_large_building(1500, seed=5).free
+    rng = np.random.default_rng(3)
+    free[rng.random(free.shape) < 0.002] = False  # specks: many small discs near band edges
+    assert free.size >= 1 << 21
+    dist = np.empty(free.shape, np.float32)
+    cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE, dst=dist)
+    shapes = c_module.centre_rectangles(dist, 500)
+    # A strided mask: the kernel takes any layout, and numba's is compiled for that one only.
+    mask = np.zeros((free.shape[0], 2 * free.shape[1]), np.uint8)[:, ::2]
+    mask[...] = free
+    got, want = np.zeros(free.shape, np.int32), np.zeros(free.shape, np.int32)
+    c_module.paint_discs(shapes, mask, got)
+    discs.paint_discs(shapes, mask, want)
+    assert np.array_equal(got, want)
+    assert (got[~free] == 0).all() and got.max() > 20

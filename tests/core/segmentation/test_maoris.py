@@ -455,6 +455,33 @@ def test_labels_do_not_depend_on_the_surrounding_obstacle_margin():
     np.testing.assert_array_equal(maoris_labels(bigger)[20:64, 30:120], maoris_labels(free))
 
 
+def test_a_map_reaching_its_border_is_labelled_alike_in_the_graphs_memory():
+    # Free space up to the image's border: the window is the whole image, and the output is
+    # made in the zone graph's own memory (its padding squeezed out) rather than copied.
+    free = two_rooms()[1:-1, 1:-1]
+    labels = maoris_labels(free)
+    bigger = np.zeros((free.shape[0] + 6, free.shape[1] + 9), bool)
+    bigger[3:-3, 4:-5] = free
+    assert labels.flags.c_contiguous and labels.flags.writeable and labels.dtype == np.int32
+    assert labels.shape == free.shape and labels.max() >= 2
+    np.testing.assert_array_equal(maoris_labels(bigger)[3:-3, 4:-5], labels)
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 9), (7, 1), (13, 8)])
+def test_unpadding_in_place_inverts_padding_in_place(shape):
+    from ursim_core.segmentation.maoris.zone_graph import _PAD, _pad_in_place, _unpad_in_place
+
+    rng = np.random.default_rng(sum(shape))
+    zones = rng.integers(1, 50, shape).astype(np.int32)
+    storage = np.full((shape[0] + 2 * _PAD) * (shape[1] + 2 * _PAD), -1, np.int32)
+    storage[: zones.size] = zones.ravel()
+    padded = _pad_in_place(storage[: zones.size].reshape(shape), storage)
+    np.testing.assert_array_equal(padded, np.pad(zones, _PAD))
+    unpadded = _unpad_in_place(padded)
+    np.testing.assert_array_equal(unpadded, zones)
+    assert unpadded.flags.c_contiguous and np.shares_memory(unpadded, storage)
+
+
 def test_empty_map_gives_no_region():
     assert not maoris_labels(np.zeros((10, 12), bool)).any()
 

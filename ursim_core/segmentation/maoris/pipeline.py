@@ -69,6 +69,7 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
+    free_shape = free.shape
     # The window is its own bounding box: the radii of inscribed_circle_radii(free).
     radii, storage = _radii_in_storage(free, params.max_radius, padding=_PAD)
     values = _quantized_radii(radii, params.quantum)
@@ -86,6 +87,10 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     remove_doors(graph, doors=params.doors)
     remove_small_zones(graph, min_size=params.small_after)
     remove_isolated_zones(graph)
+    if free_shape == shape:
+        # The window is the whole map (a map that reaches its border): the graph's memory
+        # becomes the output, sparing a fresh full-size image (256 MB at 8000 px).
+        return graph._write_label_image()
     labels = np.zeros(shape, np.int32)
     graph._write_label_image(labels[window])
     return labels

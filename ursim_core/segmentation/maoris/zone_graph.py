@@ -268,12 +268,18 @@ class ZoneGraph:
         lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
         return lookup
 
-    def _write_label_image(self, out: np.ndarray) -> None:
+    def _write_label_image(self, out: np.ndarray | None = None) -> np.ndarray:
         """Write :meth:`label_image` into ``out`` (shape ``self.shape``, any strides), renumbering
         the graph's own labels in place: the graph must not be used afterwards. At 8000 px this
-        spares a fresh 256 MB image (its page faults cost more than the pass)."""
+        spares a fresh 256 MB image (its page faults cost more than the pass).
+
+        With no ``out``, the label image is made in the graph's own memory, its padding
+        squeezed out in place, and returned (C-ordered): no image is allocated at all."""
         kernels().relabel(self._labels.ravel(), self._renumbering())
-        out[...] = self._labels[_PAD:-_PAD, _PAD:-_PAD]
+        if out is not None:
+            out[...] = self._labels[_PAD:-_PAD, _PAD:-_PAD]
+            return out
+        return _unpad_in_place(self._labels)
 
     # -- contacts and relabelling -------------------------------------------
 
@@ -377,6 +383,18 @@ def _pad_in_place(zones: np.ndarray, storage: np.ndarray) -> np.ndarray:
     padded[:_PAD] = padded[-_PAD:] = 0
     padded[:, :_PAD] = padded[:, -_PAD:] = 0
     return padded
+
+
+def _unpad_in_place(padded: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`_pad_in_place`: ``padded[_PAD:-_PAD, _PAD:-_PAD]`` moved to the first
+    pixels of ``padded``'s memory (C-ordered), which it returns as an image."""
+    rows, cols = padded.shape[0] - 2 * _PAD, padded.shape[1] - 2 * _PAD
+    flat = padded.reshape(-1)
+    # First row first: each row moves to an earlier place than any row below it starts from
+    # (row r's place ends at (r + 1) * cols, row r + 1 starts at (r + 3) * (cols + 4) + 2).
+    for row in range(rows):
+        flat[row * cols : (row + 1) * cols] = padded[row + _PAD, _PAD : _PAD + cols]
+    return flat[: rows * cols].reshape(rows, cols)
 
 
 def _adjacency_from_entries(zone, other, minimum, unbreakable, value):

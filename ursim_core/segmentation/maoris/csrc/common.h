@@ -21,6 +21,7 @@
 #include <numpy/arrayobject.h>
 
 #include <pthread.h>
+#include <sched.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -257,6 +258,21 @@ static void *prefault_run(void *arg)
     return NULL;
 }
 
+/* Ask for transparent huge pages for a large malloc'd block, as numpy does for its arrays:
+ * one fault per 2 MB rather than per 4 KB (a hint; nothing changes where they are off). */
+static inline void advise_huge_pages(void *data, size_t bytes)
+{
+#ifdef MADV_HUGEPAGE
+    const uintptr_t huge = (uintptr_t)1 << 21;
+    uintptr_t first = ((uintptr_t)data + huge - 1) & ~(huge - 1), end = ((uintptr_t)data + bytes) & ~(huge - 1);
+    if (end > first) {
+        madvise((void *)first, end - first, MADV_HUGEPAGE);
+    }
+#else
+    (void)data, (void)bytes;
+#endif
+}
+
 /* Start faulting in the whole pages of [data, data + bytes) (nothing for small arrays). */
 static inline void prefault_start(Prefault *job, void *data, size_t bytes)
 {
@@ -277,6 +293,24 @@ static inline void prefault_join(Prefault *job)
         pthread_join(job->thread, NULL);
         job->running = 0;
     }
+}
+
+/* Kernels that split an image into bands of rows, one thread each, do so from this many
+ * pixels (below it, starting the threads costs more than they save), into at most MAX_BANDS. */
+#define BAND_MIN_PIXELS ((int64_t)1 << 21)
+#define MAX_BANDS 4
+
+/* CPUs this process may run on (a container or taskset may allow fewer than the machine has). */
+static inline int64_t usable_cpus(void)
+{
+#ifdef CPU_COUNT
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof(set), &set) == 0) {
+        int count = CPU_COUNT(&set);
+        return count > 0 ? count : 1;
+    }
+#endif
+    return 1;
 }
 
 /* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts). */

@@ -193,9 +193,94 @@ static inline void raise_span(int32_t *out_row, int64_t cols, int64_t first_col,
     }
 }
 
+/* What every band of a painting reads: the shapes, the pieces, the free mask and the output. */
+typedef struct {
+    const int64_t *shapes;
+    int64_t n, rows, cols, reach_cap, trimmed_reach_limit;
+    const Pieces *pieces;
+    const Array *free_mask;
+    int32_t *out;
+} Painting;
+
+/* One band of a painting: rows first_row .. end_row - 1 of every disc, then the obstacles
+ * there set to 0. Each pixel keeps the largest radius painted over it, so bands painted apart
+ * give the image painted whole. */
+typedef struct {
+    const Painting *painting;
+    int64_t first_row, end_row;
+    pthread_t thread;
+    int running;
+} Band;
+
+static void paint_band(const Painting *p, int64_t first_row, int64_t end_row)
+{
+    int64_t cols = p->cols;
+    int32_t *out = p->out;
+    for (int64_t i = 0; i < p->n; i++) {
+        const int64_t *shape = p->shapes + 6 * i;
+        int64_t radius = shape[RADIUS];
+        int64_t reach = radius - 1 < p->reach_cap ? radius - 1 : p->reach_cap;
+        int64_t top = shape[TOP] - 1, bottom = shape[BOTTOM] - 1, left = shape[LEFT] - 1, right = shape[RIGHT] - 1;
+        if (bottom + reach < first_row || top - reach >= end_row) {
+            continue;
+        }
+        int64_t diagonals = reach < p->trimmed_reach_limit ? shape[DIAGONALS] : 0;
+        if (diagonals == 0) {
+            int64_t width = 0;
+            int64_t from_row = top - reach > first_row ? top - reach : first_row;
+            int64_t to_row = bottom + reach < end_row - 1 ? bottom + reach : end_row - 1;
+            for (int64_t row = from_row; row <= to_row; row++) {
+                int64_t d = top - row > row - bottom ? top - row : row - bottom;
+                d = d > 0 ? d : 0;
+                /* the widest span of the disc at distance d: from any start, both loops end on it */
+                while ((width + 1) * (width + 1) + d * d <= reach * reach) {
+                    width += 1;
+                }
+                while (width * width + d * d > reach * reach) {
+                    width -= 1;
+                }
+                if (0 <= row && row < p->rows) {
+                    raise_span(out + row * cols, cols, left - width, right + width, radius);
+                }
+            }
+            continue;
+        }
+        int below = (diagonals & BELOW) != 0;
+        int64_t step = below ? -1 : 1;
+        int64_t neighbours = below ? diagonals >> 2 : diagonals & ABOVE;
+        int64_t farthest = ((diagonals & ABOVE) && below) ? 0 : reach;
+        int64_t key = reach * 3 + neighbours;
+        for (int64_t piece = p->pieces->start[key - 1]; piece < p->pieces->start[key]; piece++) {
+            if (p->pieces->distance[piece] > farthest) {
+                break;
+            }
+            int64_t row = top + step * p->pieces->distance[piece];
+            if (first_row <= row && row < end_row) {
+                raise_span(out + row * cols, cols, left + p->pieces->from[piece], left + p->pieces->to[piece], radius);
+            }
+        }
+    }
+    const Array *free_mask = p->free_mask;
+    const uint8_t *free_data = free_mask->data;
+    for (int64_t row = first_row; row < end_row; row++) {
+        const uint8_t *free_row = free_data + row * free_mask->row_stride;
+        for (int64_t col = 0; col < cols; col++) {
+            if (free_row[col * free_mask->col_stride] == 0) {
+                out[row * cols + col] = 0;
+            }
+        }
+    }
+}
+
+static void *paint_band_run(void *arg)
+{
+    Band *band = arg;
+    paint_band(band->painting, band->first_row, band->end_row);
+    return NULL;
+}
+
 static int paint(const int64_t *shapes, int64_t n, const Array *free_mask, int32_t *out, int64_t rows, int64_t cols)
 {
-    const uint8_t *free_data = free_mask->data;
     int64_t reach_cap = rows + cols;
     int64_t trimmed_reach_limit = TRIMMED_REACH_LIMIT < reach_cap ? TRIMMED_REACH_LIMIT : reach_cap;
     int64_t largest_trimmed = -1;
@@ -207,51 +292,26 @@ static int paint(const int64_t *shapes, int64_t n, const Array *free_mask, int32
     }
     Pieces pieces = {0};
     int failed = uncovered_pieces(largest_trimmed, &pieces);
-    for (int64_t i = 0; i < n && !failed; i++) {
-        const int64_t *shape = shapes + 6 * i;
-        int64_t radius = shape[RADIUS];
-        int64_t reach = radius - 1 < reach_cap ? radius - 1 : reach_cap;
-        int64_t top = shape[TOP] - 1, bottom = shape[BOTTOM] - 1, left = shape[LEFT] - 1, right = shape[RIGHT] - 1;
-        int64_t diagonals = reach < trimmed_reach_limit ? shape[DIAGONALS] : 0;
-        if (diagonals == 0) {
-            int64_t width = 0;
-            for (int64_t row = top - reach; row <= bottom + reach; row++) {
-                int64_t d = top - row > row - bottom ? top - row : row - bottom;
-                d = d > 0 ? d : 0;
-                while ((width + 1) * (width + 1) + d * d <= reach * reach) {
-                    width += 1;
-                }
-                while (width * width + d * d > reach * reach) {
-                    width -= 1;
-                }
-                if (0 <= row && row < rows) {
-                    raise_span(out + row * cols, cols, left - width, right + width, radius);
-                }
-            }
-            continue;
-        }
-        int below = (diagonals & BELOW) != 0;
-        int64_t step = below ? -1 : 1;
-        int64_t neighbours = below ? diagonals >> 2 : diagonals & ABOVE;
-        int64_t farthest = ((diagonals & ABOVE) && below) ? 0 : reach;
-        int64_t key = reach * 3 + neighbours;
-        for (int64_t piece = pieces.start[key - 1]; piece < pieces.start[key]; piece++) {
-            if (pieces.distance[piece] > farthest) {
-                break;
-            }
-            int64_t row = top + step * pieces.distance[piece];
-            if (0 <= row && row < rows) {
-                raise_span(out + row * cols, cols, left + pieces.from[piece], left + pieces.to[piece], radius);
-            }
-        }
-    }
     if (!failed) {
-        for (int64_t row = 0; row < rows; row++) {
-            const uint8_t *free_row = free_data + row * free_mask->row_stride;
-            for (int64_t col = 0; col < cols; col++) {
-                if (free_row[col * free_mask->col_stride] == 0) {
-                    out[row * cols + col] = 0;
-                }
+        Painting painting = {shapes, n, rows, cols, reach_cap, trimmed_reach_limit, &pieces, free_mask, out};
+        /* Large images are painted in bands of rows, one thread each (the bands write
+         * different rows); smaller ones on this thread, where starting threads costs more. */
+        int64_t n_bands = rows * cols >= BAND_MIN_PIXELS ? usable_cpus() : 1;
+        n_bands = n_bands < MAX_BANDS ? n_bands : MAX_BANDS;
+        n_bands = n_bands < rows ? n_bands : (rows > 0 ? rows : 1);
+        Band bands[MAX_BANDS];
+        for (int64_t k = 0; k < n_bands; k++) {
+            bands[k] = (Band){&painting, rows * k / n_bands, rows * (k + 1) / n_bands, 0, 0};
+        }
+        for (int64_t k = 1; k < n_bands; k++) {
+            bands[k].running = pthread_create(&bands[k].thread, NULL, paint_band_run, &bands[k]) == 0;
+        }
+        paint_band(&painting, bands[0].first_row, bands[0].end_row);
+        for (int64_t k = 1; k < n_bands; k++) {
+            if (bands[k].running) {
+                pthread_join(bands[k].thread, NULL);
+            } else {
+                paint_band(&painting, bands[k].first_row, bands[k].end_row); /* no thread: here */
             }
         }
     }
