@@ -42,7 +42,7 @@ def remove_small_zones(graph: ZoneGraph, *, min_size: int) -> ZoneGraph:
     compact = graph._run_compiled()
     # int32 from the start: np.where of an arange went through two int64 arrays of one entry per
     # zone (6.5 million at 8000 px), and at that size fresh memory costs as much as the loop.
-    parent = np.arange(len(graph._value), dtype=np.int32)
+    parent = np.arange(len(graph._value_array), dtype=np.int32)
     parent[~graph._alive] = 0
     kernels().remove_small_zones(int(min_size), graph._size, graph._alive, parent, compact)
     kernels().resolve_parents(parent, graph._alive)

@@ -121,25 +121,40 @@ class ZoneGraph:
         values = np.asarray(values)
         if zones.shape != values.shape or zones.ndim != 2:
             raise SegmentationError(f"zones {zones.shape} and values {values.shape} must be 2-D of equal shape")
-        self.shape = zones.shape
         zones = zones.astype(np.int32, copy=False)
-        count = int(zones.max(initial=0))
-        value, self._size = kernels().zone_values_and_sizes(zones, values, count + 1)
+        value, size = kernels().zone_values_and_sizes(zones, values, int(zones.max(initial=0)) + 1)
+        self._set_up(zones, value, size, _storage)
+
+    @classmethod
+    def _of_zone_values(cls, zones: np.ndarray, value: np.ndarray, size: np.ndarray, *, storage) -> ZoneGraph:
+        """The graph of C-ordered int32 ``zones`` whose values and sizes the caller took
+        (``zone_values_and_sizes``): the value image can go before the graph is built, the
+        step of the peak memory (64 MB at 8000 px, touched afresh otherwise)."""
+        graph = cls.__new__(cls)
+        graph._set_up(zones, value, size, storage)
+        return graph
+
+    def _set_up(self, zones: np.ndarray, value: np.ndarray, size: np.ndarray, storage: np.ndarray | None) -> None:
+        self.shape = zones.shape
+        self._size = size
         self._value_array = value
-        self._value: list[int] = value.tolist()
+        # Values of the zones read one by one (the steps on dicts): filled as they are asked
+        # for. A list of all of them was 52 MB of fresh memory at 8000 px, for a few hundred.
+        self._value: dict[int, int] = {}
         # The adjacency lives either in compact arrays (the compiled steps'
         # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
         self._alive = self._size > 0
         self._alive[0] = False
         self._compact: tuple | None = kernels().build_adjacency(zones, value)
-        self._labels = np.pad(zones, _PAD) if _storage is None else _pad_in_place(zones, _storage)
+        self._labels = np.pad(zones, _PAD) if storage is None else _pad_in_place(zones, storage)
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         # Contact counts, computed for the whole image when first queried and
         # dropped by the next fusion (the compiled steps track their own).
         self._contacts: dict[int, int] | None = None
         # Fusions not yet written into the label image: zone -> receiver (0 = deleted).
         self._pending: dict[int, int] = {}
-        self._identity = np.arange(count + 1, dtype=np.int32)
+        # The lookup of _flush, made at its first flush (one entry per zone).
+        self._identity: np.ndarray | None = None
 
     @property
     def adj(self) -> dict[int, dict[int, ZoneEdge | None]]:
@@ -178,7 +193,7 @@ class ZoneGraph:
             zone, other, minimum = (np.array(column, np.int32) for column in columns[:3])
             unbreakable = np.array(columns[3], bool)
             self._compact = _adjacency_from_entries(zone, other, minimum, unbreakable, self._value_array)
-            self._alive = np.zeros(len(self._value), bool)
+            self._alive = np.zeros(len(self._value_array), bool)
             self._alive[list(self._adj)] = True
             self._adj = None
         return self._compact
@@ -219,7 +234,10 @@ class ZoneGraph:
 
     def value(self, zone: int) -> int:
         """Quantised value of a zone (it keeps it when other zones are fused into it)."""
-        return self._value[zone]
+        known = self._value.get(zone)
+        if known is None:
+            known = self._value[zone] = int(self._value_array[zone])
+        return known
 
     def size(self, zone: int) -> int:
         """Number of pixels of a zone."""
@@ -242,7 +260,7 @@ class ZoneGraph:
         Faster than repeated :meth:`contact_percent` calls for one zone.
         """
         contacts = self._ensure_contacts()
-        key = zone * len(self._value)
+        key = zone * len(self._value_array)
         total = contacts.get(key, 0)
         if total == 0:
             return lambda other: 0
@@ -263,8 +281,8 @@ class ZoneGraph:
         self._flush()
         zones = np.array(self.vertices(), np.int64)
         # The padding adds no labels, so raster order in it is raster order in the map.
-        first = kernels().first_pixels(self._labels, len(self._value))[zones]
-        lookup = np.zeros(len(self._value), np.int32)
+        first = kernels().first_pixels(self._labels, len(self._value_array))[zones]
+        lookup = np.zeros(len(self._value_array), np.int32)
         lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
         return lookup
 
@@ -291,6 +309,8 @@ class ZoneGraph:
         zones = np.fromiter(pending.keys(), np.int64, len(pending))
         # A persistent identity lookup, patched for this flush: allocating one per
         # flush would cost O(zones) each time.
+        if self._identity is None:
+            self._identity = np.arange(len(self._value_array), dtype=np.int32)
         parent = self._identity
         parent[zones] = np.fromiter(pending.values(), np.int64, len(pending))
         # Follow chains z -> b -> c so every pending zone maps to its final
@@ -311,10 +331,10 @@ class ZoneGraph:
         # 3x3 neighbourhood (b >= 1), and the contour size of a (b = 0).
         if self._contacts is None:
             self._flush()
-            alive = np.zeros(len(self._value), bool)
+            alive = np.zeros(len(self._value_array), bool)
             alive[self.vertices()] = True
             table = kernels().contact_table(self._labels.ravel(), self._labels.shape[1], alive)
-            codes = table[:, 0] * len(self._value) + table[:, 1]
+            codes = table[:, 0] * len(self._value_array) + table[:, 1]
             self._contacts = dict(zip(codes.tolist(), table[:, 2].tolist()))
         return self._contacts
 
@@ -342,7 +362,7 @@ class ZoneGraph:
         self._pending[zone] = into
         self._contacts = None
         self._size[into] += self._size[zone]
-        zone_value = self._value[zone]
+        zone_value = self.value(zone)
         adj = self.adj
         target = adj[into]
         for neighbour, old in adj.pop(zone).items():
