@@ -26,6 +26,7 @@ from ursim_core.segmentation.maoris.steps import (
     remove_small_zones,
     watershed_merge,
 )
+from ursim_core.segmentation.maoris.warm_memory import warm_memory
 from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, flat_zones
 
 __all__ = ["maoris_labels", "compile_kernels"]
@@ -71,6 +72,8 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
         return np.zeros(shape, np.int32)
     free = free[window]
     free_shape = free.shape
+    # The zone graph's memory is faulted in on a second thread meanwhile (see .warm_memory).
+    warming = warm_memory(free)
     # The window is its own bounding box: the radii of inscribed_circle_radii(free).
     radii, storage = _radii_in_storage(free, params.max_radius, padding=_PAD)
     values = _quantized_radii(radii, params.quantum)
@@ -83,6 +86,8 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     # on the virtual machines this was measured on, memory touched for the first time cost
     # 1-2.5 s per GB (the host backs each page on its first touch), against 0.07 s to reuse it.
     del values, free, radii
+    if warming is not None:
+        warming.release()
     graph = ZoneGraph._of_zone_values(zones, value, size, storage=storage)
     del zones, storage
     remove_small_zones(graph, min_size=params.small_before)
