@@ -160,7 +160,18 @@ def test_every_c_kernel_gives_numba_results_and_leaves_its_arguments_alike(c_mod
     the test) rather than on their raw arrays."""
     import copy
 
-    from ursim_core.segmentation.maoris import PRESETS, compiled, contact_tracking, maoris_labels
+    from ursim_core.segmentation.maoris import (
+        PRESETS,
+        ZoneGraph,
+        compiled,
+        contact_tracking,
+        flat_zones,
+        inscribed_circle_image,
+        maoris_labels,
+        merge_ripples,
+        quantize,
+        remove_small_zones,
+    )
     from ursim_core.segmentation.watershed import watershed_labels
     from ursim_core.synth import make_large_building
 
@@ -197,6 +208,9 @@ def test_every_c_kernel_gives_numba_results_and_leaves_its_arguments_alike(c_mod
             for preset in ("default", "sketch", "robot"):
                 maoris_labels(free, PRESETS[preset])
             watershed_labels(free, min_size=0, door_ratio=1.0)
+            # The step on its own keeps the zone ids (expand_graph); maoris_labels renumbers.
+            values = quantize(inscribed_circle_image(free))
+            merge_ripples(remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=10))
         monkeypatch.setattr(contact_tracking, "_BAND_PIXELS", 0)
         monkeypatch.setattr(contact_tracking, "_usable_cpus", lambda: 3)
         labels = maoris_labels(maps[1], PRESETS["robot"])

@@ -65,7 +65,14 @@ def jit_kernels(monkeypatch):
 
 def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit_kernels):
     from ursim_core.segmentation.flooding import watershed_flood
-    from ursim_core.segmentation.maoris import ZoneGraph, contact_tracking, flat_zones, maoris_labels, quantize
+    from ursim_core.segmentation.maoris import (
+        ZoneGraph,
+        contact_tracking,
+        flat_zones,
+        maoris_labels,
+        merge_ripples,
+        quantize,
+    )
     from ursim_core.segmentation.maoris.kernels import signatures
     from ursim_core.segmentation.watershed import watershed_labels
     from ursim_core.synth import make_large_building
@@ -77,6 +84,7 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
     maoris_labels(free)
     values = quantize(np.where(free, 100, 0).astype(np.uint8))
     ZoneGraph(flat_zones(values), values).contact_percent(1, 2)  # contact_table
+    merge_ripples(ZoneGraph(flat_zones(values), values))  # expand_graph: the step on its own keeps the ids
     flat_zones(np.array([[5, 5, 0], [0, 5, 7]]))  # another dtype goes through the one signature too
     watershed_labels(free)  # the flooding kernels of the watershed segmenter
     watershed_flood(np.arange(6.0).reshape(2, 3), np.array([[1, 0, 0], [0, 0, 2]]), connectivity=2)

@@ -333,6 +333,39 @@ def test_ripple_is_fused_into_its_base():
     assert graph.vertices() == [1] and graph.value(1) == 200
 
 
+def test_renumbering_after_the_ripples_changes_ids_only():
+    # The pipeline renumbers the zones that enter ripple merging 1..n in id order, so the zones
+    # left keep their order under smaller ids: every later step sees the same graph up to the
+    # ids, and must decide alike.
+    from ursim_core.segmentation.maoris.inscribed_circle import _quantized_radii
+    from ursim_core.synth import make_large_building
+
+    free = make_large_building(400, seed=6).free
+    values = _quantized_radii(inscribed_circle_radii(free), 5)
+    graphs = []
+    for renumber in (False, True):
+        graph = remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=10)
+        graphs.append(merge_ripples(graph, ripples=40, _renumber=renumber))
+    kept, renumbered = graphs
+    old_ids = kept.vertices()
+    new_ids = renumbered.vertices()
+    assert len(new_ids) == len(old_ids) > 5 and all(new <= old for new, old in zip(new_ids, old_ids))
+    assert len(renumbered._value_array) < len(kept._value_array) / 5  # the arrays shrank
+    new_of = dict(zip(old_ids, new_ids))
+    np.testing.assert_array_equal(renumbered.label_image(), kept.label_image())
+    for old in old_ids:
+        new = new_of[old]
+        assert renumbered.neighbours(new) == [new_of[n] for n in kept.neighbours(old)]
+        assert renumbered.value(new) == kept.value(old) and renumbered.size(new) == kept.size(old)
+        for other in kept.neighbours(old):
+            edge, renumbered_edge = kept.edge(old, other), renumbered.edge(new, new_of[other])
+            assert (edge.minimum, edge.unbreakable) == (renumbered_edge.minimum, renumbered_edge.unbreakable)
+    for graph in graphs:  # and the steps after decide alike
+        watershed_merge(mark_unbreakable_edges(graph, threshold=0.5), threshold=0.5)
+        remove_small_zones(remove_doors(graph, doors=40), min_size=100)
+    np.testing.assert_array_equal(renumbered.label_image(), kept.label_image())
+
+
 def test_ripple_test_has_no_value_condition():
     # As in the C++, a zone whose contour lies on a lower ring is that ring's ripple.
     values = np.full((9, 9), 100, np.uint8)

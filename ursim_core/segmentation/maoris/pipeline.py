@@ -91,7 +91,7 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     graph = ZoneGraph._of_zone_values(zones, value, size, storage=storage)
     del zones, storage
     remove_small_zones(graph, min_size=params.small_before)
-    merge_ripples(graph, ripples=params.ripples)
+    merge_ripples(graph, ripples=params.ripples, _renumber=True)
     mark_unbreakable_edges(graph, threshold=params.threshold)
     watershed_merge(graph, threshold=params.threshold, margin=params.margin)
     remove_doors(graph, doors=params.doors)

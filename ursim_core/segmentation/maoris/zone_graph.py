@@ -299,6 +299,18 @@ class ZoneGraph:
             return out
         return _unpad_in_place(self._labels)
 
+    def _renumbered(self, original: np.ndarray, size: np.ndarray, alive: np.ndarray, compact: tuple) -> None:
+        """Become the graph of zones renumbered 1..n (zone k was ``original[k - 1]``, in
+        increasing order), with the labels already so renumbered, their sizes ``size``,
+        ``alive`` and adjacency ``compact`` indexed by the new ids (see :func:`.steps.merge_ripples`)."""
+        if self._pending or self._adj is not None:
+            raise SegmentationError("only a compact graph with no pending fusion can be renumbered")
+        value = np.zeros(len(original) + 1, np.int32)
+        value[1:] = self._value_array[original]
+        self._value_array, self._value = value, {}
+        self._size, self._alive, self._compact = size, alive, compact
+        self._contacts, self._identity = None, None
+
     # -- contacts and relabelling -------------------------------------------
 
     def _flush(self) -> None:
