@@ -35,8 +35,26 @@ def test_small_maps_warm_nothing_and_large_ones_touch_every_page_of_their_block(
     warming._thread.join()
     assert warming.block.size == warm_module.warm_bytes(free) > 0
     assert (warming.block[:: warm_module.mmap.PAGESIZE] == 1).all()
+    assert warming.touched == warming.block.size
     warming.release()
     assert warming.block is None and not warming._thread.is_alive()
+
+
+def test_a_release_stops_the_touching_at_the_next_chunk(monkeypatch):
+    import time
+
+    made = []
+
+    def slow_to_size(free):  # the touching starts only once the release has asked it to stop
+        while not made:
+            time.sleep(0.001)
+        made[0]._stop.wait()
+        return 64 * warm_module.CHUNK_BYTES
+
+    monkeypatch.setattr(warm_module, "warm_bytes", slow_to_size)
+    made.append(warm_module.Warming(np.ones((50, 50), bool)))
+    made[0].release()
+    assert made[0].touched == 0 and made[0].block is None and not made[0]._thread.is_alive()
 
 
 def test_a_block_that_cannot_be_had_leaves_nothing_warmed(monkeypatch):

@@ -68,8 +68,8 @@ def merge_ripples(graph: ZoneGraph, *, ripples: float = 40, _renumber: bool = Fa
     1
 
     ``_renumber`` (private, :func:`~ursim_core.segmentation.maoris.maoris_labels`): the zones
-    left are renumbered 1..n in the order of their ids (every later order, hence the labels,
-    unchanged). The steps after this one then work on arrays of the few hundred thousand zones
+    that enter the step are renumbered 1..n in the order of their ids, so the zones left keep
+    their order under new ids (every later order, hence the labels, unchanged). The steps after this one then work on arrays of the few hundred thousand zones
     that entered it rather than of the millions of flat zones (at 8000 x 8000 px, 6.5 million:
     150 MB of arrays no longer made).
     """

@@ -23,6 +23,7 @@ import threading
 import numpy as np
 
 __all__ = [
+    "CHUNK_BYTES",
     "WARM_MIN_PIXELS",
     "BYTES_PER_ZONE",
     "ZONES_PER_BORDER",
@@ -46,6 +47,9 @@ BYTES_PER_ZONE = 88
 #: scans, whose walls are smooth, 0.3-1). The number of flat zones is not known before they are
 #: labelled, by which time it is too late to warm anything; their borders are counted at once.
 ZONES_PER_BORDER = 3
+
+#: Bytes touched between two looks at whether the block is still wanted.
+CHUNK_BYTES = 8 << 20
 
 #: The most bytes warmed per pixel: a building's robot map, with 0.1 flat zones per pixel,
 #: needs about 8.8 (at 12 per pixel the peak memory grew by 210 MB at 8000 x 8000 px).
@@ -94,22 +98,30 @@ class Warming:
 
     def __init__(self, free: np.ndarray):
         self.block: np.ndarray | None = None
+        self.touched = 0  # bytes of the block faulted in so far
+        self._stop = threading.Event()
         self._thread = threading.Thread(target=self._touch, args=(free,), daemon=True)
         self._thread.start()
 
     def _touch(self, free: np.ndarray) -> None:
         nbytes = warm_bytes(free)
         try:
-            block = np.empty(max(nbytes, 1), np.uint8)
+            self.block = np.empty(max(nbytes, 1), np.uint8)
         except MemoryError:
             return
         # One write per page faults it in (numpy asks for huge pages for a block this large,
-        # so most writes land in pages already there); numpy releases the GIL meanwhile.
-        block[:: mmap.PAGESIZE] = 1
-        self.block = block
+        # so most writes land in pages already there); numpy releases the GIL meanwhile. In
+        # chunks, so that a release need not wait for the whole block.
+        for start in range(0, nbytes, CHUNK_BYTES):
+            if self._stop.is_set():
+                return
+            self.block[start : start + CHUNK_BYTES : mmap.PAGESIZE] = 1
+            self.touched = min(start + CHUNK_BYTES, nbytes)
 
     def release(self) -> None:
-        """Wait for the touching to end, then free the block."""
+        """Stop the touching (after the chunk under way) and free the block: what was not
+        touched by then faults in where it is used, as it would have without warming."""
+        self._stop.set()
         self._thread.join()
         self.block = None
 

@@ -140,7 +140,7 @@ class ZoneGraph:
         self._value_array = value
         # Values of the zones read one by one (the steps on dicts): filled as they are asked
         # for. A list of all of them was 52 MB of fresh memory at 8000 px, for a few hundred.
-        self._value: dict[int, int] = {}
+        self._values_read: dict[int, int] = {}
         # The adjacency lives either in compact arrays (the compiled steps'
         # form, cheap for millions of zones) or in `_adj` dicts (see `adj`).
         self._alive = self._size > 0
@@ -234,9 +234,9 @@ class ZoneGraph:
 
     def value(self, zone: int) -> int:
         """Quantised value of a zone (it keeps it when other zones are fused into it)."""
-        known = self._value.get(zone)
+        known = self._values_read.get(zone)
         if known is None:
-            known = self._value[zone] = int(self._value_array[zone])
+            known = self._values_read[zone] = int(self._value_array[zone])
         return known
 
     def size(self, zone: int) -> int:
@@ -307,7 +307,7 @@ class ZoneGraph:
             raise SegmentationError("only a compact graph with no pending fusion can be renumbered")
         value = np.zeros(len(original) + 1, np.int32)
         value[1:] = self._value_array[original]
-        self._value_array, self._value = value, {}
+        self._value_array, self._values_read = value, {}
         self._size, self._alive, self._compact = size, alive, compact
         self._contacts, self._identity = None, None
 
