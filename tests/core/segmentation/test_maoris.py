@@ -500,19 +500,41 @@ def test_a_map_reaching_its_border_is_labelled_alike_in_the_graphs_memory():
     np.testing.assert_array_equal(maoris_labels(bigger)[3:-3, 4:-5], labels)
 
 
-@pytest.mark.parametrize("shape", [(1, 1), (1, 9), (7, 1), (13, 8)])
-def test_unpadding_in_place_inverts_padding_in_place(shape):
-    from ursim_core.segmentation.maoris.zone_graph import _PAD, _pad_in_place, _unpad_in_place
+@pytest.mark.parametrize(
+    ("zones_shape", "shape", "origin"),
+    [
+        ((1, 1), (1, 1), (0, 0)),
+        ((13, 8), (13, 8), (0, 0)),  # the window is the image
+        ((13, 8), (20, 9), (5, 1)),  # narrower than the padded labels, a tall top margin
+        ((13, 8), (14, 30), (0, 20)),  # much wider: every row moves on
+        ((40, 30), (45, 33), (2, 1)),  # rows moving back, then rows moving on
+        ((7, 1), (9, 12), (1, 11)),
+        ((1, 9), (3, 10), (2, 0)),
+    ],
+)
+def test_labels_placed_in_place_are_the_labels_in_a_fresh_image(zones_shape, shape, origin):
+    from ursim_core.segmentation.maoris.zone_graph import _PAD, _pad_in_place, _place_in_place
 
-    rng = np.random.default_rng(sum(shape))
-    zones = rng.integers(1, 50, shape).astype(np.int32)
-    storage = np.full((shape[0] + 2 * _PAD) * (shape[1] + 2 * _PAD), -1, np.int32)
+    rng = np.random.default_rng(sum(zones_shape) + sum(shape))
+    zones = rng.integers(1, 50, zones_shape).astype(np.int32)
+    padded_size = (zones_shape[0] + 2 * _PAD) * (zones_shape[1] + 2 * _PAD)
+    storage = np.full(max(padded_size, shape[0] * shape[1]) + 3, -1, np.int32)
     storage[: zones.size] = zones.ravel()
-    padded = _pad_in_place(storage[: zones.size].reshape(shape), storage)
+    padded = _pad_in_place(storage[: zones.size].reshape(zones_shape), storage)
     np.testing.assert_array_equal(padded, np.pad(zones, _PAD))
-    unpadded = _unpad_in_place(padded)
-    np.testing.assert_array_equal(unpadded, zones)
-    assert unpadded.flags.c_contiguous and np.shares_memory(unpadded, storage)
+    want = np.zeros(shape, np.int32)
+    want[origin[0] : origin[0] + zones_shape[0], origin[1] : origin[1] + zones_shape[1]] = zones
+    placed = _place_in_place(padded, storage, shape, origin)
+    np.testing.assert_array_equal(placed, want)
+    assert placed.flags.c_contiguous and np.shares_memory(placed, storage)
+
+
+def test_labels_that_do_not_fit_are_refused():
+    from ursim_core.segmentation.maoris.zone_graph import _place_in_place
+
+    storage = np.zeros(100, np.int32)
+    with pytest.raises(SegmentationError, match="do not fit"):
+        _place_in_place(storage[:36].reshape(6, 6), storage, (5, 5), (4, 0))
 
 
 def test_empty_map_gives_no_region():

@@ -91,16 +91,19 @@ def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:
     return _radii_in_storage(free, max_radius, padding=0)[0]
 
 
-def _radii_in_storage(free: np.ndarray, max_radius: int, *, padding: int) -> tuple[np.ndarray, np.ndarray]:
+def _radii_in_storage(
+    free: np.ndarray, max_radius: int, *, padding: int, size: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
     """The radii of :func:`inscribed_circle_radii` for a ``free`` window (its bounding box
     plus margin), and the int32 storage they are the first pixels of, with room for the
     image padded by ``padding`` on every side (:class:`~.zone_graph.ZoneGraph` pads its
-    labels in it: at 8000 px each fresh 256 MB image costs 0.15-0.6 s of page faults)."""
+    labels in it: at 8000 px each fresh 256 MB image costs 0.15-0.6 s of page faults), and
+    at least ``size`` pixels (the segmentation makes its output there too)."""
     # Cropping to the free pixels' bounding box plus a 1-pixel obstacle margin
     # leaves the distance transform unchanged (the margin is obstacle, and the
     # image border is kept where the box touches it).
     rows, cols = free.shape
-    storage = np.empty((rows + 2 * padding) * (cols + 2 * padding), np.float32)
+    storage = np.empty(max((rows + 2 * padding) * (cols + 2 * padding), size), np.float32)
     dist = storage[: rows * cols].reshape(rows, cols)
     cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE, dst=dist)
     # Radii are int32 (as the output); a larger cap only matters without any obstacle.

@@ -31,6 +31,10 @@ from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, flat_zone
 
 __all__ = ["maoris_labels", "compile_kernels"]
 
+#: The output is made in the zone graph's memory when that memory need grow by at most this
+#: factor to hold it (maps whose border around the free space is thin; 1.02 at 8000 px).
+OUTPUT_IN_STORAGE_GROWTH = 1.25
+
 
 def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -> np.ndarray:
     """Segment a free-space mask into rooms with MAORIS.
@@ -71,11 +75,18 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
-    free_shape = free.shape
+    # When the map's border around its free space is thin, the output is made in the memory of
+    # the zone graph's labels, grown to hold it (a few % at 8000 px), rather than in a fresh
+    # image: see ZoneGraph._label_image_in_storage. A wide border is mostly zeros, which a fresh
+    # image gives for free.
+    padded_size = (free.shape[0] + 2 * _PAD) * (free.shape[1] + 2 * _PAD)
+    in_storage = shape[0] * shape[1] <= OUTPUT_IN_STORAGE_GROWTH * padded_size
     # The zone graph's memory is faulted in on a second thread meanwhile (see .warm_memory).
     warming = warm_memory(free)
     # The window is its own bounding box: the radii of inscribed_circle_radii(free).
-    radii, storage = _radii_in_storage(free, params.max_radius, padding=_PAD)
+    radii, storage = _radii_in_storage(
+        free, params.max_radius, padding=_PAD, size=shape[0] * shape[1] if in_storage else 0
+    )
     values = _quantized_radii(radii, params.quantum)
     # The zones are labelled over the radii, read only for the values, and the graph pads
     # them in place (a fresh image of that size costs more in page faults than the pass).
@@ -97,10 +108,9 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     remove_doors(graph, doors=params.doors)
     remove_small_zones(graph, min_size=params.small_after)
     remove_isolated_zones(graph)
-    if free_shape == shape:
-        # The window is the whole map (a map that reaches its border): the graph's memory
-        # becomes the output, sparing a fresh full-size image (256 MB at 8000 px).
-        return graph._write_label_image()
+    labels = graph._label_image_in_storage(shape, (window[0].start, window[1].start)) if in_storage else None
+    if labels is not None:
+        return labels
     labels = np.zeros(shape, np.int32)
     graph._write_label_image(labels[window])
     return labels

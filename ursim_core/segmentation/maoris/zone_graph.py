@@ -147,6 +147,7 @@ class ZoneGraph:
         self._alive[0] = False
         self._compact: tuple | None = kernels().build_adjacency(zones, value)
         self._labels = np.pad(zones, _PAD) if storage is None else _pad_in_place(zones, storage)
+        self._storage = storage  # the memory the labels are padded in, if given
         self._adj: dict[int, dict[int, ZoneEdge | None]] | None = None
         # Contact counts, computed for the whole image when first queried and
         # dropped by the next fusion (the compiled steps track their own).
@@ -286,18 +287,23 @@ class ZoneGraph:
         lookup[zones[np.argsort(first, kind="stable")]] = np.arange(1, len(zones) + 1, dtype=np.int32)
         return lookup
 
-    def _write_label_image(self, out: np.ndarray | None = None) -> np.ndarray:
+    def _write_label_image(self, out: np.ndarray) -> None:
         """Write :meth:`label_image` into ``out`` (shape ``self.shape``, any strides), renumbering
         the graph's own labels in place: the graph must not be used afterwards. At 8000 px this
-        spares a fresh 256 MB image (its page faults cost more than the pass).
-
-        With no ``out``, the label image is made in the graph's own memory, its padding
-        squeezed out in place, and returned (C-ordered): no image is allocated at all."""
+        spares a fresh 256 MB image (its page faults cost more than the pass)."""
         kernels().relabel(self._labels.ravel(), self._renumbering())
-        if out is not None:
-            out[...] = self._labels[_PAD:-_PAD, _PAD:-_PAD]
-            return out
-        return _unpad_in_place(self._labels)
+        out[...] = self._labels[_PAD:-_PAD, _PAD:-_PAD]
+
+    def _label_image_in_storage(self, shape: tuple[int, int], origin: tuple[int, int]) -> np.ndarray | None:
+        """:meth:`label_image` placed at ``origin`` (row, col) of an image of ``shape``, zeros
+        elsewhere, made in the graph's own memory, or None when that memory cannot hold
+        ``shape`` (then use :meth:`_write_label_image`). The graph must not be used afterwards.
+        No image is allocated: at 8000 px a fresh one, 256 MB, cost 0.4-0.5 s of page faults."""
+        storage = self._storage
+        if storage is None or storage.size < shape[0] * shape[1]:
+            return None
+        kernels().relabel(self._labels.ravel(), self._renumbering())
+        return _place_in_place(self._labels, storage, shape, origin)
 
     def _renumbered(self, original: np.ndarray, size: np.ndarray, alive: np.ndarray, compact: tuple) -> None:
         """Become the graph of zones renumbered 1..n (zone k was ``original[k - 1]``, in
@@ -417,16 +423,35 @@ def _pad_in_place(zones: np.ndarray, storage: np.ndarray) -> np.ndarray:
     return padded
 
 
-def _unpad_in_place(padded: np.ndarray) -> np.ndarray:
-    """The inverse of :func:`_pad_in_place`: ``padded[_PAD:-_PAD, _PAD:-_PAD]`` moved to the first
-    pixels of ``padded``'s memory (C-ordered), which it returns as an image."""
+def _place_in_place(padded: np.ndarray, storage: np.ndarray, shape: tuple[int, int], origin: tuple[int, int]):
+    """``padded[_PAD:-_PAD, _PAD:-_PAD]`` placed at ``origin`` of a C-ordered image of ``shape``
+    (zeros elsewhere) made in the first pixels of ``storage``, the memory ``padded`` starts.
+
+    Row i moves from P(i) to D(i), both increasing with i, and rows are shorter than the
+    distance between two P or two D. The rows that move back (D < P) go first, in increasing
+    order: each lands before its own source, so before every source still to read. The rows
+    that move on then go in decreasing order: each lands after its own source, so after every
+    source still to read. The zeros go last, around the placed rows."""
     rows, cols = padded.shape[0] - 2 * _PAD, padded.shape[1] - 2 * _PAD
-    flat = padded.reshape(-1)
-    # First row first: each row moves to an earlier place than any row below it starts from
-    # (row r's place ends at (r + 1) * cols, row r + 1 starts at (r + 3) * (cols + 4) + 2).
-    for row in range(rows):
-        flat[row * cols : (row + 1) * cols] = padded[row + _PAD, _PAD : _PAD + cols]
-    return flat[: rows * cols].reshape(rows, cols)
+    height, width = shape
+    top, left = origin
+    if padded.ctypes.data != storage.ctypes.data or not padded.flags.c_contiguous:
+        raise SegmentationError("the padded labels must be the first pixels of their storage")
+    if top < 0 or left < 0 or top + rows > height or left + cols > width:
+        raise SegmentationError(f"labels of {rows}x{cols} do not fit at {origin} in {shape}")
+    flat = storage
+    source = [(row + _PAD) * (cols + 2 * _PAD) + _PAD for row in range(rows)]
+    target = [(top + row) * width + left for row in range(rows)]
+    back = [row for row in range(rows) if target[row] < source[row]]
+    on = [row for row in range(rows) if target[row] >= source[row]]
+    for row in back + on[::-1]:
+        # numpy copies through a buffer when a row overlaps its own place
+        flat[target[row] : target[row] + cols] = flat[source[row] : source[row] + cols]
+    ends = [0] + [start + cols for start in target]
+    starts = target + [height * width]
+    for end, start in zip(ends, starts):
+        flat[end:start] = 0
+    return flat[: height * width].reshape(height, width)
 
 
 def _adjacency_from_entries(zone, other, minimum, unbreakable, value):
