@@ -212,6 +212,21 @@ def test_normalisation_of_integer_images_matches_opencv_on_floats(dtype, lo, hi)
         np.testing.assert_array_equal(quantize(as_float, quantum=quantum), rounded)
 
 
+@pytest.mark.parametrize("dtype", [np.uint8, np.int32, np.uint16])
+def test_quantize_and_normalise_leave_their_input_alone(dtype):
+    # The lookup writes its result over its own 8-bit temporary, never over the caller's image.
+    values = (np.arange(240).reshape(12, 20) % 200).astype(dtype)
+    kept = values.copy()
+    quantized = quantize(values)
+    np.testing.assert_array_equal(values, kept)
+    assert not np.shares_memory(quantized, values)
+    from ursim_core.segmentation.maoris.inscribed_circle import _normalise_to_uint8, _quantized_radii
+
+    for result in (_normalise_to_uint8(values), _quantized_radii(values, 5)):
+        np.testing.assert_array_equal(values, kept)
+        assert not np.shares_memory(result, values)
+
+
 def test_quantize_rejects_bad_quantum():
     with pytest.raises(ParameterError, match="quantum"):
         quantize(np.zeros((2, 2), np.uint8), quantum=0)

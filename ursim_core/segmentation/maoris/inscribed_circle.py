@@ -142,7 +142,12 @@ def _by_lookup(values: np.ndarray, function) -> np.ndarray:
     table = function(np.arange(lo, hi + 1, dtype=values.dtype)[None, :])[0]
     offsets = values - lo if lo else values
     if hi - lo <= 255:  # cv2.LUT takes 8-bit indices, and is several times faster than numpy
-        return cv2.LUT(offsets.astype(np.uint8, copy=False), np.pad(table, (0, 255 - (hi - lo))))
+        indices = offsets.astype(np.uint8, copy=False)
+        lut = np.pad(table, (0, 255 - (hi - lo)))
+        if np.shares_memory(indices, values):  # the caller's image: the result is a new one
+            return cv2.LUT(indices, lut)
+        # Our own temporary takes the result: one fresh image fewer (64 MB at 8000 px).
+        return cv2.LUT(indices, lut, dst=indices)
     return table[offsets]
 
 
