@@ -19,11 +19,11 @@ import pytest
 from ursim_core.cli import main
 
 
-def two_rooms(path: Path) -> Path:
+def two_rooms(path: Path, *, door: bool = True) -> Path:
     image = np.zeros((80, 170), np.uint8)
     image[5:75, 5:80] = 255
     image[5:75, 90:165] = 255
-    image[35:45, 80:90] = 255
+    image[35:45, 80:90] = 255 if door else 0
     path.parent.mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(path), image)
     return path
@@ -44,6 +44,7 @@ def _dat(path: Path) -> Path:
 @pytest.fixture()
 def files(tmp_path):
     rooms = two_rooms(tmp_path / "rooms.png")
+    closed = two_rooms(tmp_path / "closed.png", door=False)
     white = tmp_path / "white.png"
     cv2.imwrite(str(white), np.full((60, 60), 255, np.uint8))
     black = tmp_path / "black.png"
@@ -55,6 +56,7 @@ def files(tmp_path):
     dataset.mkdir()
     return {
         "rooms": rooms,
+        "closed": closed,
         "white": white,
         "black": black,
         "file": a_file,
@@ -69,6 +71,10 @@ BAD_INPUTS = {
     "segment -o under a file": (lambda f: ["segment", f["rooms"], "-o", f["file"] / "out"], "is a file"),
     "segment all-white map": (lambda f: ["segment", f["white"], "-o", f["tmp"] / "o"], "0 regions"),
     "segment all-black map": (lambda f: ["segment", f["black"], "-o", f["tmp"] / "o"], "no free pixel"),
+    "segment two rooms without a door": (
+        lambda f: ["segment", f["closed"], "-o", f["tmp"] / "o"],
+        "2 separate areas with no opening between them",
+    ),
     "match -o onto a file": (lambda f: ["match", f["rooms"], f["rooms"], "-o", f["file"]], "must be a folder"),
     "match --reference of unknown type": (
         lambda f: ["match", f["rooms"], f["rooms"], "-o", f["tmp"] / "m", "--reference", f["file"]],

@@ -283,3 +283,19 @@ def test_no_compiling_note_once_the_kernels_are_cached(window, qtbot, monkeypatc
     window.segmentation_panel.boxes["sketch"].segment_button.click()
     assert "Compiling" not in window.status.currentMessage()
     qtbot.waitUntil(lambda: not window.jobs.busy, timeout=120_000)
+
+
+def test_a_segmentation_with_no_region_says_why(window, qtbot, tmp_path):
+    """Two rooms with no door between them: MAORIS drops both, and the status says so, as the
+    CLI does, instead of a bare "0 regions"."""
+    import cv2
+
+    image = np.zeros((80, 170), np.uint8)
+    image[5:75, 5:80] = 255
+    image[5:75, 90:165] = 255
+    cv2.imwrite(str(tmp_path / "closed.png"), image)
+    window.session.load_map("sketch", tmp_path / "closed.png")
+    window.segmentation_panel.boxes["sketch"].segment_button.click()
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=120_000)
+    qtbot.waitUntil(lambda: "0 regions" in window.status.currentMessage(), timeout=10_000)
+    assert "2 separate areas with no opening between them" in window.status.currentMessage()

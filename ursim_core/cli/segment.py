@@ -119,19 +119,13 @@ def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: 
     ``canonical``: in the map's canonical pose (:mod:`ursim_core.segmentation.canonical`), for a
     sketch whose orientation the matcher does not assume.
     """
-    from ursim_core.segmentation import segment, segment_canonical
+    from ursim_core.segmentation import segment, segment_canonical, why_no_region
 
     announce_kernel_compilation()
     segmenter = segment_canonical if canonical else segment
     segmentation = segmenter(the_map, method=method, preset=preset, params=params)
     if segmentation.n_regions == 0:
-        free = int(the_map.free.sum())
-        why = (
-            "every pixel is free: there are no walls to find rooms between"
-            if free == the_map.free.size
-            else f"{free} free pixel(s), but no room of the preset's minimum size"
-        )
-        raise SegmentationError(f"0 regions: {why}", path=the_map.path)
+        raise SegmentationError(f"0 regions: {why_no_region(the_map.free, method=method)}", path=the_map.path)
     return segmentation
 
 

@@ -47,6 +47,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "read_label_array",
             "load_label_image",
             "save_label_image",
+            "why_no_region",
         ],
         "regions": ["RegionTable", "region_table", "adjacent_pairs", "contour_pca_shape"],
         "graph": ["region_graph"],

@@ -25,6 +25,7 @@ __all__ = [
     "DEFAULT_SEGMENTERS",
     "segment",
     "segment_canonical",
+    "why_no_region",
     "resolve_params",
     "read_label_array",
     "load_label_image",
@@ -385,3 +386,30 @@ def save_label_image(segmentation: Segmentation, path: str | Path) -> None:
     if not ok:
         raise SegmentationError("could not encode the label image", path=path)
     atomic_write_bytes(Path(path), encoded.tobytes())
+
+
+def why_no_region(free: np.ndarray, *, method: str = "maoris") -> str:
+    """Why a segmentation of the free-space mask ``free`` by ``method`` found no region, in words
+    a user can act on (the CLI's error and the app's status say it).
+
+    Examples
+    --------
+    >>> free = np.zeros((20, 41), bool); free[2:18, 2:20] = free[2:18, 21:39] = True
+    >>> why_no_region(free)[:46]
+    '576 free pixel(s) in 2 separate areas with no '
+    """
+    free = np.asarray(free, bool)
+    count = int(free.sum())
+    if count == free.size:
+        return "every pixel is free: there are no walls to find rooms between"
+    if method == "maoris":
+        import cv2
+
+        areas = cv2.connectedComponents(free.astype(np.uint8), connectivity=4)[0] - 1
+        if areas > 1:
+            return (
+                f"{count} free pixel(s) in {areas} separate areas with no opening between them: MAORIS drops "
+                "every room that touches no other room, as the authors' code does (join the areas by a door, "
+                "or segment each on its own)"
+            )
+    return f"{count} free pixel(s), but no room of the preset's minimum size"

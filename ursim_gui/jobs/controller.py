@@ -164,7 +164,13 @@ class JobController(QObject):
             return
         if isinstance(job, SegmentJob):
             self._session.set_segmentation(job.side, result)
-            self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
+            if result.n_regions == 0:
+                from ursim_core.segmentation import why_no_region
+
+                reason = why_no_region(getattr(job.map, "free", job.map), method=result.method)
+                self._status.showMessage(f"{job.side.capitalize()}: 0 regions: {reason}", 15000)
+            else:
+                self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
         elif isinstance(job, MatchJob):
             self._session.apply_match(result)
             self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)

@@ -67,3 +67,15 @@ def test_a_segmentation_is_immutable_and_survives_pickling_and_copies():
     assert given.regions.nodes == region_table(labels).nodes
     with pytest.raises(TypeError, match="graph or the region table"):
         Segmentation(labels)
+
+
+def test_why_no_region_names_what_to_change():
+    from ursim_core.segmentation import why_no_region
+
+    assert "no walls" in why_no_region(np.ones((10, 10), bool))
+    closed = np.zeros((20, 41), bool)
+    closed[2:18, 2:20] = closed[2:18, 21:39] = True
+    assert "2 separate areas" in why_no_region(closed)
+    assert "separate areas" not in why_no_region(closed, method="watershed")  # MAORIS' rule only
+    closed[9, 20] = True  # a door: one area
+    assert "minimum size" in why_no_region(closed)
