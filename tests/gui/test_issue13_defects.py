@@ -299,3 +299,5 @@ def test_a_segmentation_with_no_region_says_why(window, qtbot, tmp_path):
     qtbot.waitUntil(lambda: not window.jobs.busy, timeout=120_000)
     qtbot.waitUntil(lambda: "0 regions" in window.status.currentMessage(), timeout=10_000)
     assert "2 separate areas with no opening between them" in window.status.currentMessage()
+    summary = window.segmentation_panel.boxes["sketch"].summary.text()  # and it stays in the panel
+    assert summary.startswith("0 regions (maoris): ") and "no opening between them" in summary

@@ -114,6 +114,7 @@ class SideSegmentationBox(QGroupBox):
         self.load_button.setObjectName(f"{side}_load_labels")
         self.summary = QLabel("no segmentation")
         self.summary.setObjectName(f"{side}_summary")
+        self.summary.setWordWrap(True)  # a segmentation with no region says why, at length
         buttons = QHBoxLayout()
         buttons.addWidget(self.segment_button)
         buttons.addWidget(self.load_button)

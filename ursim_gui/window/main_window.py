@@ -347,9 +347,15 @@ class MainWindow(QMainWindow):
 
     def _show_summary(self, side: str) -> None:
         segmentation = self.session.segmentation(side)
-        text = (
-            "no segmentation" if segmentation is None else f"{segmentation.n_regions} regions ({segmentation.method})"
-        )
+        if segmentation is None:
+            text = "no segmentation"
+        else:
+            text = f"{segmentation.n_regions} regions ({segmentation.method})"
+            map_ = self.session.map(side)
+            if segmentation.n_regions == 0 and map_ is not None and map_.free.shape == segmentation.labels.shape:
+                from ursim_core.segmentation import why_no_region
+
+                text += f": {why_no_region(map_.free, method=segmentation.method)}"
         self.segmentation_panel.boxes[side].set_summary(text)
 
     def _show_map_title(self, side: str) -> None:
