@@ -114,22 +114,22 @@ class ZoneGraph:
     ([1, 2], [2], 100)
     """
 
-    def __init__(self, zones: np.ndarray, values: np.ndarray, *, _storage: np.ndarray | None = None):
-        # _storage (private): int32 memory whose first pixels are ``zones`` (C-ordered), with
-        # room for them padded; the labels are padded in it, in place, not copied.
+    def __init__(self, zones: np.ndarray, values: np.ndarray):
         zones = np.asarray(zones)
         values = np.asarray(values)
         if zones.shape != values.shape or zones.ndim != 2:
             raise SegmentationError(f"zones {zones.shape} and values {values.shape} must be 2-D of equal shape")
         zones = zones.astype(np.int32, copy=False)
         value, size = kernels().zone_values_and_sizes(zones, values, int(zones.max(initial=0)) + 1)
-        self._set_up(zones, value, size, _storage)
+        self._set_up(zones, value, size, None)
 
     @classmethod
     def _of_zone_values(cls, zones: np.ndarray, value: np.ndarray, size: np.ndarray, *, storage) -> ZoneGraph:
         """The graph of C-ordered int32 ``zones`` whose values and sizes the caller took
         (``zone_values_and_sizes``): the value image can go before the graph is built, the
-        step of the peak memory (64 MB at 8000 px, touched afresh otherwise)."""
+        step of the peak memory (64 MB at 8000 px, touched afresh otherwise). ``storage``: int32
+        memory whose first pixels are ``zones``, with room for them padded (the labels are
+        padded in it, in place, not copied), or None."""
         graph = cls.__new__(cls)
         graph._set_up(zones, value, size, storage)
         return graph
@@ -439,19 +439,18 @@ def _place_in_place(padded: np.ndarray, storage: np.ndarray, shape: tuple[int, i
         raise SegmentationError("the padded labels must be the first pixels of their storage")
     if top < 0 or left < 0 or top + rows > height or left + cols > width:
         raise SegmentationError(f"labels of {rows}x{cols} do not fit at {origin} in {shape}")
-    flat = storage
     source = [(row + _PAD) * (cols + 2 * _PAD) + _PAD for row in range(rows)]
     target = [(top + row) * width + left for row in range(rows)]
     back = [row for row in range(rows) if target[row] < source[row]]
     on = [row for row in range(rows) if target[row] >= source[row]]
     for row in back + on[::-1]:
         # numpy copies through a buffer when a row overlaps its own place
-        flat[target[row] : target[row] + cols] = flat[source[row] : source[row] + cols]
+        storage[target[row] : target[row] + cols] = storage[source[row] : source[row] + cols]
     ends = [0] + [start + cols for start in target]
     starts = target + [height * width]
     for end, start in zip(ends, starts):
-        flat[end:start] = 0
-    return flat[: height * width].reshape(height, width)
+        storage[end:start] = 0
+    return storage[: height * width].reshape(height, width)
 
 
 def _adjacency_from_entries(zone, other, minimum, unbreakable, value):
