@@ -285,10 +285,20 @@ def test_no_compiling_note_once_the_kernels_are_cached(window, qtbot, monkeypatc
     qtbot.waitUntil(lambda: not window.jobs.busy, timeout=120_000)
 
 
-def test_a_segmentation_with_no_region_says_why(window, qtbot, tmp_path):
+def test_a_segmentation_with_no_region_says_why(window, qtbot, tmp_path, monkeypatch):
     """Two rooms with no door between them: MAORIS drops both, and the status says so, as the
     CLI does, instead of a bare "0 regions"."""
     import cv2
+
+    from ursim_core import segmentation as segmentation_module
+
+    asked, why = [], segmentation_module.why_no_region
+
+    def counted(*args, **kwargs):
+        asked.append(1)
+        return why(*args, **kwargs)
+
+    monkeypatch.setattr(segmentation_module, "why_no_region", counted)
 
     image = np.zeros((80, 170), np.uint8)
     image[5:75, 5:80] = 255
@@ -301,3 +311,4 @@ def test_a_segmentation_with_no_region_says_why(window, qtbot, tmp_path):
     assert "2 separate areas with no opening between them" in window.status.currentMessage()
     summary = window.segmentation_panel.boxes["sketch"].summary.text()  # and it stays in the panel
     assert summary.startswith("0 regions (maoris): ") and "no opening between them" in summary
+    assert len(asked) == 1, "the status bar and the panel each worked the reason out"

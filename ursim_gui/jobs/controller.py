@@ -165,9 +165,7 @@ class JobController(QObject):
         if isinstance(job, SegmentJob):
             self._session.set_segmentation(job.side, result)
             if result.n_regions == 0:
-                from ursim_core.segmentation import why_no_region
-
-                reason = why_no_region(getattr(job.map, "free", job.map), method=result.method)
+                reason = self._session.no_region_reason(job.side)
                 self._status.showMessage(f"{job.side.capitalize()}: 0 regions: {reason}", 15000)
             else:
                 self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)

@@ -113,6 +113,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self.annotator = annotator
         self._maps: dict[str, Any] = {side: None for side in SIDES}
         self._segmentations: dict[str, Any] = {side: None for side in SIDES}
+        self._no_region_reasons: dict[str, tuple[Any, str]] = {}  # side -> (segmentation, reason)
         self._presets = dict(DEFAULT_PRESETS)
         self._corr = Correspondences(annotator=annotator)
         self._saved: Correspondences | None = self._corr
@@ -139,6 +140,21 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
     def segmentation(self, side: str):
         """The ``ursim_core.segmentation.Segmentation`` of ``side``, or None."""
         return self._segmentations[_check_side(side)]
+
+    def no_region_reason(self, side: str) -> str | None:
+        """Why the segmentation of ``side`` has no region (``why_no_region``), or None when it
+        has regions or there is no map or segmentation; worked out once per segmentation (the
+        status bar and the segmentation panel both say it)."""
+        segmentation, map_ = self.segmentation(side), self._maps[side]
+        if segmentation is None or map_ is None or segmentation.n_regions != 0:
+            return None
+        known = self._no_region_reasons.get(side)
+        if known is None or known[0] is not segmentation:
+            from ursim_core.segmentation import why_no_region
+
+            known = (segmentation, why_no_region(map_.free, method=segmentation.method))
+            self._no_region_reasons[side] = known
+        return known[1]
 
     def segmentation_preset(self, side: str) -> str:
         """Preset name the segmentation panel offers for ``side``."""

@@ -351,11 +351,9 @@ class MainWindow(QMainWindow):
             text = "no segmentation"
         else:
             text = f"{segmentation.n_regions} regions ({segmentation.method})"
-            map_ = self.session.map(side)
-            if segmentation.n_regions == 0 and map_ is not None and map_.free.shape == segmentation.labels.shape:
-                from ursim_core.segmentation import why_no_region
-
-                text += f": {why_no_region(map_.free, method=segmentation.method)}"
+            reason = self.session.no_region_reason(side)
+            if reason is not None:
+                text += f": {reason}"
         self.segmentation_panel.boxes[side].set_summary(text)
 
     def _show_map_title(self, side: str) -> None:

@@ -798,3 +798,18 @@ def test_a_second_session_on_the_same_file_does_not_silently_drop_the_first_ones
     reopened = AnnotationSession()
     reopened.open(path)
     reopened.save()
+
+
+def test_the_no_region_reason_is_worked_out_once_per_segmentation(session, monkeypatch):
+    from ursim_core import segmentation as segmentation_module
+
+    assert session.no_region_reason("sketch") is None  # it has regions
+    asked = []
+    monkeypatch.setattr(segmentation_module, "why_no_region", lambda free, method: asked.append(1) or "why")
+    empty = seg_of(np.zeros_like(SKETCH_LABELS))
+    session.set_segmentation("sketch", empty)
+    assert session.no_region_reason("sketch") == session.no_region_reason("sketch") == "why"
+    assert len(asked) == 1
+    session.set_segmentation("sketch", seg_of(np.zeros_like(SKETCH_LABELS)))  # a new one: asked again
+    assert session.no_region_reason("sketch") == "why" and len(asked) == 2
+    assert AnnotationSession().no_region_reason("metric") is None
