@@ -148,7 +148,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         segmentation, map_ = self.segmentation(side), self._maps[side]
         if segmentation is None or map_ is None or segmentation.n_regions != 0:
             return None
-        known = self._no_region_reasons.get(side)
+        known = self._no_region_reasons.get(side)  # dropped whenever the segmentation changes
         if known is None or known[0] is not segmentation:
             from ursim_core.segmentation import why_no_region
 
@@ -323,6 +323,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         was_dirty = self.dirty
         self._maps[side] = map_
         self._segmentations[side] = None
+        self._no_region_reasons.pop(side, None)  # and the old label image it holds
         self._forget_match()
         self._history.map_values(rebase)
         self._corr = rebase(self._corr)
@@ -368,6 +369,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
 
         was_dirty = self.dirty
         self._segmentations[side] = segmentation
+        self._no_region_reasons.pop(side, None)
         # The last match's anchors and pairs name regions of the old segmentation.
         self._forget_match()
         self._history.map_values(rebase)

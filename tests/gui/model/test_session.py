@@ -813,3 +813,13 @@ def test_the_no_region_reason_is_worked_out_once_per_segmentation(session, monke
     session.set_segmentation("sketch", seg_of(np.zeros_like(SKETCH_LABELS)))  # a new one: asked again
     assert session.no_region_reason("sketch") == "why" and len(asked) == 2
     assert AnnotationSession().no_region_reason("metric") is None
+
+
+def test_a_new_map_drops_the_kept_no_region_reason_and_its_segmentation(session, monkeypatch):
+    from ursim_core import segmentation as segmentation_module
+
+    monkeypatch.setattr(segmentation_module, "why_no_region", lambda free, method: "why")
+    session.set_segmentation("sketch", seg_of(np.zeros_like(SKETCH_LABELS)))
+    assert session.no_region_reason("sketch") == "why"
+    session.set_map("sketch", map_of(SKETCH_LABELS))
+    assert session.no_region_reason("sketch") is None and "sketch" not in session._no_region_reasons
