@@ -72,14 +72,24 @@ def position_distance(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """
     first = np.asarray(first, dtype=np.float64).reshape(-1, 2)
     second = np.asarray(second, dtype=np.float64).reshape(-1, 2)
-    # Per axis rather than one (n1, n2, 2) array: half the memory, the same sums.
-    rows = np.subtract.outer(first[:, 0], second[:, 0])
-    rows *= rows
-    cols = np.subtract.outer(first[:, 1], second[:, 1])
-    cols *= cols
-    rows += cols
-    del cols
-    return np.sqrt(rows, out=rows)
+    out = np.empty((len(first), len(second)))
+    # In blocks of rows, per axis: the temporaries of a block stay in cache, and the only large
+    # array is the result (4249 x 4256 regions: 145 MB; full-size temporaries doubled the fresh
+    # memory, 0.1 s of each of the 16 calls of a building-sized match). Same sums, same order.
+    step = max(1, _BLOCK_ELEMENTS // max(1, len(second)))
+    for start in range(0, len(first), step):
+        block = out[start : start + step]
+        np.subtract.outer(first[start : start + step, 0], second[:, 0], out=block)
+        block *= block
+        cols = np.subtract.outer(first[start : start + step, 1], second[:, 1])
+        cols *= cols
+        block += cols
+        np.sqrt(block, out=block)
+    return out
+
+
+#: Elements of a block of :func:`position_distance` (256 KiB of float64: within a core's cache).
+_BLOCK_ELEMENTS = 1 << 15
 
 
 def blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_nodes, position_weight):

@@ -79,3 +79,60 @@ def test_why_no_region_names_what_to_change():
     assert "separate areas" not in why_no_region(closed, method="watershed")  # MAORIS' rule only
     closed[9, 20] = True  # a door: one area
     assert "minimum size" in why_no_region(closed)
+
+
+def _direct_table(labels):
+    """The region table by its definitions, pixel by pixel and region by region."""
+    import cv2
+
+    from ursim_core.segmentation.regions import contour_pca_shape
+
+    nodes = {}
+    for region in range(1, int(labels.max()) + 1):
+        mask = labels == region
+        if not mask.any():
+            continue
+        rows, cols = np.nonzero(mask)
+        box = (int(rows.min()), int(cols.min()), int(rows.max()) + 1, int(cols.max()) + 1)
+        crop = mask[box[0] : box[2], box[1] : box[3]]
+        inside = cv2.distanceTransform(np.pad(crop.astype(np.uint8), 1), cv2.DIST_L2, 5)[1:-1, 1:-1]
+        peak = np.unravel_index(int(np.argmax(inside)), inside.shape)
+        nodes[region] = {
+            "size": int(mask.sum()),
+            "centroid": (float(rows.sum() / mask.sum()), float(cols.sum() / mask.sum())),
+            "interior": (box[0] + int(peak[0]), box[1] + int(peak[1])),
+            "bbox": box,
+            "pca_shape": contour_pca_shape(crop),
+        }
+    edges: dict = {}
+    for a, b in ((labels[:, :-1], labels[:, 1:]), (labels[:-1], labels[1:])):
+        for x, y in zip(a.ravel().tolist(), b.ravel().tolist()):
+            if x != y and x and y:
+                key = (min(x, y), max(x, y))
+                edges[key] = edges.get(key, 0) + 1
+    return nodes, dict(sorted(edges.items()))
+
+
+@pytest.mark.parametrize("shape", [(700, 1100), (1300, 240), (3, 90000), (9, 9)])
+def test_the_table_follows_the_definitions_across_bands_of_rows(shape):
+    # Sizes come from runs of labels along rows, adjacency and runs are counted in bands of
+    # rows, and the interior point is the argmax of the padded transform: all must give what
+    # the pixel-by-pixel definitions give, on images of several bands and of one thin band.
+    rng = np.random.default_rng(sum(shape))
+    coarse = rng.integers(0, 9, (max(1, shape[0] // 50), max(1, shape[1] // 50)))
+    labels = cv2_resize_nearest(coarse, shape).astype(np.int32)
+    specks = rng.random(shape) < 0.02
+    labels[specks] = rng.integers(0, 9, int(specks.sum()))  # holes, and specks touching on every row
+    labels[labels == 4] = 0  # an id with no pixels
+    table = region_table(labels)
+    nodes, edges = _direct_table(labels)
+    assert table.nodes == nodes and table.edges == edges
+    assert all(
+        type(v) is int for node in table.nodes.values() for v in (*node["interior"], *node["bbox"], node["size"])
+    )
+
+
+def cv2_resize_nearest(coarse, shape):
+    import cv2
+
+    return cv2.resize(coarse.astype(np.int32), (shape[1], shape[0]), interpolation=cv2.INTER_NEAREST)
