@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from ursim_core.render.figures import side_by_side_matches
 from ursim_core.segmentation.graph import region_graph
@@ -33,12 +34,13 @@ def test_a_map_above_the_limit_is_drawn_scaled_down():
     assert (figure[:, :75].std(axis=2) > 20).any() and (figure[:, 99:].std(axis=2) > 20).any()
 
 
-def test_the_table_blend_gives_the_pixels_of_the_float_blend():
+@pytest.mark.parametrize("shape", [(40, 50), (1200, 700)])  # one band of rows; several (and a partial one)
+def test_the_table_blend_gives_the_pixels_of_the_float_blend(shape):
     from ursim_core.render.figures import _base_image, _blended, label_colors
 
     rng = np.random.default_rng(0)
-    labels = rng.integers(0, 30, (40, 50)).astype(np.int32)
-    grey = rng.integers(0, 256, (40, 50)).astype(np.uint8)
+    labels = rng.integers(0, 30, shape).astype(np.int32)
+    grey = rng.integers(0, 256, shape).astype(np.uint8)
     # Half of the pixels white, as free space is in a map (the blend's shortcut for them).
     grey[rng.random(grey.shape) < 0.5] = 255
     base = _base_image(grey, None, labels.shape)
