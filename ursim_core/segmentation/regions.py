@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
+from ursim_core.errors import ParameterError
+
 if TYPE_CHECKING:
     import networkx as nx
 
@@ -251,6 +253,9 @@ def region_table(labels: np.ndarray) -> RegionTable:
     nodes: dict[int, dict] = {}
     if labels.size == 0 or not labels.any():
         return RegionTable(nodes=nodes, edges={})
+    if labels.dtype.kind == "i" and int(labels.min()) < 0:
+        # The runs keep positive labels only: a negative one would be dropped without a word.
+        raise ParameterError("label image has negative labels (0 = no region, regions 1, 2, ...)", field="labels")
     n_max = int(labels.max())
     runs = _runs(labels)
     # From the runs, not the pixels: a bincount of the image converts it to int64 first (512 MB

@@ -36,6 +36,15 @@ def test_the_table_is_the_graph_in_the_same_order():
     assert (3 in table) == (3 in graph) and 0 not in table
 
 
+def test_negative_labels_are_refused_by_name():
+    from ursim_core.errors import ParameterError
+
+    labels = np.zeros((6, 6), np.int32)
+    labels[1:3, 1:3], labels[3:5, 3:5] = -1, 2
+    with pytest.raises(ParameterError, match="negative labels"):
+        region_table(labels)
+
+
 def test_an_empty_label_image_has_no_regions():
     table = region_table(np.zeros((4, 5), np.int32))
     assert len(table) == 0 and table.edges == {} and table.to_graph().number_of_nodes() == 0
