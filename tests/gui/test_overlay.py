@@ -58,6 +58,20 @@ def test_outline_marks_only_region_borders():
     assert not outline_mask(labels_big)[0, 0]
 
 
+def test_outline_follows_its_definition_across_bands_of_rows():
+    # The mask is made in bands of rows with a row of context each side: on an image of several
+    # bands (and on a single long row) it must be the pixel-by-pixel definition.
+    rng = np.random.default_rng(4)
+    for shape in ((700, 900), (2, 300000), (1, 7)):
+        labels = rng.integers(0, 4, shape).astype(np.int32)
+        expected = np.zeros(shape, bool)
+        expected[1:] |= labels[1:] != labels[:-1]
+        expected[:-1] |= labels[1:] != labels[:-1]
+        expected[:, 1:] |= labels[:, 1:] != labels[:, :-1]
+        expected[:, :-1] |= labels[:, 1:] != labels[:, :-1]
+        assert np.array_equal(outline_mask(labels), expected & (labels > 0)), shape
+
+
 def test_label_positions_use_interior_points_and_masks_are_cropped():
     labels = three_room_labels()
     graph = region_graph(labels)
