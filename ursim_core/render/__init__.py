@@ -1,6 +1,6 @@
 """Pictures of results: segmentation overlays and side-by-side match figures (PNG, atomic).
 
-May import: :mod:`ursim_core.io` and :mod:`ursim_core.errors`; it draws plain arrays and graphs.
+May import: :mod:`ursim_core.io`, :mod:`ursim_core.errors` and :func:`ursim_core.segmentation.regions.row_bands`; it draws plain arrays and graphs.
 """
 
 import lazy_loader as _lazy

@@ -15,6 +15,7 @@ import numpy as np
 
 from ursim_core.errors import UrsimError
 from ursim_core.io.atomic import atomic_write_bytes
+from ursim_core.segmentation.regions import row_bands
 
 if TYPE_CHECKING:  # networkx is imported where a graph is made (_shrunk), not to draw one
     import networkx as nx
@@ -85,10 +86,6 @@ def _base_image(image: np.ndarray | None, free: np.ndarray | None, shape: tuple[
     return np.repeat(grey[..., None], 3, axis=2)
 
 
-#: Pixels per band of the colour lookup in :func:`_blended` (a few MB of temporaries).
-_BAND_PIXELS = 1 << 18
-
-
 def _blended(base: np.ndarray, labels: np.ndarray, inside: np.ndarray, table: np.ndarray, opacity: float) -> np.ndarray:
     """``base`` with each labelled pixel blended towards its label's colour in ``table``.
 
@@ -116,9 +113,7 @@ def _blended(base: np.ndarray, labels: np.ndarray, inside: np.ndarray, table: np
     # In bands of rows: np.take makes an intp copy of the labels it is given, 512 MB of fresh
     # memory for a whole 8000 x 8000 image (2 s of `ursim segment`'s overlay measured).
     colours, white_mask = lookup[255][table], white.view(np.uint8)
-    rows = max(1, _BAND_PIXELS // max(1, labels.shape[1]))
-    for start in range(0, labels.shape[0], rows):
-        band = slice(start, start + rows)
+    for band in row_bands(labels):
         cv2.copyTo(np.take(colours, labels[band], axis=0), white_mask[band], canvas[band])
     where = np.flatnonzero(inside & ~white)
     regions = labels.ravel()[where]

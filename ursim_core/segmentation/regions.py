@@ -9,6 +9,7 @@ makes the same as a ``networkx.Graph``; a command that only writes a segmentatio
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -20,7 +21,7 @@ from ursim_core.errors import ParameterError
 if TYPE_CHECKING:
     import networkx as nx
 
-__all__ = ["RegionTable", "region_table", "adjacent_pairs", "contour_pca_shape"]
+__all__ = ["RegionTable", "region_table", "adjacent_pairs", "contour_pca_shape", "row_bands"]
 
 
 @dataclass(frozen=True)
@@ -104,10 +105,10 @@ def adjacent_pairs(labels: np.ndarray) -> dict[tuple[int, int], int]:
     # In bands of rows (each with the next band's first row, for the pairs across): the masks
     # of a band stay small, where full-size ones were several images of fresh memory (64 MB
     # each at 8000 x 8000 px). The pairs are counted, so their order does not matter.
-    rows = _band_rows(labels)
-    for start in range(0, labels.shape[0], rows):
-        band = labels[start : start + rows + 1]
-        for a, b in ((band[:rows, :-1], band[:rows, 1:]), (band[:-1, :], band[1:, :])):
+    for rows in row_bands(labels):
+        band = labels[rows.start : rows.stop + 1]
+        height = rows.stop - rows.start
+        for a, b in ((band[:height, :-1], band[:height, 1:]), (band[:-1, :], band[1:, :])):
             touching = a != b
             touching &= a != 0
             touching &= b != 0
@@ -125,13 +126,27 @@ def adjacent_pairs(labels: np.ndarray) -> dict[tuple[int, int], int]:
     return {(int(k // base), int(k % base)): int(n) for k, n in zip(keys, counts)}
 
 
-#: Pixels per band of :func:`adjacent_pairs` (its masks then fit a core's 2 MB cache; at 8000 px
-#: 0.07-0.14 s against 0.16-0.19 s for bands of 1024 rows and 0.17-0.79 s for the whole image).
-_BAND_PIXELS = 1 << 18
+#: Pixels per band of :func:`row_bands`: the masks of a band then fit a core's 2 MB cache
+#: (:func:`adjacent_pairs` at 8000 px: 0.07-0.14 s, against 0.16-0.19 s for bands of 1024 rows
+#: and 0.17-0.79 s for the whole image).
+BAND_PIXELS = 1 << 18
 
 
-def _band_rows(labels: np.ndarray) -> int:
-    return max(1, _BAND_PIXELS // max(1, labels.shape[1]))
+def row_bands(image: np.ndarray, *, pixels: int = BAND_PIXELS) -> Iterator[slice]:
+    """Consecutive bands of rows of ``image``, about ``pixels`` pixels each (at least one row).
+
+    For passes over a whole label image whose temporaries (masks, index copies) would otherwise
+    be image-sized fresh memory: 64-512 MB each at 8000 x 8000 px.
+
+    Examples
+    --------
+    >>> [(band.start, band.stop) for band in row_bands(np.zeros((5, 4)), pixels=8)]
+    [(0, 2), (2, 4), (4, 5)]
+    """
+    rows = image.shape[0]
+    step = max(1, pixels // max(1, image.shape[1]))
+    for start in range(0, rows, step):
+        yield slice(start, min(rows, start + step))
 
 
 def contour_pca_shape(mask: np.ndarray) -> float:
@@ -173,14 +188,13 @@ def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nd
     """Runs of equal non-zero labels along the rows: ``(label, row, col_start, col_stop)``."""
     cols = labels.shape[1]
     # In bands of rows, as adjacent_pairs: a full-size mask was 64 MB of fresh memory at 8000 px.
-    rows = _band_rows(labels)
     found_rows, found_cols = [np.zeros(0, np.intp)], [np.zeros(0, np.intp)]
-    for start in range(0, labels.shape[0], rows):
-        band = labels[start : start + rows]
+    for rows in row_bands(labels):
+        band = labels[rows]
         starts = np.ones(band.shape, bool)
         np.not_equal(band[:, 1:], band[:, :-1], out=starts[:, 1:])
         band_rows, band_cols = np.nonzero(starts)
-        band_rows += start
+        band_rows += rows.start
         found_rows.append(band_rows)
         found_cols.append(band_cols)
     run_rows, run_cols = np.concatenate(found_rows), np.concatenate(found_cols)

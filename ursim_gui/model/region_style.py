@@ -16,6 +16,8 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
+from ursim_core.segmentation.regions import row_bands
+
 __all__ = [
     "Colour",
     "NEUTRAL_REGION",
@@ -121,9 +123,8 @@ def outline_mask(labels: np.ndarray) -> np.ndarray:
     # In bands of rows, each with one row of context above and below: full-size masks were
     # several images of fresh memory for a building-sized map (0.5 s a call at 8000 x 8000 px).
     total = labels.shape[0]
-    step = max(1, _BAND_PIXELS // max(1, labels.shape[1]))
-    for start in range(0, total, step):
-        stop = min(total, start + step)
+    for rows in row_bands(labels):
+        start, stop = rows.start, rows.stop
         low, high = max(0, start - 1), min(total, stop + 1)
         block = labels[low:high]
         marked = np.zeros(block.shape, bool)
@@ -136,10 +137,6 @@ def outline_mask(labels: np.ndarray) -> np.ndarray:
         marked &= block > 0
         edge[start:stop] = marked[start - low : stop - low]
     return edge
-
-
-#: Pixels per band of :func:`outline_mask`.
-_BAND_PIXELS = 1 << 18
 
 
 def region_label_positions(graph) -> dict[int, tuple[float, float]]:
