@@ -745,6 +745,21 @@ def test_match_config_defaults_to_the_core_defaults(session):
     assert session.match_config is custom
 
 
+def _cancelled_during_the_sweep(session, config) -> int:
+    """Run a match job that is cancelled at its sixth poll; the number of polls."""
+    polls = []
+
+    def cancel_during_the_sweep():
+        polls.append(1)
+        return len(polls) > 5
+
+    with pytest.raises(JobCancelled):
+        MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
+            lambda *a: None, cancel_during_the_sweep
+        )
+    return len(polls)
+
+
 def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(session):
     from ursim_core.matching import MatchConfig
 
@@ -760,17 +775,7 @@ def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(sess
     steps = [message for _, message in reports if message.startswith("matching at m = ")]
     assert len(steps) == len(config.m_grid)
 
-    polls = []
-
-    def cancel_during_the_sweep():
-        polls.append(1)
-        return len(polls) > 5
-
-    with pytest.raises(JobCancelled):
-        MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
-            lambda *a: None, cancel_during_the_sweep
-        )
-    assert len(polls) == 6
+    assert _cancelled_during_the_sweep(session, config) == 6
 
 
 def test_a_large_pair_shares_its_sweeps_with_the_helper_process_and_a_cancel_stops_it(session, monkeypatch):
@@ -800,16 +805,7 @@ def test_a_large_pair_shares_its_sweeps_with_the_helper_process_and_a_cancel_sto
     )
     assert closed == [1] and sweep_helper._ACTIVE is None
 
-    polls = []
-
-    def cancel_during_the_sweep():
-        polls.append(1)
-        return len(polls) > 5
-
-    with pytest.raises(JobCancelled):
-        MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
-            lambda *a: None, cancel_during_the_sweep
-        )
+    _cancelled_during_the_sweep(session, config)
     assert closed == [1, 1] and sweep_helper._ACTIVE is None  # the helper went with the cancel
 
 
