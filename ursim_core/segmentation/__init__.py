@@ -49,7 +49,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "save_label_image",
             "why_no_region",
         ],
-        "regions": ["RegionTable", "region_table", "adjacent_pairs", "contour_pca_shape"],
+        "regions": ["RegionTable", "region_table", "adjacent_pairs", "contour_pca_shape", "row_bands"],
         "graph": ["region_graph"],
         "watershed": ["watershed_labels"],
         "presets_cv": ["cross_validate"],
