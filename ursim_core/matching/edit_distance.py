@@ -270,22 +270,24 @@ def cyclic_align(
     candidates = [(False, sequence)]
     if reflections:
         candidates.append((True, sequence[::-1]))
+    # Every rotation has the same lengths, so the lowest normalised distance is the lowest
+    # distance: only an improvement builds an Alignment (this runs for every seed of the matcher).
     best = None
     for reflected, base in candidates:
         for offset in range(len(base)):
             rotated = base[offset:] + base[:offset]
-            result = align(rotated, second, same)
-            if best is None or result.normalised < best.normalised:
+            distance, operations = levenshtein(rotated, second, same)
+            if best is None or distance < best.distance:
                 best = Alignment(
-                    distance=result.distance,
-                    normalised=result.normalised,
-                    operations=result.operations,
+                    distance=distance,
+                    normalised=normalised_distance(distance, len(rotated), len(second)),
+                    operations=operations,
                     rotation=offset,
                     reflected=reflected,
-                    first=result.first,
-                    second=result.second,
+                    first=tuple(rotated),
+                    second=tuple(second),
                 )
-                if best.distance == 0:
+                if distance == 0:
                     return best
     return best
 

@@ -293,20 +293,31 @@ def _adjacency_ends(neighbour_sets) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(sources, dtype=np.intp), np.asarray(targets, dtype=np.intp)
 
 
-def _inner_edges(ends, n_vertices: int, vertices) -> int:
+#: Graphs with at most this many (vertex, neighbour) entries count the edges of a hypothesis in
+#: Python (:func:`_inner_edges`): for a sketch-sized graph NumPy's call overhead costs more than
+#: the count.
+_LISTED_ENTRIES = 256
+
+
+def _inner_edges(ends, n_vertices: int, vertices, neighbour_sets) -> int:
     """Edges between two of ``vertices``: entries with both ends in them, each edge seen twice.
 
-    The count of ``sum(1 for v in vertices for n in neighbours[v] if n in vertices) // 2`` with
-    one pass of NumPy over the entries instead of Python over thousands of matched regions.
+    The count of ``sum(1 for v in vertices for n in neighbours[v] if n in vertices) // 2``: so in
+    Python for small graphs, with one pass of NumPy over the entries (``ends``) for larger ones
+    instead of Python over thousands of matched regions.
     """
+    sources, targets = ends
+    if sources.size <= _LISTED_ENTRIES:
+        inside = set(vertices)
+        return sum(1 for vertex in inside for neighbour in neighbour_sets[vertex] if neighbour in inside) // 2
     inside = np.zeros(n_vertices, dtype=np.bool_)
     inside[np.fromiter(vertices, dtype=np.intp)] = True
-    sources, targets = ends
     return int(np.count_nonzero(inside[sources] & inside[targets])) // 2
 
 
-#: Pair-cost matrices of at most this many cells are read as nested lists by :func:`planar_match`
-#: (a KTH pair has about a hundred); larger ones are indexed as arrays (no n1 x n2 lists).
+#: Pair-cost and "same" matrices of at most this many cells are read as nested lists by
+#: :func:`planar_match` (a KTH pair has about a hundred); larger ones are indexed as arrays (no
+#: n1 x n2 lists).
 _LISTED_COSTS = 4096
 
 
@@ -390,6 +401,15 @@ def planar_match(
     def pair_term(pairs):
         return pair_cost_weight * sum(pair_costs_of(pairs)) if weighted else 0
 
+    if isinstance(same, np.ndarray) and same.size <= _LISTED_COSTS:
+        longest_first = max(map(len, first.neighbours), default=0)
+        longest_second = max(map(len, second.neighbours), default=0)
+        if longest_first * longest_second < COMPILED_CELLS:
+            # A sketch-sized "same" read as lists: every alignment reads a block of it, and
+            # indexing lists costs less than a NumPy block per call. No alignment is long
+            # enough for the compiled kernel (which needs the array), so the answers are the same.
+            same = same.tolist()
+
     # Every one-pair hypothesis has the same structural cost; they come first, so the first seed
     # wins among them (the first of the lowest pair cost when pair costs are used).
     single_structure = (n_first - 1) + (n_second - 1) + edges_first + edges_second
@@ -465,8 +485,8 @@ def planar_match(
                     see_second(b)
                     consume(candidate)
         hypotheses += 1
-        inner_first = _inner_edges(first_ends, n_first, matched.keys())
-        inner_second = _inner_edges(second_ends, n_second, matched.values())
+        inner_first = _inner_edges(first_ends, n_first, matched.keys(), first_sets)
+        inner_second = _inner_edges(second_ends, n_second, matched.values(), second_sets)
         structure = (
             (n_first - len(pairs))
             + (n_second - len(pairs))

@@ -145,3 +145,31 @@ def test_pairs_are_one_to_one(rotation_search):
     metric_side = [b for _, b in result.pairs]
     assert len(set(sketch_side)) == len(sketch_side) and len(set(metric_side)) == len(metric_side)
     assert result.cost == hypothesis_cost(first, second, result.pairs)
+
+
+@pytest.mark.parametrize("n_regions", [12, 45])
+def test_lists_and_arrays_give_the_same_answer(monkeypatch, n_regions):
+    """Sketch-sized pairs read "same" as lists and count inner edges in Python: the answer and
+    every hypothesis are those of the array paths that larger pairs take."""
+    import ursim_core.matching.planar as planar
+
+    graph = random_region_graph(n_regions, seed=3)
+    copy, _ = perturbed_copy(graph, seed=4, size_noise=0.3, position_noise=40)
+    first, second = planar_graph(graph), planar_graph(copy)
+    rng = np.random.default_rng(n_regions)
+    same = rng.uniform(size=(n_regions, n_regions)) < 0.2
+    costs = rng.uniform(size=(n_regions, n_regions))
+
+    def answer():
+        result = planar_match(
+            first, second, same, reflections=True, keep_alternatives=True, pair_costs=costs, pair_cost_weight=2.0
+        )
+        return result.pairs, result.cost, result.structural_cost, result.hypotheses, result.alternatives
+
+    monkeypatch.setattr(planar, "_LISTED_COSTS", n_regions * n_regions)
+    monkeypatch.setattr(planar, "_LISTED_ENTRIES", 10**9)
+    listed = answer()
+    monkeypatch.setattr(planar, "_LISTED_COSTS", 0)
+    monkeypatch.setattr(planar, "_LISTED_ENTRIES", -1)
+    assert answer() == listed
+    assert len(listed[4]) > 3  # several expansions were compared, not only one-pair hypotheses
