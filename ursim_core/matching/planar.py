@@ -302,9 +302,9 @@ _LISTED_ENTRIES = 256
 def _inner_edges(ends, n_vertices: int, vertices, neighbour_sets) -> int:
     """Edges between two of ``vertices``: entries with both ends in them, each edge seen twice.
 
-    The count of ``sum(1 for v in vertices for n in neighbours[v] if n in vertices) // 2``: so in
-    Python for small graphs, with one pass of NumPy over the entries (``ends``) for larger ones
-    instead of Python over thousands of matched regions.
+    The count of ``sum(1 for v in vertices for n in neighbours[v] if n in vertices) // 2``:
+    computed so for small graphs, and for larger ones by one pass of NumPy over the entries
+    (``ends``) instead of Python over thousands of matched regions.
     """
     sources, targets = ends
     if sources.size <= _LISTED_ENTRIES:
