@@ -41,7 +41,7 @@ _FIRST_STEPS = (0.2, 0.2, 0.1, 0.1, 0.1)
 #: most, the KTH evaluation in the 8 orientations was unchanged and at 15-degree steps 5 of the
 #: 432 sketch orientations changed (3 better, 2 worse); the Hungarian and VF2 baselines, which
 #: choose their orientation the same way, changed on 6 sketches upright (mean F1 at automatic m
-#: within 0.03, up). Chosen for speed, checked on the same 18 sketches.
+#: -0.001 to +0.028). Chosen for speed, checked on the same 18 sketches.
 _SMALLEST_STEP = 0.02
 _MAX_ROUNDS = 60
 
