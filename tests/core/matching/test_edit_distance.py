@@ -108,3 +108,26 @@ def test_compiled_alignment_gives_the_python_operations_and_pairs(density):
         assert levenshtein(first, second, same) == levenshtein(first, second, same.tolist())
         assert aligned_index_pairs(first, second, same) == aligned_index_pairs(first, second, same.tolist())
     assert long_ones > 10
+
+
+@pytest.mark.parametrize("reflections", [False, True])
+def test_cyclic_align_keeps_the_first_rotation_of_lowest_normalised_distance(reflections):
+    # The definition, spelled out: every rotation (then every rotation of the reversed sequence)
+    # aligned in turn, the first one of lowest normalised distance kept.
+    import numpy as np
+
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        first = rng.integers(0, 4, int(rng.integers(2, 8))).tolist()
+        second = rng.integers(0, 4, int(rng.integers(0, 8))).tolist()
+        candidates = [(False, first)] + ([(True, first[::-1])] if reflections else [])
+        expected = None
+        for reflected, base in candidates:
+            for offset in range(len(base)):
+                result = align(base[offset:] + base[:offset], second, equal)
+                if expected is None or result.normalised < expected[0].normalised:
+                    expected = (result, offset, reflected)
+        got = cyclic_align(first, second, equal, reflections=reflections)
+        result, offset, reflected = expected
+        assert (got.distance, got.normalised, got.operations) == (result.distance, result.normalised, result.operations)
+        assert (got.rotation, got.reflected, got.first, got.second) == (offset, reflected, result.first, result.second)
