@@ -277,3 +277,82 @@ def test_discs_painted_in_bands_are_numbas(c_module):
     discs.paint_discs(shapes, mask, want)
     assert np.array_equal(got, want)
     assert (got[~free] == 0).all() and got.max() > 20
+
+
+def _bands_run_here():
+    import os
+
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("one usable CPU: the kernels scan images whole, in no bands")
+
+
+def _band_crossing_values() -> np.ndarray:
+    """4 Mpx of zones that cross the band boundaries: on the left, rows joined at alternate ends
+    (one zone snaking down the whole image); on the right, flat blocks of three values and specks."""
+    rng = np.random.default_rng(7)
+    values = np.zeros((2048, 2048), np.uint8)
+    values[::2, :1024] = 5
+    values[1::4, 1023] = 5
+    values[3::4, 0] = 5
+    blocks = rng.integers(0, 4, (2048 // 8, 1024 // 8)).astype(np.uint8)
+    values[:, 1024:] = np.repeat(np.repeat(blocks, 8, 0), 8, 1)
+    right = values[:, 1024:]
+    right[rng.random(right.shape) < 0.002] = 9
+    return values
+
+
+def test_flat_zones_labelled_in_bands_are_numbas(c_module):
+    """Images of 2**21 px and more are labelled in bands of rows, one thread each, and the
+    bands joined: the labels (numbered in raster order of their first pixel), values and sizes
+    are those numba's one pass gives, also for a zone that crosses every band."""
+    from ursim_core.segmentation.maoris.kernels import flat_zones
+
+    _bands_run_here()
+    values = _band_crossing_values()
+    got, value, size = c_module.label_flat_zones_counted(values, np.empty(values.shape, np.int32))
+    want = flat_zones.label_flat_zones(values, np.empty(values.shape, np.int32))
+    want_value, want_size = flat_zones.zone_values_and_sizes(want, values, int(want.max()) + 1)
+    assert np.array_equal(got, want)
+    assert np.array_equal(value, want_value) and np.array_equal(size, want_size)
+    assert np.array_equal(c_module.label_flat_zones(values, np.empty(values.shape, np.int32)), want)
+    snake = got[0, 0]
+    assert snake == got[-2, 0] and size[snake] > 2048 * 1024 // 2  # one zone through every band
+
+
+def test_centre_rectangles_scanned_in_bands_are_numbas(c_module):
+    """The disc centres of 2**21 px and more are scanned in bands of rows: the rectangles,
+    those that go on across a band's first row joined again, are numba's, in numba's order."""
+    import cv2
+
+    from ursim_core.segmentation.maoris.kernels import discs
+    from ursim_core.synth import make_large_building
+
+    _bands_run_here()
+    free = make_large_building(1500, seed=5).free
+    free[:, 700:760] = True  # a wide corridor through every band: tall rectangles across them
+    rng = np.random.default_rng(3)
+    free[rng.random(free.shape) < 0.002] = False
+    dist = np.empty(free.shape, np.float32)
+    cv2.distanceTransform(free.view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE, dst=dist)
+    got, want = c_module.centre_rectangles(dist, 500), discs.centre_rectangles(dist, 500)
+    assert got.shape == want.shape and np.array_equal(got, want)
+    middle = free.shape[0] // 2
+    assert ((want[:, 0] < middle) & (want[:, 1] >= middle)).any(), "a rectangle must cross the band boundary"
+
+
+def test_values_looked_up_in_parts_are_the_tables_and_out_of_table_ones_refused(c_module):
+    """The radii of 2**21 px and more are mapped to the value image in parts, one thread each:
+    every pixel is the table's entry for it; a value outside the table is an IndexError, in C as
+    in numba, not a read past the table."""
+    from ursim_core.segmentation.maoris.kernels import discs
+
+    rng = np.random.default_rng(11)
+    values = rng.integers(-3, 300, (1500, 1500)).astype(np.int32)
+    table = rng.integers(0, 256, 303).astype(np.uint8)
+    got = np.zeros(values.shape, np.uint8)
+    c_module.lookup_bytes(values, -3, table, got)
+    assert np.array_equal(got, table[values + 3])
+    values[-1, -1] = 300  # one past the table, in the last part
+    for kernel in (c_module.lookup_bytes, discs.lookup_bytes):
+        with pytest.raises(IndexError, match="outside"):
+            kernel(values, -3, table, got)

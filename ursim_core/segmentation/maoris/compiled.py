@@ -52,8 +52,15 @@ __all__ = [
 #: The kernels called from Python, by module of :mod:`.kernels` (the helpers they call are
 #: compiled into them). A test checks this against :data:`.kernels.signatures.SIGNATURES`.
 ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
-    "discs": ("centre_rectangles", "paint_discs"),
-    "flat_zones": ("label_flat_zones", "zone_values_and_sizes", "first_pixels", "resolve_parents", "relabel"),
+    "discs": ("centre_rectangles", "paint_discs", "lookup_bytes"),
+    "flat_zones": (
+        "label_flat_zones",
+        "label_flat_zones_counted",
+        "zone_values_and_sizes",
+        "first_pixels",
+        "resolve_parents",
+        "relabel",
+    ),
     "adjacency": (
         "build_adjacency",
         "adjacency_entries",

@@ -140,6 +140,13 @@ def _by_lookup(values: np.ndarray, function) -> np.ndarray:
     if hi - lo > 1 << 16:
         return function(values)
     table = function(np.arange(lo, hi + 1, dtype=values.dtype)[None, :])[0]
+    if values.dtype == np.int32 and table.dtype == np.uint8 and values.flags.c_contiguous:
+        # The radii: one compiled pass, in parts on threads for large images, into a fresh image
+        # (the offsets, the 8-bit indices and the table's result were three passes and a fresh
+        # image on one thread: 0.22-0.25 s at 8000 x 8000 px).
+        out = np.empty(values.shape, np.uint8)
+        kernels().lookup_bytes(values, lo, np.ascontiguousarray(table), out)
+        return out
     offsets = values - lo if lo else values
     if hi - lo <= 255:  # cv2.LUT takes 8-bit indices, and is several times faster than numpy
         indices = offsets.astype(np.uint8, copy=False)

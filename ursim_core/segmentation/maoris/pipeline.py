@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 
 from ursim_core.errors import ParameterError
-from ursim_core.segmentation.maoris.compiled import kernels
 from ursim_core.segmentation.maoris.inscribed_circle import (
     _as_free_mask,
     _free_bbox,
@@ -27,7 +26,7 @@ from ursim_core.segmentation.maoris.steps import (
     watershed_merge,
 )
 from ursim_core.segmentation.maoris.warm_memory import warm_memory
-from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, flat_zones
+from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, _flat_zones_counted
 
 __all__ = ["maoris_labels", "compile_kernels"]
 
@@ -89,9 +88,9 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     )
     values = _quantized_radii(radii, params.quantum)
     # The zones are labelled over the radii, read only for the values, and the graph pads
-    # them in place (a fresh image of that size costs more in page faults than the pass).
-    zones = flat_zones(values, out=radii)
-    value, size = kernels().zone_values_and_sizes(zones, values, int(zones.max(initial=0)) + 1)
+    # them in place (a fresh image of that size costs more in page faults than the pass); their
+    # values and sizes are counted as they are labelled.
+    zones, value, size = _flat_zones_counted(values, out=radii)
     # Large temporaries go as soon as they are read, here the value image before the graph is
     # built (the step of the peak memory): at 8000 x 8000 each full-size image is 64-256 MB, and
     # on the virtual machines this was measured on, memory touched for the first time cost

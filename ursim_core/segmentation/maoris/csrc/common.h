@@ -313,11 +313,51 @@ static inline int64_t usable_cpus(void)
     return 1;
 }
 
-/* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts). */
+/* A part of relabel_in_place's work, for a thread. */
+typedef struct {
+    int32_t *labels;
+    int64_t first, end;
+    const int32_t *lookup;
+    pthread_t thread;
+    int running;
+} RelabelPart;
+
+static inline void relabel_part(RelabelPart *part)
+{
+    int32_t *labels = part->labels;
+    const int32_t *lookup = part->lookup;
+    for (int64_t i = part->first; i < part->end; i++) {
+        labels[i] = lookup[labels[i]];
+    }
+}
+
+static void *relabel_part_run(void *arg)
+{
+    relabel_part(arg);
+    return NULL;
+}
+
+/* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts
+ * and fusion): from BAND_MIN_PIXELS labels on, in parts, one thread each (at 8000 x 8000 px a
+ * pass reads and writes 256 MB and is bound by one core's memory traffic). */
 static inline void relabel_in_place(int32_t *labels, int64_t n, const int32_t *lookup)
 {
-    for (int64_t i = 0; i < n; i++) {
-        labels[i] = lookup[labels[i]];
+    int64_t n_parts = n >= BAND_MIN_PIXELS ? usable_cpus() : 1;
+    n_parts = n_parts < MAX_BANDS ? n_parts : MAX_BANDS;
+    RelabelPart parts[MAX_BANDS];
+    for (int64_t k = 0; k < n_parts; k++) {
+        parts[k] = (RelabelPart){labels, n * k / n_parts, n * (k + 1) / n_parts, lookup};
+    }
+    for (int64_t k = 1; k < n_parts; k++) {
+        parts[k].running = pthread_create(&parts[k].thread, NULL, relabel_part_run, &parts[k]) == 0;
+    }
+    relabel_part(&parts[0]);
+    for (int64_t k = 1; k < n_parts; k++) {
+        if (parts[k].running) {
+            pthread_join(parts[k].thread, NULL);
+        } else {
+            relabel_part(&parts[k]);
+        }
     }
 }
 

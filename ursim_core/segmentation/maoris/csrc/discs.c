@@ -21,25 +21,43 @@ static void load_radii(const float *dist_row, int64_t cols, int64_t max_radius, 
     }
 }
 
-/* discs.centre_rectangles; returns the malloc'd (count, 6) table, or NULL when out of memory. */
-static int64_t *centre_rectangles(const float *dist, int64_t rows, int64_t cols, int64_t max_radius, int64_t *count_out)
+/* discs.centre_rectangles over rows first_row .. end_row - 1 (the rows around them read too):
+ * the rectangles created there, as if the rows above did not exist (a rectangle that goes on
+ * from the row above starts again at first_row), in the malloc'd b->shapes; b->open_at: the
+ * last rectangle created at each column. b->failed when out of memory. */
+typedef struct {
+    const float *dist;
+    int64_t rows, cols, max_radius, first_row, end_row;
+    int64_t *shapes, count, *open_at;
+    int failed, running;
+    pthread_t thread;
+} CentreBand;
+
+static void centre_band(CentreBand *b)
 {
+    const float *dist = b->dist;
+    int64_t rows = b->rows, cols = b->cols, max_radius = b->max_radius;
     int32_t *ring = calloc((size_t)(3 * (cols + 2)), sizeof(int32_t));
     int32_t *centre_radius = calloc((size_t)(cols + 1), sizeof(int32_t));
     int64_t *open_at = malloc((size_t)(cols > 0 ? cols : 1) * sizeof(int64_t));
-    int64_t capacity = rows * cols / 64 > 16 ? rows * cols / 64 : 16;
+    int64_t band_pixels = (b->end_row - b->first_row) * cols;
+    int64_t capacity = band_pixels / 64 > 16 ? band_pixels / 64 : 16;
     int64_t *shapes = malloc((size_t)capacity * 6 * sizeof(int64_t));
     int64_t count = 0;
     if (ring == NULL || centre_radius == NULL || open_at == NULL || shapes == NULL) {
         goto fail;
     }
-    if (rows > 0) {
-        load_radii(dist, cols, max_radius, ring);
+    int64_t first = b->first_row;
+    if (first > 0) {
+        load_radii(dist + (first - 1) * cols, cols, max_radius, ring + ((first + 2) % 3) * (cols + 2));
+    }
+    if (first < rows) {
+        load_radii(dist + first * cols, cols, max_radius, ring + (first % 3) * (cols + 2));
     }
     for (int64_t col = 0; col < cols; col++) {
         open_at[col] = -1;
     }
-    for (int64_t row = 0; row < rows; row++) {
+    for (int64_t row = first; row < b->end_row; row++) {
         int32_t *up = ring + ((row + 2) % 3) * (cols + 2), *here = ring + (row % 3) * (cols + 2);
         int32_t *down = ring + ((row + 1) % 3) * (cols + 2);
         if (row + 1 < rows) {
@@ -100,15 +118,117 @@ static int64_t *centre_rectangles(const float *dist, int64_t rows, int64_t cols,
     }
     free(ring);
     free(centre_radius);
-    free(open_at);
-    *count_out = count;
-    return shapes;
+    b->shapes = shapes;
+    b->count = count;
+    b->open_at = open_at;
+    return;
 fail:
     free(ring);
     free(centre_radius);
     free(open_at);
     free(shapes);
+    b->failed = 1;
+}
+
+static void *centre_band_run(void *arg)
+{
+    centre_band(arg);
     return NULL;
+}
+
+/* discs.centre_rectangles; returns the malloc'd (count, 6) table, or NULL when out of memory.
+ * Large images are scanned in bands of rows, one thread each; a rectangle that a band starts on
+ * its first row is then joined to the one it goes on from (the last created at its column in
+ * the band above, which ends on the row above with the same right end and radius), as one
+ * scan of all rows would have grown it: the same rectangles in the same order. */
+static int64_t *centre_rectangles(const float *dist, int64_t rows, int64_t cols, int64_t max_radius, int64_t *count_out)
+{
+    int64_t n_bands = rows * cols >= BAND_MIN_PIXELS ? usable_cpus() : 1;
+    n_bands = n_bands < MAX_BANDS ? n_bands : MAX_BANDS;
+    n_bands = n_bands < rows ? n_bands : (rows > 0 ? rows : 1);
+    CentreBand bands[MAX_BANDS];
+    for (int64_t k = 0; k < n_bands; k++) {
+        bands[k] = (CentreBand){dist, rows, cols, max_radius, rows * k / n_bands, rows * (k + 1) / n_bands};
+    }
+    for (int64_t k = 1; k < n_bands; k++) {
+        bands[k].running = pthread_create(&bands[k].thread, NULL, centre_band_run, &bands[k]) == 0;
+    }
+    centre_band(&bands[0]);
+    int failed = bands[0].failed;
+    for (int64_t k = 1; k < n_bands; k++) {
+        if (bands[k].running) {
+            pthread_join(bands[k].thread, NULL);
+        } else {
+            centre_band(&bands[k]); /* no thread: here */
+        }
+        failed |= bands[k].failed;
+    }
+    int64_t *shapes = NULL, *start = NULL, *alias = NULL, total = 0;
+    if (failed) {
+        goto done;
+    }
+    for (int64_t k = 0; k < n_bands; k++) {
+        total += bands[k].count;
+    }
+    if (n_bands == 1) {
+        shapes = bands[0].shapes, bands[0].shapes = NULL;
+        *count_out = total;
+        goto done;
+    }
+    /* Every band's rectangles by one index (band k's i-th: start[k] + i); alias: the index a
+     * joined rectangle went into (itself when kept). */
+    start = malloc((size_t)(n_bands + 1) * sizeof(int64_t));
+    alias = malloc((size_t)(total > 0 ? total : 1) * sizeof(int64_t));
+    /* The first band's table grown to hold them all (its pages are there already). */
+    shapes = start == NULL || alias == NULL ? NULL : realloc(bands[0].shapes, (size_t)(total + 1) * 6 * sizeof(int64_t));
+    if (shapes == NULL) {
+        goto done;
+    }
+    bands[0].shapes = NULL;
+    start[0] = 0;
+    for (int64_t k = 0; k < n_bands; k++) {
+        start[k + 1] = start[k] + bands[k].count;
+        if (k > 0) {
+            memcpy(shapes + 6 * start[k], bands[k].shapes, (size_t)bands[k].count * 6 * sizeof(int64_t));
+        }
+    }
+    for (int64_t i = 0; i < total; i++) {
+        alias[i] = i;
+    }
+    for (int64_t k = 1; k < n_bands; k++) {
+        int64_t row = bands[k].first_row;
+        const int64_t *open_above = bands[k - 1].open_at;
+        for (int64_t i = start[k]; i < start[k + 1] && shapes[6 * i + TOP] == row; i++) {
+            int64_t *shape = shapes + 6 * i;
+            int64_t above = open_above[shape[LEFT]];
+            if (above < 0) {
+                continue;
+            }
+            above = alias[start[k - 1] + above];
+            int64_t *into = shapes + 6 * above;
+            if (into[BOTTOM] == row - 1 && into[RIGHT] == shape[RIGHT] && into[RADIUS] == shape[RADIUS]) {
+                into[BOTTOM] = shape[BOTTOM];
+                into[DIAGONALS] = 0;
+                alias[i] = above;
+            }
+        }
+    }
+    int64_t kept = 0;
+    for (int64_t i = 0; i < total; i++) {
+        if (alias[i] == i) {
+            memmove(shapes + 6 * kept, shapes + 6 * i, 6 * sizeof(int64_t));
+            kept += 1;
+        }
+    }
+    *count_out = kept;
+done:
+    for (int64_t k = 0; k < n_bands; k++) {
+        free(bands[k].shapes);
+        free(bands[k].open_at);
+    }
+    free(start);
+    free(alias);
+    return shapes;
 }
 
 KERNEL(centre_rectangles)

@@ -1,19 +1,53 @@
 /* MAORIS step 3 in C: flat zones, zone values and sizes, relabelling (port of ../kernels/flat_zones.py). */
 #include "kernels.h"
 
-/* 4-connected components of equal non-zero value, numbered 1..N in the raster order of their
- * first pixel, by one raster pass with union-find over provisional labels (a set's root is
- * always its smallest label). Returns 0, or -1 when out of memory. */
-static int label_zones(const uint8_t *restrict values, int32_t *restrict labels, int64_t rows, int64_t cols)
+/* One band of rows of the labelling: provisional labels 1..n, numbered in the raster order of
+ * the pixel that created them, with union-find parents (a set's root is always its smallest
+ * label), and each label's value and pixel count. */
+typedef struct {
+    const uint8_t *values;
+    int32_t *labels;
+    int64_t cols, first_row, end_row;
+    int32_t *parent;
+    uint8_t *value;
+    uint32_t *count; /* a band has fewer than 2^32 pixels (label_zones) */
+    int64_t n, capacity;
+    int failed, running;
+    pthread_t thread;
+} LabelBand;
+
+static int grow_band(LabelBand *b)
 {
-    int64_t capacity = 1024, n = 0;
-    int32_t *parent = malloc((size_t)capacity * sizeof(int32_t));
+    int64_t capacity = 2 * b->capacity;
+    int32_t *parent = realloc(b->parent, (size_t)capacity * sizeof(int32_t));
     if (parent == NULL) {
         return -1;
     }
-    for (int64_t row = 0; row < rows; row++) {
-        const uint8_t *line = values + row * cols;
-        int32_t *out = labels + row * cols;
+    b->parent = parent;
+    uint8_t *value = realloc(b->value, (size_t)capacity);
+    if (value == NULL) {
+        return -1;
+    }
+    b->value = value;
+    uint32_t *count = realloc(b->count, (size_t)capacity * sizeof(uint32_t));
+    if (count == NULL) {
+        return -1;
+    }
+    b->count = count;
+    b->capacity = capacity;
+    return 0;
+}
+
+/* One raster pass over the band's rows; the row above the band is not looked at (the bands
+ * are joined along their first rows afterwards). */
+static void label_band(LabelBand *b)
+{
+    const int64_t cols = b->cols;
+    int64_t n = 0;
+    for (int64_t row = b->first_row; row < b->end_row; row++) {
+        const uint8_t *line = b->values + row * cols;
+        int32_t *out = b->labels + row * cols;
+        const int has_up = row > b->first_row;
         for (int64_t col = 0; col < cols; col++) {
             uint8_t value = line[col];
             if (value == 0) {
@@ -21,51 +55,229 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
                 continue;
             }
             int64_t left = (col > 0 && line[col - 1] == value) ? out[col - 1] : 0;
-            int64_t up = (row > 0 && line[col - cols] == value) ? out[col - cols] : 0;
+            int64_t up = (has_up && line[col - cols] == value) ? out[col - cols] : 0;
             if (left == 0 && up == 0) {
                 n += 1;
-                if (n == capacity) {
-                    int32_t *grown = realloc(parent, (size_t)(2 * n) * sizeof(int32_t));
-                    if (grown == NULL) {
-                        free(parent);
-                        return -1;
-                    }
-                    parent = grown;
-                    capacity = 2 * n;
+                if (n == b->capacity && grow_band(b) < 0) {
+                    b->failed = 1;
+                    return;
                 }
-                parent[n] = (int32_t)n;
+                b->parent[n] = (int32_t)n;
+                b->value[n] = value;
+                b->count[n] = 1;
                 out[col] = (int32_t)n;
             } else {
-                out[col] = (int32_t)(left != 0 ? left : up);
-                if (left != 0 && up != 0) {
-                    int64_t a = zone_of(left, parent), b = zone_of(up, parent);
-                    if (a < b) {
-                        parent[b] = (int32_t)a;
-                    } else if (b < a) {
-                        parent[a] = (int32_t)b;
+                int64_t label = left != 0 ? left : up;
+                out[col] = (int32_t)label;
+                b->count[label] += 1;
+                if (left != 0 && up != 0 && left != up) {
+                    int64_t a = zone_of(left, b->parent), c = zone_of(up, b->parent);
+                    if (a < c) {
+                        b->parent[c] = (int32_t)a;
+                    } else if (c < a) {
+                        b->parent[a] = (int32_t)c;
                     }
                 }
             }
         }
     }
-    int32_t *final = calloc((size_t)(n + 1), sizeof(int32_t));
-    if (final == NULL) {
-        free(parent);
-        return -1;
+    b->n = n;
+}
+
+static void *label_band_run(void *arg)
+{
+    label_band(arg);
+    return NULL;
+}
+
+/* The second pass of one band: its provisional labels replaced by their zones (``lookup`` is
+ * indexed by the band's own labels; 0 stays 0). */
+typedef struct {
+    int32_t *labels;
+    int64_t first, end;
+    const int32_t *lookup;
+    int running;
+    pthread_t thread;
+} RelabelBand;
+
+static void relabel_band(RelabelBand *b)
+{
+    int32_t *labels = b->labels;
+    const int32_t *lookup = b->lookup;
+    for (int64_t i = b->first; i < b->end; i++) {
+        int32_t label = labels[i];
+        labels[i] = label != 0 ? lookup[label] : 0;
     }
-    int32_t zones = 0;
-    for (int64_t label = 1; label <= n; label++) {
-        int64_t root = zone_of(label, parent);
-        if (root == label) {
-            final[label] = ++zones;
-        } else {
-            final[label] = final[root];
+}
+
+static void *relabel_band_run(void *arg)
+{
+    relabel_band(arg);
+    return NULL;
+}
+
+/* Each zone's value and size (zone 0: no value, the pixels of no zone), as
+ * zone_values_and_sizes gives them; malloc'd, n_zones + 1 entries. */
+typedef struct {
+    int32_t *value;
+    int64_t *size;
+    int64_t n_zones;
+} ZoneStats;
+
+/* 4-connected components of equal non-zero value, numbered 1..N in the raster order of their
+ * first pixel. Large images are labelled in bands of rows, one thread each: each band by one
+ * raster pass with union-find over its own provisional labels, then the bands' labels are
+ * numbered one after another (which keeps the raster order of their creation), the sets are
+ * joined where equal values meet across a band's first row, and the roots (each set's smallest
+ * label: the one its first pixel created) numbered in order, as one pass over the whole image
+ * would. ``stats`` (or NULL): also the zones' values and sizes. Returns 0, or -1 when out of
+ * memory. */
+static int label_zones(const uint8_t *restrict values, int32_t *restrict labels, int64_t rows, int64_t cols,
+                       ZoneStats *stats)
+{
+    int64_t pixels = rows * cols;
+    int64_t n_bands = pixels >= BAND_MIN_PIXELS ? usable_cpus() : 1;
+    n_bands = n_bands < MAX_BANDS ? n_bands : MAX_BANDS;
+    /* Each band's pixel counts fit in 32 bits. */
+    while (n_bands < rows && ((rows + n_bands - 1) / n_bands) * cols >= (int64_t)UINT32_MAX) {
+        n_bands += 1;
+    }
+    n_bands = n_bands < rows ? n_bands : (rows > 0 ? rows : 1);
+    LabelBand *bands = calloc((size_t)n_bands, sizeof(LabelBand));
+    RelabelBand *passes = calloc((size_t)n_bands, sizeof(RelabelBand));
+    int64_t *offset = calloc((size_t)n_bands + 1, sizeof(int64_t));
+    int32_t *parent = NULL;
+    int status = -1;
+    if (bands == NULL || passes == NULL || offset == NULL) {
+        goto done;
+    }
+    for (int64_t k = 0; k < n_bands; k++) {
+        LabelBand *b = bands + k;
+        *b = (LabelBand){values, labels, cols, rows * k / n_bands, rows * (k + 1) / n_bands};
+        b->capacity = 1024;
+        b->parent = malloc((size_t)b->capacity * sizeof(int32_t));
+        b->value = malloc((size_t)b->capacity);
+        b->count = malloc((size_t)b->capacity * sizeof(uint32_t));
+        if (b->parent == NULL || b->value == NULL || b->count == NULL) {
+            goto done;
         }
     }
-    relabel_in_place(labels, rows * cols, final);
-    free(final);
+    for (int64_t k = 1; k < n_bands; k++) {
+        bands[k].running = pthread_create(&bands[k].thread, NULL, label_band_run, &bands[k]) == 0;
+    }
+    label_band(&bands[0]);
+    for (int64_t k = 1; k < n_bands; k++) {
+        if (bands[k].running) {
+            pthread_join(bands[k].thread, NULL);
+        } else {
+            label_band(&bands[k]); /* no thread: here */
+        }
+    }
+    for (int64_t k = 0; k < n_bands; k++) {
+        if (bands[k].failed) {
+            goto done;
+        }
+        offset[k + 1] = offset[k] + bands[k].n;
+    }
+    int64_t total = offset[n_bands];
+    if (total >= INT32_MAX) {
+        goto done;
+    }
+    /* The bands' labels one after another (band k's label i is offset[k] + i), in the first
+     * band's parents grown to hold them all: at 8000 x 8000 px each array of one entry per label
+     * is about 28 MB, and the step's peak memory is that of the zone graph's build next. */
+    parent = realloc(bands[0].parent, (size_t)(total + 1) * sizeof(int32_t));
+    if (parent == NULL) {
+        goto done;
+    }
+    bands[0].parent = NULL;
+    parent[0] = 0;
+    for (int64_t k = 1; k < n_bands; k++) {
+        for (int64_t i = 1; i <= bands[k].n; i++) {
+            parent[offset[k] + i] = (int32_t)(offset[k] + bands[k].parent[i]);
+        }
+        free(bands[k].parent);
+        bands[k].parent = NULL;
+    }
+    for (int64_t k = 1; k < n_bands; k++) {
+        int64_t row = bands[k].first_row;
+        const uint8_t *line = values + row * cols;
+        const int32_t *here = labels + row * cols;
+        for (int64_t col = 0; col < cols; col++) {
+            if (line[col] != 0 && line[col - cols] == line[col]) {
+                int64_t a = zone_of(offset[k] + here[col], parent);
+                int64_t c = zone_of(offset[k - 1] + here[col - cols], parent);
+                if (a < c) {
+                    parent[c] = (int32_t)a;
+                } else if (c < a) {
+                    parent[a] = (int32_t)c;
+                }
+            }
+        }
+    }
+    /* Each label's zone, written over its parent: a label's parent is a smaller label, whose
+     * entry already holds their set's zone. */
+    int32_t zones = 0;
+    for (int64_t label = 1; label <= total; label++) {
+        parent[label] = parent[label] == label ? ++zones : parent[parent[label]];
+    }
+    for (int64_t k = 0; k < n_bands; k++) {
+        passes[k] = (RelabelBand){labels, bands[k].first_row * cols, bands[k].end_row * cols, parent + offset[k]};
+    }
+    for (int64_t k = 1; k < n_bands; k++) {
+        passes[k].running = pthread_create(&passes[k].thread, NULL, relabel_band_run, &passes[k]) == 0;
+    }
+    relabel_band(&passes[0]);
+    for (int64_t k = 1; k < n_bands; k++) {
+        if (passes[k].running) {
+            pthread_join(passes[k].thread, NULL);
+        } else {
+            relabel_band(&passes[k]);
+        }
+    }
+    if (stats != NULL) {
+        stats->n_zones = zones;
+        stats->size = calloc((size_t)zones + 1, sizeof(int64_t));
+        if (stats->size == NULL) {
+            goto done;
+        }
+        int64_t counted = 0;
+        for (int64_t k = 0; k < n_bands; k++) {
+            for (int64_t i = 1; i <= bands[k].n; i++) {
+                stats->size[parent[offset[k] + i]] += bands[k].count[i];
+                counted += bands[k].count[i];
+            }
+            free(bands[k].count);
+            bands[k].count = NULL;
+        }
+        stats->size[0] = pixels - counted;
+        /* The values written over the zones, in the same array: label g's zone is at most g, so
+         * its entry is written after every label up to it was read. */
+        for (int64_t k = 0; k < n_bands; k++) {
+            for (int64_t i = 1; i <= bands[k].n; i++) {
+                int64_t g = offset[k] + i;
+                parent[parent[g]] = bands[k].value[i];
+            }
+        }
+        parent[0] = 0;
+        int32_t *value = realloc(parent, ((size_t)zones + 1) * sizeof(int32_t));
+        stats->value = value != NULL ? value : parent;
+        parent = NULL;
+    }
+    status = 0;
+done:
+    if (bands != NULL) {
+        for (int64_t k = 0; k < n_bands; k++) {
+            free(bands[k].parent);
+            free(bands[k].value);
+            free(bands[k].count);
+        }
+    }
+    free(bands);
+    free(passes);
+    free(offset);
     free(parent);
-    return 0;
+    return status;
 }
 
 KERNEL(label_flat_zones)
@@ -81,13 +293,52 @@ KERNEL(label_flat_zones)
     }
     int failed;
     Py_BEGIN_ALLOW_THREADS
-    failed = label_zones(values.data, labels.data, values.rows, values.cols);
+    failed = label_zones(values.data, labels.data, values.rows, values.cols, NULL);
     Py_END_ALLOW_THREADS
     if (failed) {
         return PyErr_NoMemory();
     }
     Py_INCREF(args[1]);
     return args[1];
+}
+
+/* label_flat_zones, and the zones' values and sizes (zone_values_and_sizes of its labels)
+ * counted in the same passes: one pass over the image fewer. */
+KERNEL(label_flat_zones_counted)
+{
+    Array values, labels;
+    if (check_nargs("label_flat_zones_counted", nargs, 2)
+        || array_arg(args[0], NPY_UINT8, 2, 0, "values", &values)
+        || array_arg(args[1], NPY_INT32, 2, 0, "labels", &labels)) {
+        return NULL;
+    }
+    if (labels.rows != values.rows || labels.cols != values.cols) {
+        PyErr_SetString(PyExc_ValueError, "label_flat_zones_counted: values and labels differ in shape");
+        return NULL;
+    }
+    ZoneStats stats = {NULL, NULL, 0};
+    int failed;
+    Py_BEGIN_ALLOW_THREADS
+    failed = label_zones(values.data, labels.data, values.rows, values.cols, &stats);
+    Py_END_ALLOW_THREADS
+    if (failed) {
+        free(stats.value);
+        free(stats.size);
+        return PyErr_NoMemory();
+    }
+    npy_intp dims[1] = {stats.n_zones + 1};
+    PyObject *value = array_owning(stats.value, 1, dims, NPY_INT32);
+    if (value == NULL) {
+        free(stats.size);
+        return NULL;
+    }
+    PyObject *size = array_owning(stats.size, 1, dims, NPY_INT64);
+    if (size == NULL) {
+        Py_DECREF(value);
+        return NULL;
+    }
+    Py_INCREF(args[1]);
+    return Py_BuildValue("(NNN)", args[1], value, size);
 }
 
 KERNEL(zone_values_and_sizes)

@@ -12,8 +12,11 @@
 /* discs.c */
 KERNEL(centre_rectangles);
 KERNEL(paint_discs);
+/* values.c */
+KERNEL(lookup_bytes);
 /* flat_zones.c */
 KERNEL(label_flat_zones);
+KERNEL(label_flat_zones_counted);
 KERNEL(zone_values_and_sizes);
 KERNEL(first_pixels);
 KERNEL(resolve_parents);

@@ -294,3 +294,15 @@ def _uncovered_pieces(largest_reach):
                         count += 1
             piece_start[3 * reach + neighbours] = count
     return piece_start, piece_distance, piece_from, piece_to
+
+
+@njit(cache=True)
+def lookup_bytes(values, lo, table, out):
+    """``out[p] = table[values[p] - lo]`` for every pixel p of an int32 image (MAORIS step 2:
+    the radii mapped to the value image); IndexError when a value is outside the table."""
+    for row in range(values.shape[0]):
+        for col in range(values.shape[1]):
+            index = values[row, col] - lo
+            if index < 0 or index >= len(table):
+                raise IndexError("lookup_bytes: a value is outside lo .. lo + len(table) - 1")
+            out[row, col] = table[index]

@@ -70,6 +70,19 @@ def zone_values_and_sizes(zones, values, count):
 
 
 @njit(cache=True)
+def label_flat_zones_counted(values, labels):
+    """:func:`label_flat_zones`, and :func:`zone_values_and_sizes` of its labels (zones 0..N):
+    ``(labels, value, size)``. The C kernel counts them in the labelling's own passes."""
+    label_flat_zones(values, labels)
+    count = 1
+    for row in range(labels.shape[0]):
+        for col in range(labels.shape[1]):
+            count = max(count, labels[row, col] + 1)
+    value, size = zone_values_and_sizes(labels, values, count)
+    return labels, value, size
+
+
+@njit(cache=True)
 def first_pixels(labels, count):
     """Flat index of the first pixel (raster order) of each label 1..count - 1, -1 if absent."""
     first = _filled(count, -1, np.int64)

@@ -15,7 +15,7 @@ from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, f
 
 __all__ = ["SIGNATURES", "RETURN_TYPES", "GROUPS", "compile_group"]
 
-_I32, _I64, _BOOL = types.int32[::1], types.int64[::1], types.bool_[::1]
+_I32, _I64, _BOOL, _U8 = types.int32[::1], types.int64[::1], types.bool_[::1], types.uint8[::1]
 _I32_2D, _I64_2D = types.int32[:, ::1], types.int64[:, ::1]
 _F32_2D, _U8_2D, _U32_2D = types.float32[:, ::1], types.uint8[:, ::1], types.uint32[:, ::1]
 _U8_2D_ANY = types.uint8[:, :]
@@ -31,7 +31,9 @@ _TRACKING = types.Tuple((_I32, _I32, _STATE))
 SIGNATURES: dict[tuple[str, str], tuple] = {
     ("discs", "centre_rectangles"): (_F32_2D, _INT),
     ("discs", "paint_discs"): (_I64_2D, _U8_2D_ANY, _I32_2D),
+    ("discs", "lookup_bytes"): (_I32_2D, _INT, _U8, _U8_2D),
     ("flat_zones", "label_flat_zones"): (_U8_2D, _I32_2D),
+    ("flat_zones", "label_flat_zones_counted"): (_U8_2D, _I32_2D),
     ("flat_zones", "zone_values_and_sizes"): (_I32_2D, _U8_2D, _INT),
     ("flat_zones", "first_pixels"): (_I32_2D, _INT),
     ("flat_zones", "resolve_parents"): (_I32, _BOOL),
@@ -59,7 +61,9 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
 RETURN_TYPES: dict[tuple[str, str], types.Type] = {
     ("discs", "centre_rectangles"): _I64_2D,
     ("discs", "paint_discs"): types.none,
+    ("discs", "lookup_bytes"): types.none,
     ("flat_zones", "label_flat_zones"): _I32_2D,
+    ("flat_zones", "label_flat_zones_counted"): types.Tuple((_I32_2D, _I32, _I64)),
     ("flat_zones", "zone_values_and_sizes"): types.Tuple((_I32, _I64)),
     ("flat_zones", "first_pixels"): _I64,
     ("flat_zones", "resolve_parents"): types.none,
