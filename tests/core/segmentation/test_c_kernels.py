@@ -356,3 +356,20 @@ def test_values_looked_up_in_parts_are_the_tables_and_out_of_table_ones_refused(
     for kernel in (c_module.lookup_bytes, discs.lookup_bytes):
         with pytest.raises(IndexError, match="outside"):
             kernel(values, -3, table, got)
+
+
+def test_first_pixels_found_in_parts_are_numbas(c_module):
+    """The first pixel of each label, in an image of 2**21 px and more looked at in parts on
+    threads, is numba's (one pass): also for labels only in a later part, and absent ones."""
+    from ursim_core.segmentation.maoris.kernels import flat_zones
+
+    _bands_run_here()
+    rng = np.random.default_rng(5)
+    labels = rng.integers(0, 5000, (2048, 1100)).astype(np.int32)
+    labels[1500:, :] = rng.integers(5000, 6000, (548, 1100))  # only in the last part
+    got, want = c_module.first_pixels(labels, 6100), flat_zones.first_pixels(labels, 6100)
+    assert np.array_equal(got, want)
+    assert (got[6000:] == -1).all() and got[5000] >= 1500 * 1100
+    labels[-1, -1] = 6100
+    with pytest.raises(IndexError, match="outside"):
+        c_module.first_pixels(labels, 6100)

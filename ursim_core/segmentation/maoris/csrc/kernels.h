@@ -14,7 +14,7 @@ KERNEL(centre_rectangles);
 KERNEL(paint_discs);
 /* values.c */
 KERNEL(lookup_bytes);
-/* flat_zones.c */
+/* flat_zones.c, relabelling.c */
 KERNEL(label_flat_zones);
 KERNEL(label_flat_zones_counted);
 KERNEL(zone_values_and_sizes);
