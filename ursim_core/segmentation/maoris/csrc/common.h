@@ -313,52 +313,80 @@ static inline int64_t usable_cpus(void)
     return 1;
 }
 
+/* How many parts, one thread each, a pass over ``pixels`` pixels is split into: one per usable
+ * CPU from BAND_MIN_PIXELS on, at most MAX_BANDS and ``most`` (e.g. the rows), at least one. */
+static inline int64_t parts_for(int64_t pixels, int64_t most)
+{
+    int64_t n = pixels >= BAND_MIN_PIXELS ? usable_cpus() : 1;
+    n = n < MAX_BANDS ? n : MAX_BANDS;
+    n = n < most ? n : most;
+    return n > 0 ? n : 1;
+}
+
+/* ``work(item)`` for each of the ``n`` items of ``size`` bytes at ``items``: the first on this
+ * thread, every other on a thread of its own (or on this one afterwards, when a thread cannot
+ * start, or no memory is left to start them). Returns when all are done. */
+static inline void run_parts(void *items, int64_t n, size_t size, void *(*work)(void *))
+{
+    char *item = items;
+    pthread_t few_threads[MAX_BANDS];
+    int few_running[MAX_BANDS] = {0};
+    pthread_t *threads = n <= MAX_BANDS ? few_threads : malloc((size_t)n * sizeof(pthread_t));
+    int *running = n <= MAX_BANDS ? few_running : calloc((size_t)n, sizeof(int));
+    if (threads == NULL || running == NULL) {
+        for (int64_t k = 0; k < n; k++) {
+            work(item + k * size);
+        }
+    } else {
+        for (int64_t k = 1; k < n; k++) {
+            running[k] = pthread_create(&threads[k], NULL, work, item + k * size) == 0;
+        }
+        if (n > 0) {
+            work(item);
+        }
+        for (int64_t k = 1; k < n; k++) {
+            if (running[k]) {
+                pthread_join(threads[k], NULL);
+            } else {
+                work(item + k * size);
+            }
+        }
+    }
+    if (threads != few_threads) {
+        free(threads);
+        free(running);
+    }
+}
+
 /* A part of relabel_in_place's work, for a thread. */
 typedef struct {
     int32_t *labels;
     int64_t first, end;
     const int32_t *lookup;
-    pthread_t thread;
-    int running;
 } RelabelPart;
 
-static inline void relabel_part(RelabelPart *part)
+static void *relabel_part(void *arg)
 {
+    RelabelPart *part = arg;
     int32_t *labels = part->labels;
     const int32_t *lookup = part->lookup;
     for (int64_t i = part->first; i < part->end; i++) {
         labels[i] = lookup[labels[i]];
     }
-}
-
-static void *relabel_part_run(void *arg)
-{
-    relabel_part(arg);
     return NULL;
 }
 
 /* flat_zones.relabel's loop, ``labels[i] = lookup[labels[i]]`` for i < n (also used by contacts
- * and fusion): from BAND_MIN_PIXELS labels on, in parts, one thread each (at 8000 x 8000 px a
- * pass reads and writes 256 MB and is bound by one core's memory traffic). */
+ * and fusion): in parts on threads (parts_for; at 8000 x 8000 px a pass reads and writes 256 MB
+ * and is bound by one core's memory traffic). */
 static inline void relabel_in_place(int32_t *labels, int64_t n, const int32_t *lookup)
 {
-    int64_t n_parts = n >= BAND_MIN_PIXELS ? usable_cpus() : 1;
-    n_parts = n_parts < MAX_BANDS ? n_parts : MAX_BANDS;
+    int64_t n_parts = parts_for(n, n);
     RelabelPart parts[MAX_BANDS];
     for (int64_t k = 0; k < n_parts; k++) {
         parts[k] = (RelabelPart){labels, n * k / n_parts, n * (k + 1) / n_parts, lookup};
     }
-    for (int64_t k = 1; k < n_parts; k++) {
-        parts[k].running = pthread_create(&parts[k].thread, NULL, relabel_part_run, &parts[k]) == 0;
-    }
-    relabel_part(&parts[0]);
-    for (int64_t k = 1; k < n_parts; k++) {
-        if (parts[k].running) {
-            pthread_join(parts[k].thread, NULL);
-        } else {
-            relabel_part(&parts[k]);
-        }
-    }
+    run_parts(parts, n_parts, sizeof(RelabelPart), relabel_part);
 }
 
 #endif

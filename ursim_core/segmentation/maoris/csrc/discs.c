@@ -28,25 +28,31 @@ static void load_radii(const float *dist_row, int64_t cols, int64_t max_radius, 
 typedef struct {
     const float *dist;
     int64_t rows, cols, max_radius, first_row, end_row;
-    int64_t *shapes, count, *open_at;
-    int failed, running;
-    pthread_t thread;
+    int64_t *shapes, capacity, count, *open_at;
+    int32_t *ring, *centre_radius;
+    int failed;
 } CentreBand;
 
-static void centre_band(CentreBand *b)
+/* A band's buffers, allocated on the calling thread: glibc keeps what a thread allocates in
+ * that thread's arena, where it stays resident once freed (the band's realloc keeps its arena). */
+static int centre_band_buffers(CentreBand *b)
 {
+    int64_t cols = b->cols, band_pixels = (b->end_row - b->first_row) * cols;
+    b->capacity = band_pixels / 64 > 16 ? band_pixels / 64 : 16;
+    b->ring = calloc((size_t)(3 * (cols + 2)), sizeof(int32_t));
+    b->centre_radius = calloc((size_t)(cols + 1), sizeof(int32_t));
+    b->open_at = malloc((size_t)(cols > 0 ? cols : 1) * sizeof(int64_t));
+    b->shapes = malloc((size_t)b->capacity * 6 * sizeof(int64_t));
+    return b->ring == NULL || b->centre_radius == NULL || b->open_at == NULL || b->shapes == NULL ? -1 : 0;
+}
+
+static void *centre_band(void *arg)
+{
+    CentreBand *b = arg;
     const float *dist = b->dist;
     int64_t rows = b->rows, cols = b->cols, max_radius = b->max_radius;
-    int32_t *ring = calloc((size_t)(3 * (cols + 2)), sizeof(int32_t));
-    int32_t *centre_radius = calloc((size_t)(cols + 1), sizeof(int32_t));
-    int64_t *open_at = malloc((size_t)(cols > 0 ? cols : 1) * sizeof(int64_t));
-    int64_t band_pixels = (b->end_row - b->first_row) * cols;
-    int64_t capacity = band_pixels / 64 > 16 ? band_pixels / 64 : 16;
-    int64_t *shapes = malloc((size_t)capacity * 6 * sizeof(int64_t));
-    int64_t count = 0;
-    if (ring == NULL || centre_radius == NULL || open_at == NULL || shapes == NULL) {
-        goto fail;
-    }
+    int32_t *ring = b->ring, *centre_radius = b->centre_radius;
+    int64_t *open_at = b->open_at, *shapes = b->shapes, capacity = b->capacity, count = 0;
     int64_t first = b->first_row;
     if (first > 0) {
         load_radii(dist + (first - 1) * cols, cols, max_radius, ring + ((first + 2) % 3) * (cols + 2));
@@ -116,23 +122,12 @@ static void centre_band(CentreBand *b)
             col = last + 1;
         }
     }
-    free(ring);
-    free(centre_radius);
     b->shapes = shapes;
     b->count = count;
-    b->open_at = open_at;
-    return;
+    return NULL;
 fail:
-    free(ring);
-    free(centre_radius);
-    free(open_at);
-    free(shapes);
+    b->shapes = shapes; /* freed by the caller */
     b->failed = 1;
-}
-
-static void *centre_band_run(void *arg)
-{
-    centre_band(arg);
     return NULL;
 }
 
@@ -143,27 +138,21 @@ static void *centre_band_run(void *arg)
  * scan of all rows would have grown it: the same rectangles in the same order. */
 static int64_t *centre_rectangles(const float *dist, int64_t rows, int64_t cols, int64_t max_radius, int64_t *count_out)
 {
-    int64_t n_bands = rows * cols >= BAND_MIN_PIXELS ? usable_cpus() : 1;
-    n_bands = n_bands < MAX_BANDS ? n_bands : MAX_BANDS;
-    n_bands = n_bands < rows ? n_bands : (rows > 0 ? rows : 1);
+    int64_t n_bands = parts_for(rows * cols, rows);
     CentreBand bands[MAX_BANDS];
+    int failed = 0;
     for (int64_t k = 0; k < n_bands; k++) {
         bands[k] = (CentreBand){dist, rows, cols, max_radius, rows * k / n_bands, rows * (k + 1) / n_bands};
-    }
-    for (int64_t k = 1; k < n_bands; k++) {
-        bands[k].running = pthread_create(&bands[k].thread, NULL, centre_band_run, &bands[k]) == 0;
-    }
-    centre_band(&bands[0]);
-    int failed = bands[0].failed;
-    for (int64_t k = 1; k < n_bands; k++) {
-        if (bands[k].running) {
-            pthread_join(bands[k].thread, NULL);
-        } else {
-            centre_band(&bands[k]); /* no thread: here */
-        }
-        failed |= bands[k].failed;
+        failed |= centre_band_buffers(&bands[k]) < 0;
     }
     int64_t *shapes = NULL, *start = NULL, *alias = NULL, total = 0;
+    if (failed) {
+        goto done;
+    }
+    run_parts(bands, n_bands, sizeof(CentreBand), centre_band);
+    for (int64_t k = 0; k < n_bands; k++) {
+        failed |= bands[k].failed;
+    }
     if (failed) {
         goto done;
     }
@@ -225,6 +214,8 @@ done:
     for (int64_t k = 0; k < n_bands; k++) {
         free(bands[k].shapes);
         free(bands[k].open_at);
+        free(bands[k].ring);
+        free(bands[k].centre_radius);
     }
     free(start);
     free(alias);
@@ -328,8 +319,6 @@ typedef struct {
 typedef struct {
     const Painting *painting;
     int64_t first_row, end_row;
-    pthread_t thread;
-    int running;
 } Band;
 
 static void paint_band(const Painting *p, int64_t first_row, int64_t end_row)
@@ -416,24 +405,12 @@ static int paint(const int64_t *shapes, int64_t n, const Array *free_mask, int32
         Painting painting = {shapes, n, rows, cols, reach_cap, trimmed_reach_limit, &pieces, free_mask, out};
         /* Large images are painted in bands of rows, one thread each (the bands write
          * different rows); smaller ones on this thread, where starting threads costs more. */
-        int64_t n_bands = rows * cols >= BAND_MIN_PIXELS ? usable_cpus() : 1;
-        n_bands = n_bands < MAX_BANDS ? n_bands : MAX_BANDS;
-        n_bands = n_bands < rows ? n_bands : (rows > 0 ? rows : 1);
+        int64_t n_bands = parts_for(rows * cols, rows);
         Band bands[MAX_BANDS];
         for (int64_t k = 0; k < n_bands; k++) {
-            bands[k] = (Band){&painting, rows * k / n_bands, rows * (k + 1) / n_bands, 0, 0};
+            bands[k] = (Band){&painting, rows * k / n_bands, rows * (k + 1) / n_bands};
         }
-        for (int64_t k = 1; k < n_bands; k++) {
-            bands[k].running = pthread_create(&bands[k].thread, NULL, paint_band_run, &bands[k]) == 0;
-        }
-        paint_band(&painting, bands[0].first_row, bands[0].end_row);
-        for (int64_t k = 1; k < n_bands; k++) {
-            if (bands[k].running) {
-                pthread_join(bands[k].thread, NULL);
-            } else {
-                paint_band(&painting, bands[k].first_row, bands[k].end_row); /* no thread: here */
-            }
-        }
+        run_parts(bands, n_bands, sizeof(Band), paint_band_run);
     }
     free(pieces.start);
     free(pieces.distance);

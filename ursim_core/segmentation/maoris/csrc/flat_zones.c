@@ -12,8 +12,7 @@ typedef struct {
     uint8_t *value;
     uint32_t *count; /* a band has fewer than 2^32 pixels (label_zones) */
     int64_t n, capacity;
-    int failed, running;
-    pthread_t thread;
+    int failed;
 } LabelBand;
 
 static int grow_band(LabelBand *b)
@@ -40,8 +39,9 @@ static int grow_band(LabelBand *b)
 
 /* One raster pass over the band's rows; the row above the band is not looked at (the bands
  * are joined along their first rows afterwards). */
-static void label_band(LabelBand *b)
+static void *label_band(void *arg)
 {
+    LabelBand *b = arg;
     const int64_t cols = b->cols;
     int64_t n = 0;
     for (int64_t row = b->first_row; row < b->end_row; row++) {
@@ -60,7 +60,7 @@ static void label_band(LabelBand *b)
                 n += 1;
                 if (n == b->capacity && grow_band(b) < 0) {
                     b->failed = 1;
-                    return;
+                    return NULL;
                 }
                 b->parent[n] = (int32_t)n;
                 b->value[n] = value;
@@ -82,11 +82,6 @@ static void label_band(LabelBand *b)
         }
     }
     b->n = n;
-}
-
-static void *label_band_run(void *arg)
-{
-    label_band(arg);
     return NULL;
 }
 
@@ -96,23 +91,17 @@ typedef struct {
     int32_t *labels;
     int64_t first, end;
     const int32_t *lookup;
-    int running;
-    pthread_t thread;
 } RelabelBand;
 
-static void relabel_band(RelabelBand *b)
+static void *relabel_band(void *arg)
 {
+    RelabelBand *b = arg;
     int32_t *labels = b->labels;
     const int32_t *lookup = b->lookup;
     for (int64_t i = b->first; i < b->end; i++) {
         int32_t label = labels[i];
         labels[i] = label != 0 ? lookup[label] : 0;
     }
-}
-
-static void *relabel_band_run(void *arg)
-{
-    relabel_band(arg);
     return NULL;
 }
 
@@ -136,13 +125,12 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
                        ZoneStats *stats)
 {
     int64_t pixels = rows * cols;
-    int64_t n_bands = pixels >= BAND_MIN_PIXELS ? usable_cpus() : 1;
-    n_bands = n_bands < MAX_BANDS ? n_bands : MAX_BANDS;
-    /* Each band's pixel counts fit in 32 bits. */
+    int64_t n_bands = parts_for(pixels, rows);
+    /* Each band's pixel counts fit in 32 bits (more bands than MAX_BANDS for images of over
+     * 17 Gpx: run_parts starts them all). */
     while (n_bands < rows && ((rows + n_bands - 1) / n_bands) * cols >= (int64_t)UINT32_MAX) {
         n_bands += 1;
     }
-    n_bands = n_bands < rows ? n_bands : (rows > 0 ? rows : 1);
     LabelBand *bands = calloc((size_t)n_bands, sizeof(LabelBand));
     RelabelBand *passes = calloc((size_t)n_bands, sizeof(RelabelBand));
     int64_t *offset = calloc((size_t)n_bands + 1, sizeof(int64_t));
@@ -162,17 +150,7 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
             goto done;
         }
     }
-    for (int64_t k = 1; k < n_bands; k++) {
-        bands[k].running = pthread_create(&bands[k].thread, NULL, label_band_run, &bands[k]) == 0;
-    }
-    label_band(&bands[0]);
-    for (int64_t k = 1; k < n_bands; k++) {
-        if (bands[k].running) {
-            pthread_join(bands[k].thread, NULL);
-        } else {
-            label_band(&bands[k]); /* no thread: here */
-        }
-    }
+    run_parts(bands, n_bands, sizeof(LabelBand), label_band);
     for (int64_t k = 0; k < n_bands; k++) {
         if (bands[k].failed) {
             goto done;
@@ -224,17 +202,7 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
     for (int64_t k = 0; k < n_bands; k++) {
         passes[k] = (RelabelBand){labels, bands[k].first_row * cols, bands[k].end_row * cols, parent + offset[k]};
     }
-    for (int64_t k = 1; k < n_bands; k++) {
-        passes[k].running = pthread_create(&passes[k].thread, NULL, relabel_band_run, &passes[k]) == 0;
-    }
-    relabel_band(&passes[0]);
-    for (int64_t k = 1; k < n_bands; k++) {
-        if (passes[k].running) {
-            pthread_join(passes[k].thread, NULL);
-        } else {
-            relabel_band(&passes[k]);
-        }
-    }
+    run_parts(passes, n_bands, sizeof(RelabelBand), relabel_band);
     if (stats != NULL) {
         stats->n_zones = zones;
         stats->size = calloc((size_t)zones + 1, sizeof(int64_t));

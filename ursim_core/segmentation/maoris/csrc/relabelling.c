@@ -7,12 +7,12 @@
 typedef struct {
     const int32_t *labels;
     int64_t first, end, count, *out;
-    int bad, running;
-    pthread_t thread;
+    int bad;
 } FirstPart;
 
-static void first_part(FirstPart *p)
+static void *first_part(void *arg)
 {
+    FirstPart *p = arg;
     int64_t *out = p->out;
     for (int64_t i = 0; i < p->count; i++) {
         out[i] = -1;
@@ -21,17 +21,12 @@ static void first_part(FirstPart *p)
         int64_t label = p->labels[i];
         if (label < 0 || label >= p->count) {
             p->bad = 1;
-            return;
+            return NULL;
         }
         if (out[label] == -1) {
             out[label] = i;
         }
     }
-}
-
-static void *first_part_run(void *arg)
-{
-    first_part(arg);
     return NULL;
 }
 
@@ -55,8 +50,7 @@ KERNEL(first_pixels)
         return NULL;
     }
     int64_t *out = PyArray_DATA(first), n = labels.size;
-    int64_t n_parts = n >= BAND_MIN_PIXELS && count <= n / 16 ? usable_cpus() : 1;
-    n_parts = n_parts < MAX_BANDS ? n_parts : MAX_BANDS;
+    int64_t n_parts = count <= n / 16 ? parts_for(n, n) : 1;
     FirstPart parts[MAX_BANDS];
     int bad = 0, failed = 0;
     Py_BEGIN_ALLOW_THREADS
@@ -69,19 +63,7 @@ KERNEL(first_pixels)
             break;
         }
     }
-    for (int64_t k = 1; k < n_parts; k++) {
-        parts[k].running = pthread_create(&parts[k].thread, NULL, first_part_run, &parts[k]) == 0;
-    }
-    if (n_parts > 0) {
-        first_part(&parts[0]);
-    }
-    for (int64_t k = 1; k < n_parts; k++) {
-        if (parts[k].running) {
-            pthread_join(parts[k].thread, NULL);
-        } else {
-            first_part(&parts[k]);
-        }
-    }
+    run_parts(parts, n_parts, sizeof(FirstPart), first_part);
     for (int64_t k = 0; k < n_parts; k++) {
         bad |= parts[k].bad;
     }

@@ -9,12 +9,12 @@ typedef struct {
     uint8_t *out;
     int64_t first, end, lo, n_table;
     const uint8_t *table;
-    int bad, running;
-    pthread_t thread;
+    int bad;
 } LookupPart;
 
-static void lookup_part(LookupPart *p)
+static void *lookup_part(void *arg)
 {
+    LookupPart *p = arg;
     const int32_t *values = p->values;
     uint8_t *out = p->out;
     const uint8_t *table = p->table;
@@ -24,15 +24,10 @@ static void lookup_part(LookupPart *p)
         uint64_t index = (uint64_t)((int64_t)values[i] - lo);
         if (index >= n_table) {
             p->bad = 1;
-            return;
+            return NULL;
         }
         out[i] = table[index];
     }
-}
-
-static void *lookup_part_run(void *arg)
-{
-    lookup_part(arg);
     return NULL;
 }
 
@@ -52,8 +47,7 @@ KERNEL(lookup_bytes)
         return NULL;
     }
     int64_t n = values.size;
-    int64_t n_parts = n >= BAND_MIN_PIXELS ? usable_cpus() : 1;
-    n_parts = n_parts < MAX_BANDS ? n_parts : MAX_BANDS;
+    int64_t n_parts = parts_for(n, n);
     LookupPart parts[MAX_BANDS];
     int bad = 0;
     Py_BEGIN_ALLOW_THREADS
@@ -61,17 +55,7 @@ KERNEL(lookup_bytes)
         parts[k] = (LookupPart){values.data, out.data, n * k / n_parts, n * (k + 1) / n_parts, lo, table.size,
                                 table.data};
     }
-    for (int64_t k = 1; k < n_parts; k++) {
-        parts[k].running = pthread_create(&parts[k].thread, NULL, lookup_part_run, &parts[k]) == 0;
-    }
-    lookup_part(&parts[0]);
-    for (int64_t k = 1; k < n_parts; k++) {
-        if (parts[k].running) {
-            pthread_join(parts[k].thread, NULL);
-        } else {
-            lookup_part(&parts[k]);
-        }
-    }
+    run_parts(parts, n_parts, sizeof(LookupPart), lookup_part);
     for (int64_t k = 0; k < n_parts; k++) {
         bad |= parts[k].bad;
     }
