@@ -358,11 +358,14 @@ static inline void run_parts(void *items, int64_t n, size_t size, void *(*work)(
     }
 }
 
-/* A part of relabel_in_place's work, for a thread. */
+/* A part of a relabelling, for a thread: labels[i] = lookup[labels[i]] for first <= i < end,
+ * except that with ``keep_zero`` 0 stays 0 whatever lookup[0] is (a band's own lookup, which
+ * is a window of a larger one). */
 typedef struct {
     int32_t *labels;
     int64_t first, end;
     const int32_t *lookup;
+    int keep_zero;
 } RelabelPart;
 
 static void *relabel_part(void *arg)
@@ -370,8 +373,15 @@ static void *relabel_part(void *arg)
     RelabelPart *part = arg;
     int32_t *labels = part->labels;
     const int32_t *lookup = part->lookup;
-    for (int64_t i = part->first; i < part->end; i++) {
-        labels[i] = lookup[labels[i]];
+    if (part->keep_zero) {
+        for (int64_t i = part->first; i < part->end; i++) {
+            int32_t label = labels[i];
+            labels[i] = label != 0 ? lookup[label] : 0;
+        }
+    } else {
+        for (int64_t i = part->first; i < part->end; i++) {
+            labels[i] = lookup[labels[i]];
+        }
     }
     return NULL;
 }
@@ -384,7 +394,7 @@ static inline void relabel_in_place(int32_t *labels, int64_t n, const int32_t *l
     int64_t n_parts = parts_for(n, n);
     RelabelPart parts[MAX_BANDS];
     for (int64_t k = 0; k < n_parts; k++) {
-        parts[k] = (RelabelPart){labels, n * k / n_parts, n * (k + 1) / n_parts, lookup};
+        parts[k] = (RelabelPart){labels, n * k / n_parts, n * (k + 1) / n_parts, lookup, 0};
     }
     run_parts(parts, n_parts, sizeof(RelabelPart), relabel_part);
 }

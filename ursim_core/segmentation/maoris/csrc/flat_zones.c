@@ -85,26 +85,6 @@ static void *label_band(void *arg)
     return NULL;
 }
 
-/* The second pass of one band: its provisional labels replaced by their zones (``lookup`` is
- * indexed by the band's own labels; 0 stays 0). */
-typedef struct {
-    int32_t *labels;
-    int64_t first, end;
-    const int32_t *lookup;
-} RelabelBand;
-
-static void *relabel_band(void *arg)
-{
-    RelabelBand *b = arg;
-    int32_t *labels = b->labels;
-    const int32_t *lookup = b->lookup;
-    for (int64_t i = b->first; i < b->end; i++) {
-        int32_t label = labels[i];
-        labels[i] = label != 0 ? lookup[label] : 0;
-    }
-    return NULL;
-}
-
 /* Each zone's value and size (zone 0: no value, the pixels of no zone), as
  * zone_values_and_sizes gives them; malloc'd, n_zones + 1 entries. */
 typedef struct {
@@ -132,7 +112,7 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
         n_bands += 1;
     }
     LabelBand *bands = calloc((size_t)n_bands, sizeof(LabelBand));
-    RelabelBand *passes = calloc((size_t)n_bands, sizeof(RelabelBand));
+    RelabelPart *passes = calloc((size_t)n_bands, sizeof(RelabelPart));
     int64_t *offset = calloc((size_t)n_bands + 1, sizeof(int64_t));
     int32_t *parent = NULL;
     int status = -1;
@@ -200,9 +180,10 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
         parent[label] = parent[label] == label ? ++zones : parent[parent[label]];
     }
     for (int64_t k = 0; k < n_bands; k++) {
-        passes[k] = (RelabelBand){labels, bands[k].first_row * cols, bands[k].end_row * cols, parent + offset[k]};
+        /* Band k's labels by its own lookup, a window of the whole one: 0 stays 0. */
+        passes[k] = (RelabelPart){labels, bands[k].first_row * cols, bands[k].end_row * cols, parent + offset[k], 1};
     }
-    run_parts(passes, n_bands, sizeof(RelabelBand), relabel_band);
+    run_parts(passes, n_bands, sizeof(RelabelPart), relabel_part);
     if (stats != NULL) {
         stats->n_zones = zones;
         stats->size = calloc((size_t)zones + 1, sizeof(int64_t));
