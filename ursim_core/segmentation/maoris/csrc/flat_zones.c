@@ -142,8 +142,9 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
         goto done;
     }
     /* The bands' labels one after another (band k's label i is offset[k] + i), in the first
-     * band's parents grown to hold them all: at 8000 x 8000 px each array of one entry per label
-     * is about 28 MB, and the step's peak memory is that of the zone graph's build next. */
+     * band's parents grown to hold them all rather than in a fresh array: at 8000 x 8000 px each
+     * array of one entry per label is about 28 MB, and this step adds to the memory held while
+     * the zone graph's is being faulted in (warm_memory). */
     parent = realloc(bands[0].parent, (size_t)(total + 1) * sizeof(int32_t));
     if (parent == NULL) {
         goto done;
