@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ursim_core.segmentation.maoris.kernels.helpers import _filled, _grown, _zone_of
+from ursim_core.segmentation.maoris.kernels.helpers import _filled, _grown, _zone_of, inner_kernel
 
 
 @njit(cache=True)
@@ -59,6 +59,11 @@ def label_flat_zones(values, labels):
 @njit(cache=True)
 def zone_values_and_sizes(zones, values, count):
     """Each zone's value (of any of its pixels) and size, zones 0..count - 1."""
+    return _values_and_sizes(zones, values, count)
+
+
+@inner_kernel
+def _values_and_sizes(zones, values, count):
     value = np.zeros(count, np.int32)
     size = np.zeros(count, np.int64)
     for row in range(zones.shape[0]):
@@ -74,11 +79,11 @@ def label_flat_zones_counted(values, labels):
     """:func:`label_flat_zones`, and :func:`zone_values_and_sizes` of its labels (zones 0..N):
     ``(labels, value, size)``. The C kernel counts them in the labelling's own passes."""
     label_flat_zones(values, labels)
-    count = 1
+    count = np.int64(1)  # typed, not a literal: the helper is compiled for int64 only
     for row in range(labels.shape[0]):
         for col in range(labels.shape[1]):
-            count = max(count, labels[row, col] + 1)
-    value, size = zone_values_and_sizes(labels, values, count)
+            count = max(count, np.int64(labels[row, col]) + 1)
+    value, size = _values_and_sizes(labels, values, count)
     return labels, value, size
 
 
