@@ -10,6 +10,7 @@ import pytest
 from PIL import Image
 
 from ursim_core.errors import ParameterError
+from ursim_core.evaluation import report, tables
 from ursim_core.evaluation.results import (
     DEFAULT_M_GRID,
     POOLED,
@@ -574,3 +575,33 @@ def test_a_missing_annotator_file_is_reported(synthetic_dataset, tmp_path):
     assert len(result.warnings) == 1
     assert "small" in result.warnings[0] and "vasiliki" in result.warnings[0]
     assert "malcolm only" in result.warnings[0] and result.warnings[0] in result.notes
+
+
+# ---------------------------------------------------------------------- the one-to-one ceiling
+
+
+def test_an_evaluation_reports_the_ceiling_beside_the_matcher(synthetic_dataset):
+    result = run_evaluation(synthetic_dataset, matchers=["hungarian"], variants=["T4"], m_grid=(0.1,), workers=1)
+    # malcolm annotated three rooms, vasiliki two of them: pairing all three is best for the mean
+    # (1.0 and 0.8), as pairing two (0.8 and 1.0) is; the search keeps the first found.
+    rows = {(r.map, r.annotator): r for r in result.ceiling_rows}
+    assert set(rows) == {(m, a) for m in ("copy", "small") for a in ("malcolm", "vasiliki")}
+    for (_, annotator), row in rows.items():
+        assert row.matcher == "ceiling" and row.variant == "one-to-one" and row.n_pairs == 3
+        assert row.f1 == pytest.approx(1.0 if annotator == "malcolm" else 0.8)
+        assert row.place_accuracy == pytest.approx(1.0)
+    assert result.ceiling_summary.mean == pytest.approx(0.9)
+    assert "Ceiling (the best one-to-one answer" in tables.format_tables(result)
+    assert "## Ceiling of a one-to-one matcher" in report.markdown_summary(result)
+    header, sketch_rows = tables.per_sketch_table(result, "hungarian", "T4")
+    assert header[-1] == "ceiling" and all(row[-1] == "0.90 / 1.00" for row in sketch_rows)
+    csv_rows = [line for line in report.runs_csv(result).splitlines() if ",ceiling," in line]
+    assert len(csv_rows) == 4
+
+
+def test_legacy_scoring_has_no_ceiling(synthetic_dataset):
+    result = run_evaluation(
+        synthetic_dataset, matchers=["hungarian"], variants=["T4"], m_grid=(0.1,), workers=1, legacy_scoring="fnfix"
+    )
+    assert result.ceiling_rows == () and result.ceiling_summary is None
+    assert "Ceiling" not in tables.format_tables(result)

@@ -5,7 +5,8 @@ layouts and where the datasets are (:mod:`~ursim_core.evaluation.layouts`,
 :mod:`~ursim_core.evaluation.datasets`), the experiment runner behind ``ursim evaluate``
 (:mod:`~ursim_core.evaluation.runner`, with its segmentation cache :mod:`~ursim_core.evaluation.cache`,
 process pool :mod:`~ursim_core.evaluation.pool` and scored tasks :mod:`~ursim_core.evaluation.tasks`),
-the values it produces and their summaries (:mod:`~ursim_core.evaluation.results`), the KTH protocol
+the values it produces and their summaries (:mod:`~ursim_core.evaluation.results`), the ceiling of a
+one-to-one matcher against the annotators (:mod:`~ursim_core.evaluation.ceiling`), the KTH protocol
 of the matching benchmark (:mod:`~ursim_core.evaluation.kth_protocol`), turned and mirrored
 sketches with their ground truth (:mod:`~ursim_core.evaluation.augment`) and the report
 (:mod:`~ursim_core.evaluation.report`: CSV and markdown; :mod:`~ursim_core.evaluation.tables`,
@@ -22,6 +23,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
     submodules=[
         "augment",
         "cache",
+        "ceiling",
         "datasets",
         "formatting",
         "kth_protocol",
@@ -45,6 +47,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "PlaceScore",
             "place_accuracy",
         ],
+        "ceiling": ["Ceiling", "best_one_to_one"],
         "augment": ["Orientation", "DIHEDRAL", "parse_augment", "transform_image", "transform_points"],
         "layouts": ["Experiment", "discover"],
         "datasets": ["dataset_root", "DATASET_ENV", "MISSING_REASON"],

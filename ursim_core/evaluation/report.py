@@ -23,6 +23,7 @@ from ursim_core.evaluation.results import POOLED, RUN_COLUMNS, mean_f1_by_m
 from ursim_core.evaluation.tables import (
     CHOICE_TITLES,
     annotator_groups,
+    ceiling_lines,
     format_tables,
     heading,
     headline_choice,
@@ -40,7 +41,7 @@ __all__ = ["runs_csv", "format_tables", "markdown_summary", "plot_f1_vs_m", "plo
 
 
 def runs_csv(result) -> str:
-    """Every run (matcher rows, then human-vs-human rows) as CSV text, one row per RunRow.
+    """Every run (matcher rows, then human-vs-human rows, then the ceiling's) as CSV text, one row per RunRow.
 
     Floats are written with 6 significant digits; a NaN (the m of a human row, a place accuracy
     with no scorable clique) is empty.
@@ -56,7 +57,7 @@ def runs_csv(result) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(RUN_COLUMNS)
-    for row in (*result.rows, *result.human_rows):
+    for row in (*result.rows, *result.human_rows, *result.ceiling_rows):
         writer.writerow([_csv_value(getattr(row, column)) for column in RUN_COLUMNS])
     return buffer.getvalue()
 
@@ -124,6 +125,21 @@ def markdown_summary(
     human = human_lines(result)
     if human:
         lines += ["## Human vs human", ""] + [f"- {line}" for line in human] + [""]
+    ceiling = ceiling_lines(result)
+    if ceiling:
+        lines += (
+            [
+                "## Ceiling of a one-to-one matcher",
+                "",
+                "A matcher gives one answer per map pair, scored against every annotator. Where the annotators",
+                "disagree, or a clique joins several regions on a side, no one-to-one answer scores 1 against all of",
+                "them: the ceiling is the best mean F1 any one-to-one answer reaches (its pairs found by exhaustive",
+                "search, then scored as a matcher's), and the place accuracy of that answer.",
+                "",
+            ]
+            + [f"- {line}" for line in ceiling]
+            + [""]
+        )
 
     table = orientation_table(result)
     if table is not None:

@@ -32,6 +32,7 @@ __all__ = [
     "CHOICES",
     "POOLED",
     "HUMAN",
+    "CEILING",
     "AUTO",
     "RUN_COLUMNS",
     "RunRow",
@@ -59,6 +60,8 @@ CHOICES = ("oracle", "fixed", "auto")
 POOLED = "all"
 #: Matcher name of the human-vs-human rows.
 HUMAN = "human"
+#: Matcher name of the rows of the one-to-one ceiling (:mod:`ursim_core.evaluation.ceiling`).
+CEILING = "ceiling"
 AUTO = "auto"
 
 
@@ -131,7 +134,7 @@ class Summary:
         An annotator, or ``'all'`` for every (map, annotator) pooled.
     matcher, variant : str
         For ``choice='human'``: ``'human'`` and the annotator scored against ``annotator``.
-    choice : {'oracle', 'fixed', 'auto', 'human'}
+    choice : {'oracle', 'fixed', 'auto', 'human', 'ceiling'}
     maps : tuple of str
         Map names (``'map/annotator'`` when pooled), in the order of the values.
     f1, precision, recall, place : tuple of float
@@ -197,6 +200,9 @@ class EvaluationResult:
         Every matcher run, scored against every annotator.
     human_rows : tuple of RunRow
         Human-vs-human comparisons.
+    ceiling_rows : tuple of RunRow
+        The best one-to-one answer against every annotator at once, scored against each
+        (``matcher='ceiling'``; :mod:`ursim_core.evaluation.ceiling`).
     experiments : tuple of Experiment
     settings : dict
         Dataset, matchers, variants, m grid, presets, scoring, workers, configuration (JSON-able).
@@ -211,6 +217,7 @@ class EvaluationResult:
 
     rows: tuple[RunRow, ...] = ()
     human_rows: tuple[RunRow, ...] = ()
+    ceiling_rows: tuple[RunRow, ...] = ()
     experiments: tuple[Experiment, ...] = ()
     settings: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
@@ -224,6 +231,15 @@ class EvaluationResult:
     @functools.cached_property
     def human_summaries(self) -> tuple[Summary, ...]:
         return summarise_human(self.human_rows)
+
+    @functools.cached_property
+    def ceiling_summary(self) -> Summary | None:
+        """The ceiling rows over every (map, annotator) pooled, or None when there are none."""
+        rows = self.ceiling_rows
+        if not rows:
+            return None
+        variant = "one-to-one" if all(r.variant == "one-to-one" for r in rows) else "one-to-one, lower bound"
+        return _summary(POOLED, CEILING, variant, CEILING, [f"{r.sample}/{r.annotator}" for r in rows], rows)
 
     @property
     def annotators(self) -> tuple[str, ...]:

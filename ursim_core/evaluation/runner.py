@@ -62,7 +62,15 @@ from ursim_core.evaluation.results import (
     summarise_human,
 )
 from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, score_matches
-from ursim_core.evaluation.tasks import Instance, MatchTask, human_vs_human_rows, model_label, references_of, run_tasks
+from ursim_core.evaluation.tasks import (
+    Instance,
+    MatchTask,
+    ceiling_rows,
+    human_vs_human_rows,
+    model_label,
+    references_of,
+    run_tasks,
+)
 
 __all__ = [
     "run_evaluation",
@@ -316,6 +324,7 @@ def run_evaluation(
     if human:
         human_rows = human_vs_human_rows(instances, segmentations, references, legacy_mode)
         reporter.step("human vs human")
+    ceilings = ceiling_rows(instances, segmentations, references, legacy_mode)
 
     settings = {
         "dataset": None if dataset is None else str(dataset),
@@ -349,6 +358,7 @@ def run_evaluation(
     return EvaluationResult(
         rows=tuple(rows),
         human_rows=tuple(human_rows),
+        ceiling_rows=tuple(ceilings),
         experiments=tuple(experiments),
         settings=settings,
         timings=timings,

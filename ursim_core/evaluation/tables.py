@@ -25,6 +25,7 @@ __all__ = [
     "table1",
     "heading",
     "human_lines",
+    "ceiling_lines",
     "headline_choice",
     "per_sample",
     "orientation_table",
@@ -93,6 +94,19 @@ def human_lines(result) -> list[str]:
             f"place accuracy mean {number(item.mean_place)} ({item.n} maps)"
         )
     return lines
+
+
+def ceiling_lines(result) -> list[str]:
+    """The one-to-one ceiling (:mod:`ursim_core.evaluation.ceiling`) in one line, or none."""
+    item = result.ceiling_summary
+    if item is None:
+        return []
+    bound = "" if item.variant == "one-to-one" else "; a lower bound: the search stopped at its node budget"
+    return [
+        "Ceiling (the best one-to-one answer against every annotator at once, found by exhaustive search): "
+        f"F1 median {number(item.median)}, mean {mean_sd(item.mean, item.sd)}; "
+        f"place accuracy mean {number(item.mean_place)} ({item.n} maps x annotators{bound})"
+    ]
 
 
 def headline_choice(result) -> str:
@@ -181,6 +195,16 @@ def per_sketch_table(result, matcher: str, variant: str, choice: str | None = No
         [name] + [_pair(*samples.get((name, orientation), (math.nan, math.nan))) for orientation in orientations]
         for name in maps
     ]
+    ceiling = result.ceiling_summary
+    if ceiling is not None:
+        # One column: the best one-to-one answer's mean over the orientations run.
+        by_map: dict[str, list[tuple[float, float]]] = {}
+        for (name, _), value in per_sample(ceiling).items():
+            by_map.setdefault(name, []).append(value)
+        header.append("ceiling")
+        for row in rows:
+            values = by_map.get(row[0], [])
+            row.append(_pair(_mean([v[0] for v in values]), _mean([v[1] for v in values])))
     return header, rows
 
 
@@ -247,7 +271,7 @@ def format_tables(result) -> str:
             f"Mean F1 / place accuracy per orientation, {CHOICE_TITLES[choice]}, all annotators pooled",
             text_table(*table),
         ]
-    human = human_lines(result)
+    human = human_lines(result) + ceiling_lines(result)
     if human:
         lines += [""] + human
     lines += [""] + comparison_lines(result)

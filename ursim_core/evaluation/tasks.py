@@ -30,7 +30,7 @@ from typing import Any
 from ursim_core.evaluation.cache import SegmentationJob
 from ursim_core.evaluation.layouts import Experiment
 from ursim_core.evaluation.pool import Progress, completed
-from ursim_core.evaluation.results import AUTO, HUMAN, RunRow, m_label
+from ursim_core.evaluation.results import AUTO, CEILING, HUMAN, RunRow, m_label
 from ursim_core.evaluation.scoring import place_problem, score_cliques, score_matches, score_places
 
 __all__ = [
@@ -43,6 +43,7 @@ __all__ = [
     "run_tasks",
     "sorted_rows",
     "human_vs_human_rows",
+    "ceiling_rows",
 ]
 
 
@@ -301,4 +302,61 @@ def human_vs_human_rows(instances: list[Instance], segmentations, references, le
                         augment=instance.augment,
                     )
                 )
+    return rows
+
+
+# --------------------------------------------------------------------------- ceiling
+
+
+def ceiling_rows(instances: list[Instance], segmentations, references, legacy_mode) -> list[RunRow]:
+    """The best one-to-one answer against every annotator at once, scored against each
+    (:mod:`ursim_core.evaluation.ceiling`): what any one-to-one matcher can reach at most.
+
+    Correct scoring only (the legacy scorers count pairs per clique): none in a legacy mode.
+    ``variant`` says whether the search was exhaustive (``'one-to-one'``) or stopped at its node
+    budget (``'one-to-one, lower bound'``).
+    """
+    from ursim_core.evaluation.ceiling import best_one_to_one
+
+    if legacy_mode != "correct":
+        return []
+    rows = []
+    for instance, per_annotator in zip(instances, references):
+        if not per_annotator:
+            continue
+        sketch_seg = segmentations[instance.sketch_job.key]
+        metric_seg = segmentations[instance.metric_job.key]
+        place_labels = segmentations[instance.place_job.key].labels
+        ceiling = best_one_to_one([reference.regions for reference in per_annotator.values()])
+        for (annotator, reference), f1 in zip(per_annotator.items(), ceiling.f1):
+            score = score_matches(ceiling.pairs, reference.regions)
+            assert abs(score.f1 - f1) < 1e-12, "the ceiling's F1 is score_matches's"
+            place = score_places(
+                ceiling.pairs, place_problem(reference.points, sketch_seg.labels, place_labels), metric_seg.graph
+            )
+            rows.append(
+                RunRow(
+                    map=instance.experiment.name,
+                    annotator=annotator,
+                    matcher=CEILING,
+                    variant="one-to-one" if ceiling.exact else "one-to-one, lower bound",
+                    m_label="-",
+                    m_value=math.nan,
+                    tp=score.tp,
+                    fp=score.fp,
+                    fn=score.fn,
+                    precision=score.precision,
+                    recall=score.recall,
+                    f1=score.f1,
+                    seeds=0,
+                    n_sketch_regions=sketch_seg.n_regions,
+                    n_metric_regions=metric_seg.n_regions,
+                    time_s=0.0,
+                    model=model_label(instance.experiment),
+                    n_pairs=len(ceiling.pairs),
+                    scoring=score.mode,
+                    place_accuracy=place.accuracy,
+                    augment=instance.augment,
+                )
+            )
     return rows
