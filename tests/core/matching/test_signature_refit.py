@@ -25,8 +25,8 @@ def test_a_cropped_generated_pair_gains_from_the_signature_start():
     assert with_start.place_accuracy > without.place_accuracy
 
 
-def test_signature_refit_is_a_bool_and_off_by_default():
+def test_signature_refit_is_a_bool_on_by_default_and_off_in_the_published_configurations():
     with pytest.raises(ParameterError):
         MatchConfig(signature_refit=1)
-    assert not MatchConfig().signature_refit
+    assert MatchConfig().signature_refit
     assert not MatchConfig.paper().signature_refit and not MatchConfig.released().signature_refit
