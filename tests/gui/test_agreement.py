@@ -37,6 +37,9 @@ def test_pair_agreement_counts_f1_and_disagreeing_cliques(labels3):
     assert a_vs_b.place == 0.5
     assert result.disagreeing == (2,)  # the rejected clique 3 is no claim
     assert result.comparisons["matcher vs A"].f1 == 1.0  # A kept both automatic cliques
+    # The best one-to-one answer for both: (1, 1) and one of A's and B's readings of room 2,
+    # B's found first; no answer scores above 0.75 on average.
+    assert (result.comparisons["ceiling vs A"].f1, result.comparisons["ceiling vs B"].f1) == (0.5, 1.0)
     whole = pooled([result, result])
     assert (whole["A vs B"].tp, whole["A vs B"].fp, whole["A vs B"].f1) == (2, 2, 0.5)
     lines = agreement_csv([result]).splitlines()
@@ -90,6 +93,8 @@ def test_agreement_view_through_the_widgets(plain_campaign, qtbot, tmp_path, mon
     with qtbot.waitSignal(window.jobs.result_ready, timeout=180_000):
         panel.compute_button.click()
     assert panel.table.rowCount() == 3 and panel.cell(2, 0) == "ALL"
+    ceiling_header = panel.table.horizontalHeaderItem(7)
+    assert ceiling_header.text() == "F1 ceiling vs A" and "best mean F1" in ceiling_header.toolTip()
     assert panel.cell(1, 1) == "1.000" and panel.cell(0, 1) not in ("1.000", "–")  # s2 agrees, s1 does not
     target = tmp_path / "agreement.csv"
     monkeypatch.setattr(file_dialogs, "ask_save_path", lambda *a, **k: target)

@@ -9,7 +9,10 @@ tolerance, as the evaluation), so the three are compared on the same regions:
 - F1 of A against B (B as the reference), the usual pair F1 of
   :func:`ursim_core.evaluation.scoring.score_matches`; rejected cliques are no claim;
 - F1 of the matcher against A and against B;
-- place accuracy of the same three, when the core has ``scoring.place_accuracy``
+- F1 of the *ceiling* against A and against B: the one-to-one answer with the best mean F1
+  against both at once (:func:`ursim_core.evaluation.ceiling.best_one_to_one`), what any
+  one-to-one matcher can reach where A and B disagree;
+- place accuracy of the same, when the core has ``scoring.place_accuracy``
   (its reference metric segmentation is the pair's metric segmentation here).
 
 The whole set pools TP / FP / FN over the pairs (a micro F1) and averages place accuracy
@@ -40,8 +43,14 @@ __all__ = [
     "AgreementJob",
 ]
 
-#: The three comparisons, as (name, claimed by, reference).
-COMPARISONS = (("A vs B", "a", "b"), ("matcher vs A", "matcher", "a"), ("matcher vs B", "matcher", "b"))
+#: The comparisons, as (name, claimed by, reference).
+COMPARISONS = (
+    ("A vs B", "a", "b"),
+    ("matcher vs A", "matcher", "a"),
+    ("matcher vs B", "matcher", "b"),
+    ("ceiling vs A", "ceiling", "a"),
+    ("ceiling vs B", "ceiling", "b"),
+)
 _TOLERANCE = 10
 
 
@@ -58,7 +67,7 @@ class Agreement:
 
 @dataclass(frozen=True)
 class PairAgreement:
-    """The three comparisons of one pair; ``disagreeing`` = A's clique ids B does not share."""
+    """The comparisons of one pair; ``disagreeing`` = A's clique ids B does not share."""
 
     name: str
     comparisons: dict[str, Agreement]
@@ -105,12 +114,16 @@ def _compare(claimed, reference, *, place_inputs=None) -> Agreement:
 
 
 def pair_agreement(name: str, a: Correspondences, b: Correspondences, sketch_labels, metric_labels) -> PairAgreement:
-    """The three comparisons of one pair on the given segmentations."""
+    """The comparisons of one pair on the given segmentations."""
+    from ursim_core.evaluation.ceiling import best_one_to_one
+
     sets = {
         "a": region_sets(a, sketch_labels, metric_labels),
         "b": region_sets(b, sketch_labels, metric_labels),
         "matcher": region_sets(a, sketch_labels, metric_labels, which="matcher"),
     }
+    ceiling = best_one_to_one([[(sketch, metric) for _id, sketch, metric in sets[side]] for side in ("a", "b")])
+    sets["ceiling"] = [(index, frozenset({s}), frozenset({m})) for index, (s, m) in enumerate(ceiling.pairs, 1)]
     values = {"a": a, "b": b}
     comparisons = {}
     for label, claimed, reference in COMPARISONS:

@@ -23,6 +23,11 @@ from ursim_gui.model.agreement import COMPARISONS, pooled
 
 __all__ = ["AgreementPanel", "FOLDER_CHOICE"]
 
+#: What the ceiling columns are (their header's tooltip).
+CEILING_TIP = (
+    "The one-to-one answer with the best mean F1 against A and B at once: "
+    "what any matcher can reach where the annotators disagree"
+)
 #: The combo entry that asks for a folder of the second annotator's JSON files.
 FOLDER_CHOICE = "Folder of JSON files…"
 
@@ -61,6 +66,10 @@ class AgreementPanel(QWidget):
         for label, _c, _r in COMPARISONS:
             headers += [f"F1 {label}", f"place {label}"]
         self.table.setHorizontalHeaderLabels(headers)
+        for column, (_label, claimed, _r) in enumerate(COMPARISONS):
+            if claimed == "ceiling":
+                for offset in (1, 2):
+                    self.table.horizontalHeaderItem(offset + 2 * column).setToolTip(CEILING_TIP)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.verticalHeader().setVisible(False)
         top = QHBoxLayout()
