@@ -278,28 +278,8 @@ def human_vs_human_rows(instances: list[Instance], segmentations, references, le
                 score = score_cliques(scored.regions, reference.regions, legacy=legacy_mode)
                 place = score_places(score.pairs, problem, metric_seg.graph)
                 rows.append(
-                    RunRow(
-                        map=instance.experiment.name,
-                        annotator=reference_annotator,
-                        matcher=HUMAN,
-                        variant=scored_annotator,
-                        m_label="-",
-                        m_value=math.nan,
-                        tp=score.tp,
-                        fp=score.fp,
-                        fn=score.fn,
-                        precision=score.precision,
-                        recall=score.recall,
-                        f1=score.f1,
-                        seeds=0,
-                        n_sketch_regions=sketch_seg.n_regions,
-                        n_metric_regions=metric_seg.n_regions,
-                        time_s=0.0,
-                        model=model_label(instance.experiment),
-                        n_pairs=len(score.pairs),
-                        scoring=score.mode,
-                        place_accuracy=place.accuracy,
-                        augment=instance.augment,
+                    _unmatched_row(
+                        instance, sketch_seg, metric_seg, reference_annotator, HUMAN, scored_annotator, score, place
                     )
                 )
     return rows
@@ -328,35 +308,37 @@ def ceiling_rows(instances: list[Instance], segmentations, references, legacy_mo
         metric_seg = segmentations[instance.metric_job.key]
         place_labels = segmentations[instance.place_job.key].labels
         ceiling = best_one_to_one([reference.regions for reference in per_annotator.values()])
-        for (annotator, reference), f1 in zip(per_annotator.items(), ceiling.f1):
+        variant = "one-to-one" if ceiling.exact else "one-to-one, lower bound"
+        for annotator, reference in per_annotator.items():
             score = score_matches(ceiling.pairs, reference.regions)
-            assert abs(score.f1 - f1) < 1e-12, "the ceiling's F1 is score_matches's"
-            place = score_places(
-                ceiling.pairs, place_problem(reference.points, sketch_seg.labels, place_labels), metric_seg.graph
-            )
-            rows.append(
-                RunRow(
-                    map=instance.experiment.name,
-                    annotator=annotator,
-                    matcher=CEILING,
-                    variant="one-to-one" if ceiling.exact else "one-to-one, lower bound",
-                    m_label="-",
-                    m_value=math.nan,
-                    tp=score.tp,
-                    fp=score.fp,
-                    fn=score.fn,
-                    precision=score.precision,
-                    recall=score.recall,
-                    f1=score.f1,
-                    seeds=0,
-                    n_sketch_regions=sketch_seg.n_regions,
-                    n_metric_regions=metric_seg.n_regions,
-                    time_s=0.0,
-                    model=model_label(instance.experiment),
-                    n_pairs=len(ceiling.pairs),
-                    scoring=score.mode,
-                    place_accuracy=place.accuracy,
-                    augment=instance.augment,
-                )
-            )
+            problem = place_problem(reference.points, sketch_seg.labels, place_labels)
+            place = score_places(ceiling.pairs, problem, metric_seg.graph)
+            rows.append(_unmatched_row(instance, sketch_seg, metric_seg, annotator, CEILING, variant, score, place))
     return rows
+
+
+def _unmatched_row(instance: Instance, sketch_seg, metric_seg, annotator, matcher, variant, score, place) -> RunRow:
+    """The row of pairs no matcher made (an annotator's, the ceiling's): no m, seeds or time."""
+    return RunRow(
+        map=instance.experiment.name,
+        annotator=annotator,
+        matcher=matcher,
+        variant=variant,
+        m_label="-",
+        m_value=math.nan,
+        tp=score.tp,
+        fp=score.fp,
+        fn=score.fn,
+        precision=score.precision,
+        recall=score.recall,
+        f1=score.f1,
+        seeds=0,
+        n_sketch_regions=sketch_seg.n_regions,
+        n_metric_regions=metric_seg.n_regions,
+        time_s=0.0,
+        model=model_label(instance.experiment),
+        n_pairs=len(score.pairs),
+        scoring=score.mode,
+        place_accuracy=place.accuracy,
+        augment=instance.augment,
+    )
