@@ -199,12 +199,7 @@ def run_task(task: MatchTask, segmentations: dict[str, Any]) -> list[RunRow]:
                     variant=task.variant,
                     m_label=label,
                     m_value=float(result.m),
-                    tp=score.tp,
-                    fp=score.fp,
-                    fn=score.fn,
-                    precision=score.precision,
-                    recall=score.recall,
-                    f1=score.f1,
+                    **_score_fields(score),
                     seeds=int(result.seeds_count),
                     n_sketch_regions=sketch_seg.n_regions,
                     n_metric_regions=metric_seg.n_regions,
@@ -326,12 +321,7 @@ def _unmatched_row(instance: Instance, sketch_seg, metric_seg, annotator, matche
         variant=variant,
         m_label="-",
         m_value=math.nan,
-        tp=score.tp,
-        fp=score.fp,
-        fn=score.fn,
-        precision=score.precision,
-        recall=score.recall,
-        f1=score.f1,
+        **_score_fields(score),
         seeds=0,
         n_sketch_regions=sketch_seg.n_regions,
         n_metric_regions=metric_seg.n_regions,
@@ -342,3 +332,8 @@ def _unmatched_row(instance: Instance, sketch_seg, metric_seg, annotator, matche
         place_accuracy=place.accuracy,
         augment=instance.augment,
     )
+
+
+def _score_fields(score) -> dict:
+    """The RunRow fields of a :class:`~ursim_core.evaluation.scoring.MatchScore`."""
+    return {name: getattr(score, name) for name in ("tp", "fp", "fn", "precision", "recall", "f1")}
