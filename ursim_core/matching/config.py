@@ -125,8 +125,9 @@ class MatchConfig:
         generated pairs (``ursim bench invariance --first-seed 8``) 0.863 -> 0.892 mean F1, seeds
         0-7 unchanged, the 18 KTH sketches unchanged in the 8 orientations and at 15-degree steps
         one of 432 sketch orientations worse (01 at 195 degrees). Costs a sweep of every fourth m
-        per mirror flag and one of every second m per finalist orientation: 35.8 -> 41.2 ms median
-        prepare per KTH pair (interleaved, loaded machine; budget 50 ms).
+        per mirror flag and one of every second m per finalist orientation: 32.6 -> 37.6 ms median
+        prepare per KTH pair on a quiet machine, 35.8 -> 41.2 ms on a loaded one (interleaved;
+        budget 50 ms).
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
