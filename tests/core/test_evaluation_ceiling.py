@@ -76,3 +76,9 @@ def test_a_search_cut_short_says_so_and_is_a_lower_bound():
     short = best_one_to_one(references, node_budget=3)
     assert exact.exact and not short.exact
     assert short.mean_f1 <= exact.mean_f1
+
+
+def test_a_map_with_more_regions_than_the_recursion_limit():
+    reference = [({k}, {k}) for k in range(1, 3001)]
+    ceiling = best_one_to_one([reference])
+    assert ceiling.exact and ceiling.f1 == (1.0,) and len(ceiling.pairs) == 3000

@@ -54,6 +54,10 @@ class Ceiling:
         return math.fsum(self.f1) / len(self.f1) if self.f1 else math.nan
 
 
+#: The end of a frame's choices (None is a choice: the region left unpaired).
+_DONE = object()
+
+
 def _f1(tp: int, fp: int, fn: int) -> float:
     if not (tp or fp or fn):
         return 1.0  # nothing to find and nothing wrong: score_matches's perfect empty answer
@@ -151,30 +155,43 @@ def best_one_to_one(references: Sequence, *, node_budget: int = NODE_BUDGET) -> 
                 elif sign < 0 and hit_counts[r][k] == 0:
                     missed[r] += 1
 
-    def search(position: int) -> None:
+    def visit(position: int) -> bool:
+        """Count the node, keep it when best; True when its choices are worth trying."""
         best["nodes"] += 1
         if best["nodes"] > node_budget:
             best["exact"] = False
-            return
+            return False
         score = current()
         if score > best["score"] + 1e-12:
             best["score"], best["pairs"] = score, tuple(chosen)
-        if position == len(sketch_order) or bound(len(sketch_order) - position) <= best["score"] + 1e-12:
-            return
-        a = sketch_order[position]
-        for b in partners[a]:
-            if b in used_metric:
-                continue
-            used_metric.add(b)
-            chosen.append((a, b))
-            add((a, b), 1)
-            search(position + 1)
-            add((a, b), -1)
-            chosen.pop()
-            used_metric.discard(b)
-        search(position + 1)
+        return position < len(sketch_order) and bound(len(sketch_order) - position) > best["score"] + 1e-12
 
-    search(0)
+    # Depth first with an explicit stack (a map can have more sketch regions than Python's
+    # recursion limit). A frame: its position, its choices left (each partner, then None: the
+    # region left unpaired) and the pair it applied for the child being explored.
+    stack = [[0, iter([*partners[sketch_order[0]], None]), None]] if visit(0) else []
+    while stack and best["exact"]:
+        frame = stack[-1]
+        position, choices, applied = frame
+        if applied is not None:
+            add(applied, -1)
+            chosen.pop()
+            used_metric.discard(applied[1])
+            frame[2] = None
+        choice = next(choices, _DONE)
+        if choice is _DONE:
+            stack.pop()
+            continue
+        if choice is not None:
+            if choice in used_metric:
+                continue
+            pair = (sketch_order[position], choice)
+            used_metric.add(choice)
+            chosen.append(pair)
+            add(pair, 1)
+            frame[2] = pair
+        if visit(position + 1):
+            stack.append([position + 1, iter([*partners[sketch_order[position + 1]], None]), None])
     pairs = tuple(sorted(best["pairs"]))
     f1 = tuple(score_matches(pairs, group).f1 for group in cliques)
     return Ceiling(pairs, f1, exact=best["exact"])
