@@ -39,6 +39,7 @@ from ursim_gui.views.status_bar import CursorStatusBar
 from ursim_gui.views.theme import apply_theme
 from ursim_gui.window.agreement_controller import AgreementController
 from ursim_gui.window.campaign_controller import CampaignController
+from ursim_gui.window.dock_tabs import hide_stray_tab_bars
 from ursim_gui.window.document_controller import DocumentController
 from ursim_gui.window.edit_commands import EditCommands
 from ursim_gui.window.navigation_controller import NavigationController
@@ -96,6 +97,7 @@ class MainWindow(QMainWindow):
     def __init__(self, data_dir: Path, session: AnnotationSession | None = None):
         super().__init__()
         self.setObjectName("main_window")
+        self._shown = False
         self.preferences = Preferences(data_dir, self)
         self.session = session if session is not None else AnnotationSession(annotator=self.preferences.annotator())
         self.actions = {spec.id: make_action(spec, self) for spec in SHORTCUTS}
@@ -383,6 +385,14 @@ class MainWindow(QMainWindow):
         """Close without asking about unsaved changes (scripted runs)."""
         self._discard_on_close = True
         self.close()
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        if not self._shown:
+            # Qt's leftovers from tabifying the docks while hidden (dock_tabs). Only now: a later
+            # show can come before a new tab bar is laid out, which would look like a leftover.
+            self._shown = True
+            hide_stray_tab_bars(self)
 
     def closeEvent(self, event) -> None:
         if not getattr(self, "_discard_on_close", False):
