@@ -89,7 +89,8 @@ def test_every_c_kernel_refuses_arrays_of_another_type_layout_or_writeability(c_
             readonly.flags.writeable = False
             other_ndim = original.reshape(-1) if original.ndim > 1 else original.reshape(1, -1)
             wrongs = [wrong_dtype, readonly, other_ndim, "not an array"]
-            if original.ndim == 2 and name != "paint_discs":  # paint_discs takes any layout
+            # Arguments typed any-layout (the free-space masks, windows of the map) take strides.
+            if original.ndim == 2 and getattr(numba_types[path[0]], "layout", "C") != "A":
                 wrongs.append(np.zeros((2, 4), original.dtype)[:, ::2])
             for wrong in wrongs:
                 with pytest.raises(TypeError):
@@ -309,7 +310,8 @@ def test_flat_zones_labelled_in_bands_are_numbas(c_module):
 
     _bands_run_here()
     values = _band_crossing_values()
-    got, value, size = c_module.label_flat_zones_counted(values, np.empty(values.shape, np.int32))
+    identity = np.arange(256, dtype=np.uint8)  # radii that are their own values
+    got, value, size = c_module.label_radii_zones_counted(values.astype(np.int32), 0, identity)
     want = flat_zones.label_flat_zones(values, np.empty(values.shape, np.int32))
     want_value, want_size = flat_zones.zone_values_and_sizes(want, values, int(want.max()) + 1)
     assert np.array_equal(got, want)
@@ -373,3 +375,28 @@ def test_first_pixels_found_in_parts_are_numbas(c_module):
     labels[-1, -1] = 6100
     with pytest.raises(IndexError, match="outside"):
         c_module.first_pixels(labels, 6100)
+
+
+def test_zones_labelled_over_their_radii_in_bands_are_the_value_images(c_module):
+    """MAORIS steps 2 and 3 at once: the values looked up from the radii row by row as the rows
+    are labelled, in bands of rows whose meeting rows are read before any band writes over
+    them. The labels, values and sizes are those of labelling the value image itself, in C as
+    in numba; a radius outside the table is an IndexError in both."""
+    from ursim_core.segmentation.maoris.kernels import flat_zones
+
+    _bands_run_here()
+    values = _band_crossing_values()
+    # Radii whose table gives those values: 0 -> 0, v -> v, and 10 + v -> v too (two radii of
+    # one value side by side must still be one zone).
+    radii = values.astype(np.int32)
+    radii[:, 1024::2] += 10 * (radii[:, 1024::2] > 0)
+    table = np.array([*range(10), 0, *range(1, 10)], np.uint8)
+    want = flat_zones.label_flat_zones_counted(values, np.empty(values.shape, np.int32))
+    for kernel in (c_module.label_radii_zones_counted, flat_zones.label_radii_zones_counted):
+        got = kernel(radii.copy(), 0, table)
+        assert all(np.array_equal(a, b) for a, b in zip(got, want, strict=True))
+    assert want[0][0, 0] == want[0][-2, 0]  # the zone through every band
+    radii[-1, -1] = len(table)
+    for kernel in (c_module.label_radii_zones_counted, flat_zones.label_radii_zones_counted):
+        with pytest.raises(IndexError, match="outside"):
+            kernel(radii.copy(), 0, table)

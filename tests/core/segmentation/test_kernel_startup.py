@@ -69,6 +69,7 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
         ZoneGraph,
         contact_tracking,
         flat_zones,
+        inscribed_circle_image,
         maoris_labels,
         merge_ripples,
         quantize,
@@ -86,6 +87,7 @@ def test_every_kernel_called_has_exactly_its_declared_signature(monkeypatch, jit
     ZoneGraph(flat_zones(values), values).contact_percent(1, 2)  # contact_table
     merge_ripples(ZoneGraph(flat_zones(values), values))  # expand_graph: the step on its own keeps the ids
     flat_zones(np.array([[5, 5, 0], [0, 5, 7]]))  # another dtype goes through the one signature too
+    inscribed_circle_image(free)  # lookup_bytes: the public value image (segmentations make none)
     watershed_labels(free)  # the flooding kernels of the watershed segmenter
     watershed_flood(np.arange(6.0).reshape(2, 3), np.array([[1, 0, 0], [0, 0, 2]]), connectivity=2)
     for key, types in signatures.SIGNATURES.items():

@@ -54,10 +54,11 @@ __all__ = [
 #: The kernels called from Python, by module of :mod:`.kernels` (the helpers they call are
 #: compiled into them). A test checks this against :data:`.kernels.signatures.SIGNATURES`.
 ENTRY_KERNELS: dict[str, tuple[str, ...]] = {
+    "distance": ("distance_transform",),
     "discs": ("centre_rectangles", "paint_discs", "lookup_bytes"),
     "flat_zones": (
         "label_flat_zones",
-        "label_flat_zones_counted",
+        "label_radii_zones_counted",
         "zone_values_and_sizes",
         "first_pixels",
         "resolve_parents",

@@ -13,9 +13,10 @@ from ursim_core.errors import ParameterError
 from ursim_core.segmentation.maoris.inscribed_circle import (
     _as_free_mask,
     _free_bbox,
-    _quantized_radii,
+    _quantization_table,
     _radii_in_storage,
 )
+from ursim_core.segmentation.maoris.compiled import kernels
 from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
 from ursim_core.segmentation.maoris.steps import (
     mark_unbreakable_edges,
@@ -26,7 +27,7 @@ from ursim_core.segmentation.maoris.steps import (
     watershed_merge,
 )
 from ursim_core.segmentation.maoris.warm_memory import warm_memory
-from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph, _flat_zones_counted
+from ursim_core.segmentation.maoris.zone_graph import _PAD, ZoneGraph
 
 __all__ = ["maoris_labels", "compile_kernels"]
 
@@ -86,16 +87,17 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     radii, storage = _radii_in_storage(
         free, params.max_radius, padding=_PAD, size=shape[0] * shape[1] if in_storage else 0
     )
-    values = _quantized_radii(radii, params.quantum)
     # The zones are labelled over the radii, read only for the values, and the graph pads
     # them in place (a fresh image of that size costs more in page faults than the pass); their
-    # values and sizes are counted as they are labelled.
-    zones, value, size = _flat_zones_counted(values, out=radii)
-    # Large temporaries go as soon as they are read, here the value image before the graph is
-    # built (the step of the peak memory): at 8000 x 8000 each full-size image is 64-256 MB, and
-    # on the virtual machines this was measured on, memory touched for the first time cost
-    # 1-2.5 s per GB (the host backs each page on its first touch), against 0.07 s to reuse it.
-    del values, free, radii
+    # values and sizes are counted as they are labelled. The values come from the radii through
+    # the quantisation's table row by row as they are labelled: no value image is made (64 MB
+    # of fresh memory at 8000 x 8000 px: on the virtual machines this was measured on, memory
+    # touched for the first time cost 1-2.5 s per GB, the host backing each page on its first
+    # touch, against 0.07 s to reuse it).
+    zones, value, size = kernels().label_radii_zones_counted(radii, *_quantization_table(radii, params.quantum))
+    # Large temporaries go as soon as they are read, before the graph is built (the step of the
+    # peak memory).
+    del free, radii
     if warming is not None:
         warming.release()
     graph = ZoneGraph._of_zone_values(zones, value, size, storage=storage)

@@ -40,14 +40,6 @@ def flat_zones(values: np.ndarray, *, out: np.ndarray | None = None) -> np.ndarr
     return kernels().label_flat_zones(values, out)
 
 
-def _flat_zones_counted(values: np.ndarray, *, out: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
-    """``(zones, value, size)``: :func:`flat_zones` and each zone's value and pixel count (zone
-    0: the pixels of no zone), counted while labelling rather than in a pass of their own (at
-    8000 x 8000 px that pass read 320 MB)."""
-    values, out = _value_bytes_and_out(values, out)
-    return kernels().label_flat_zones_counted(values, out)
-
-
 def _value_bytes_and_out(values, out: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     values = np.asarray(values)
     if values.ndim != 2:

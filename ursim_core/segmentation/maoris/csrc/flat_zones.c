@@ -1,6 +1,28 @@
 /* MAORIS step 3 in C: flat zones, their values and sizes (port of ../kernels/flat_zones.py). */
 #include "kernels.h"
 
+/* The values computed from radii as they are labelled (label_radii_zones_counted): value =
+ * table[radius - lo]; the labels are written over the radii. */
+typedef struct {
+    const int32_t *radii;
+    int64_t lo, n_table;
+    const uint8_t *table;
+} ValueSource;
+
+/* The values of ``cols`` radii from ``first``; -1 when one is outside the table. */
+static int values_of(const ValueSource *source, int64_t first, int64_t cols, uint8_t *out)
+{
+    const int32_t *radii = source->radii + first;
+    for (int64_t col = 0; col < cols; col++) {
+        uint64_t index = (uint64_t)((int64_t)radii[col] - source->lo);
+        if (index >= (uint64_t)source->n_table) {
+            return -1;
+        }
+        out[col] = source->table[index];
+    }
+    return 0;
+}
+
 /* One band of rows of the labelling: provisional labels 1..n, numbered in the raster order of
  * the pixel that created them, with union-find parents (a set's root is always its smallest
  * label), and each label's value and pixel count. */
@@ -13,6 +35,9 @@ typedef struct {
     uint32_t *count; /* a band has fewer than 2^32 pixels (label_zones) */
     int64_t n, capacity;
     int failed;
+    const ValueSource *source; /* or NULL: the values are read from ``values`` */
+    uint8_t *rows;             /* with a source: the values of this row and the one above */
+    int bad;                   /* with a source: a radius outside the table */
 } LabelBand;
 
 static int grow_band(LabelBand *b)
@@ -44,10 +69,22 @@ static void *label_band(void *arg)
     LabelBand *b = arg;
     const int64_t cols = b->cols;
     int64_t n = 0;
+    uint8_t *line_values = b->rows, *above_values = b->rows + cols;
     for (int64_t row = b->first_row; row < b->end_row; row++) {
-        const uint8_t *line = b->values + row * cols;
+        const uint8_t *line = b->values + row * cols, *above = line - cols;
         int32_t *out = b->labels + row * cols;
         const int has_up = row > b->first_row;
+        if (b->source != NULL) {
+            /* The row's radii are read before its labels are written over them; the row above
+             * is labels already, its values kept from the last row. */
+            uint8_t *previous = line_values;
+            line_values = above_values, above_values = previous;
+            if (values_of(b->source, row * cols, cols, line_values) < 0) {
+                b->bad = 1;
+                return NULL;
+            }
+            line = line_values, above = above_values;
+        }
         for (int64_t col = 0; col < cols; col++) {
             uint8_t value = line[col];
             if (value == 0) {
@@ -55,7 +92,7 @@ static void *label_band(void *arg)
                 continue;
             }
             int64_t left = (col > 0 && line[col - 1] == value) ? out[col - 1] : 0;
-            int64_t up = (has_up && line[col - cols] == value) ? out[col - cols] : 0;
+            int64_t up = (has_up && above[col] == value) ? out[col - cols] : 0;
             if (left == 0 && up == 0) {
                 n += 1;
                 if (n == b->capacity && grow_band(b) < 0) {
@@ -101,8 +138,8 @@ typedef struct {
  * label: the one its first pixel created) numbered in order, as one pass over the whole image
  * would. ``stats`` (or NULL): also the zones' values and sizes. Returns 0, or -1 when out of
  * memory. */
-static int label_zones(const uint8_t *restrict values, int32_t *restrict labels, int64_t rows, int64_t cols,
-                       ZoneStats *stats)
+static int label_zones(const uint8_t *values, int32_t *labels, int64_t rows, int64_t cols, ZoneStats *stats,
+                       const ValueSource *source)
 {
     int64_t pixels = rows * cols;
     int64_t n_bands = parts_for(pixels, rows);
@@ -114,9 +151,12 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
     LabelBand *bands = calloc((size_t)n_bands, sizeof(LabelBand));
     RelabelPart *passes = calloc((size_t)n_bands, sizeof(RelabelPart));
     int64_t *offset = calloc((size_t)n_bands + 1, sizeof(int64_t));
+    /* With a source, the values of the rows where the bands meet (band k's first row and the
+     * one above it, at 2 * k * cols), taken before the bands write labels over them. */
+    uint8_t *edges = source != NULL ? malloc((size_t)(2 * n_bands * cols + 1)) : NULL;
     int32_t *parent = NULL;
     int status = -1;
-    if (bands == NULL || passes == NULL || offset == NULL) {
+    if (bands == NULL || passes == NULL || offset == NULL || (source != NULL && edges == NULL)) {
         goto done;
     }
     for (int64_t k = 0; k < n_bands; k++) {
@@ -126,12 +166,23 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
         b->parent = malloc((size_t)b->capacity * sizeof(int32_t));
         b->value = malloc((size_t)b->capacity);
         b->count = malloc((size_t)b->capacity * sizeof(uint32_t));
-        if (b->parent == NULL || b->value == NULL || b->count == NULL) {
+        b->source = source;
+        b->rows = source != NULL ? malloc((size_t)(2 * cols + 1)) : NULL;
+        if (b->parent == NULL || b->value == NULL || b->count == NULL || (source != NULL && b->rows == NULL)) {
+            goto done;
+        }
+        if (source != NULL && k > 0
+            && values_of(source, (b->first_row - 1) * cols, 2 * cols, edges + 2 * k * cols) < 0) {
+            status = -2;
             goto done;
         }
     }
     run_parts(bands, n_bands, sizeof(LabelBand), label_band);
     for (int64_t k = 0; k < n_bands; k++) {
+        if (bands[k].bad) {
+            status = -2;
+            goto done;
+        }
         if (bands[k].failed) {
             goto done;
         }
@@ -160,10 +211,11 @@ static int label_zones(const uint8_t *restrict values, int32_t *restrict labels,
     }
     for (int64_t k = 1; k < n_bands; k++) {
         int64_t row = bands[k].first_row;
-        const uint8_t *line = values + row * cols;
+        const uint8_t *line = source != NULL ? edges + (2 * k + 1) * cols : values + row * cols;
+        const uint8_t *above = line - cols;
         const int32_t *here = labels + row * cols;
         for (int64_t col = 0; col < cols; col++) {
-            if (line[col] != 0 && line[col - cols] == line[col]) {
+            if (line[col] != 0 && above[col] == line[col]) {
                 int64_t a = zone_of(offset[k] + here[col], parent);
                 int64_t c = zone_of(offset[k - 1] + here[col - cols], parent);
                 if (a < c) {
@@ -221,8 +273,10 @@ done:
             free(bands[k].parent);
             free(bands[k].value);
             free(bands[k].count);
+            free(bands[k].rows);
         }
     }
+    free(edges);
     free(bands);
     free(passes);
     free(offset);
@@ -243,7 +297,7 @@ KERNEL(label_flat_zones)
     }
     int failed;
     Py_BEGIN_ALLOW_THREADS
-    failed = label_zones(values.data, labels.data, values.rows, values.cols, NULL);
+    failed = label_zones(values.data, labels.data, values.rows, values.cols, NULL, NULL);
     Py_END_ALLOW_THREADS
     if (failed) {
         return PyErr_NoMemory();
@@ -252,43 +306,52 @@ KERNEL(label_flat_zones)
     return args[1];
 }
 
-/* label_flat_zones, and the zones' values and sizes (zone_values_and_sizes of its labels)
- * counted in the same passes: one pass over the image fewer. */
-KERNEL(label_flat_zones_counted)
+/* The (labels, value, size) of label_radii_zones_counted, from what label_zones returned. */
+static PyObject *counted_result(const char *kernel, int failed, ZoneStats *stats, PyObject *labels)
 {
-    Array values, labels;
-    if (check_nargs("label_flat_zones_counted", nargs, 2)
-        || array_arg(args[0], NPY_UINT8, 2, 0, "values", &values)
-        || array_arg(args[1], NPY_INT32, 2, 0, "labels", &labels)) {
-        return NULL;
-    }
-    if (labels.rows != values.rows || labels.cols != values.cols) {
-        PyErr_SetString(PyExc_ValueError, "label_flat_zones_counted: values and labels differ in shape");
-        return NULL;
-    }
-    ZoneStats stats = {NULL, NULL, 0};
-    int failed;
-    Py_BEGIN_ALLOW_THREADS
-    failed = label_zones(values.data, labels.data, values.rows, values.cols, &stats);
-    Py_END_ALLOW_THREADS
     if (failed) {
-        free(stats.value);
-        free(stats.size);
+        free(stats->value);
+        free(stats->size);
+        if (failed == -2) {
+            PyErr_Format(PyExc_IndexError, "%s: a radius is outside lo .. lo + len(table) - 1", kernel);
+            return NULL;
+        }
         return PyErr_NoMemory();
     }
-    npy_intp dims[1] = {stats.n_zones + 1};
-    PyObject *value = array_owning(stats.value, 1, dims, NPY_INT32);
+    npy_intp dims[1] = {stats->n_zones + 1};
+    PyObject *value = array_owning(stats->value, 1, dims, NPY_INT32);
     if (value == NULL) {
-        free(stats.size);
+        free(stats->size);
         return NULL;
     }
-    PyObject *size = array_owning(stats.size, 1, dims, NPY_INT64);
+    PyObject *size = array_owning(stats->size, 1, dims, NPY_INT64);
     if (size == NULL) {
         Py_DECREF(value);
         return NULL;
     }
-    Py_INCREF(args[1]);
-    return Py_BuildValue("(NNN)", args[1], value, size);
+    Py_INCREF(labels);
+    return Py_BuildValue("(NNN)", labels, value, size);
+}
+
+/* label_flat_zones_counted (../kernels/flat_zones.py) of the values table[radius - lo],
+ * computed row by row as the rows are labelled, the labels written over the radii: no value image (64 MB of fresh memory at
+ * 8000 x 8000 px, which cost more than the pass that filled it). After an IndexError the radii
+ * are partly labels. */
+KERNEL(label_radii_zones_counted)
+{
+    Array radii, table;
+    int64_t lo;
+    if (check_nargs("label_radii_zones_counted", nargs, 3) || array_arg(args[0], NPY_INT32, 2, 0, "radii", &radii)
+        || int_arg(args[1], "lo", &lo) || array_arg(args[2], NPY_UINT8, 1, 0, "table", &table)) {
+        return NULL;
+    }
+    ValueSource source = {radii.data, lo, table.size, table.data};
+    ZoneStats stats = {NULL, NULL, 0};
+    int failed;
+    Py_BEGIN_ALLOW_THREADS
+    failed = label_zones(NULL, radii.data, radii.rows, radii.cols, &stats, &source);
+    Py_END_ALLOW_THREADS
+    return counted_result("label_radii_zones_counted", failed, &stats, args[0]);
 }
 
 KERNEL(zone_values_and_sizes)

@@ -12,11 +12,13 @@
 /* discs.c */
 KERNEL(centre_rectangles);
 KERNEL(paint_discs);
+/* distance.c */
+KERNEL(distance_transform);
 /* values.c */
 KERNEL(lookup_bytes);
 /* flat_zones.c, relabelling.c */
 KERNEL(label_flat_zones);
-KERNEL(label_flat_zones_counted);
+KERNEL(label_radii_zones_counted);
 KERNEL(zone_values_and_sizes);
 KERNEL(first_pixels);
 KERNEL(resolve_parents);

@@ -5,8 +5,8 @@
 #define ENTRY(name) {#name, (PyCFunction)(void (*)(void))kernel_##name, METH_FASTCALL, NULL}
 
 static PyMethodDef methods[] = {
-    ENTRY(centre_rectangles), ENTRY(paint_discs), ENTRY(lookup_bytes),
-    ENTRY(label_flat_zones), ENTRY(label_flat_zones_counted), ENTRY(zone_values_and_sizes), ENTRY(first_pixels),
+    ENTRY(distance_transform), ENTRY(centre_rectangles), ENTRY(paint_discs), ENTRY(lookup_bytes),
+    ENTRY(label_flat_zones), ENTRY(label_radii_zones_counted), ENTRY(zone_values_and_sizes), ENTRY(first_pixels),
     ENTRY(resolve_parents), ENTRY(relabel),
     ENTRY(build_adjacency), ENTRY(adjacency_entries), ENTRY(_link_entries), ENTRY(remove_small_zones),
     ENTRY(compact_graph), ENTRY(expand_graph),

@@ -1,6 +1,7 @@
 """Compiled loops of MAORIS (numba), one module per family.
 
 * :mod:`.helpers`: the decorator of the small inlined helpers, array growth, union-find, prefetch;
+* :mod:`.distance`: the exact Euclidean distance transform, along rows (step 1);
 * :mod:`.discs`: painting the inscribed discs (step 1);
 * :mod:`.flat_zones`: flat-zone labelling, zone values and sizes, relabelling (step 3);
 * :mod:`.adjacency`: the compact zone graph (records and twin nodes), edge transfer on a fusion,

@@ -77,7 +77,8 @@ def _values_and_sizes(zones, values, count):
 @njit(cache=True)
 def label_flat_zones_counted(values, labels):
     """:func:`label_flat_zones`, and :func:`zone_values_and_sizes` of its labels (zones 0..N):
-    ``(labels, value, size)``. The C kernel counts them in the labelling's own passes."""
+    ``(labels, value, size)``. The C kernel (of :func:`label_radii_zones_counted`, which
+    segmentations call) counts them in the labelling's own passes."""
     label_flat_zones(values, labels)
     count = np.int64(1)  # typed, not a literal: the helper is compiled for int64 only
     for row in range(labels.shape[0]):
@@ -85,6 +86,22 @@ def label_flat_zones_counted(values, labels):
             count = max(count, np.int64(labels[row, col]) + 1)
     value, size = _values_and_sizes(labels, values, count)
     return labels, value, size
+
+
+@njit(cache=True)
+def label_radii_zones_counted(radii, lo, table):
+    """:func:`label_flat_zones_counted` of the value image ``table[radii - lo]``, the labels
+    written over ``radii`` (MAORIS steps 2 and 3 at once: the value image, 64 MB of fresh memory
+    at 8000 x 8000 px, is never made by the C kernel). IndexError when a radius is outside the
+    table."""
+    values = np.empty(radii.shape, np.uint8)
+    for row in range(radii.shape[0]):
+        for col in range(radii.shape[1]):
+            index = radii[row, col] - lo
+            if index < 0 or index >= len(table):
+                raise IndexError("label_radii_zones_counted: a radius is outside lo .. lo + len(table) - 1")
+            values[row, col] = table[index]
+    return label_flat_zones_counted(values, radii)
 
 
 @njit(cache=True)

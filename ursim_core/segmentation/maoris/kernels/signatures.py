@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from numba import types
 
-from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, flat_zones, flooding, fusion
+from ursim_core.segmentation.maoris.kernels import adjacency, contacts, discs, distance, flat_zones, flooding, fusion
 
 __all__ = ["SIGNATURES", "RETURN_TYPES", "GROUPS", "compile_group"]
 
@@ -29,11 +29,12 @@ _TRACKING = types.Tuple((_I32, _I32, _STATE))
 
 #: ``(module, kernel name) -> argument types``.
 SIGNATURES: dict[tuple[str, str], tuple] = {
+    ("distance", "distance_transform"): (_U8_2D_ANY, _F32_2D),
     ("discs", "centre_rectangles"): (_F32_2D, _INT),
     ("discs", "paint_discs"): (_I64_2D, _U8_2D_ANY, _I32_2D),
     ("discs", "lookup_bytes"): (_I32_2D, _INT, _U8, _U8_2D),
     ("flat_zones", "label_flat_zones"): (_U8_2D, _I32_2D),
-    ("flat_zones", "label_flat_zones_counted"): (_U8_2D, _I32_2D),
+    ("flat_zones", "label_radii_zones_counted"): (_I32_2D, _INT, _U8),
     ("flat_zones", "zone_values_and_sizes"): (_I32_2D, _U8_2D, _INT),
     ("flat_zones", "first_pixels"): (_I32_2D, _INT),
     ("flat_zones", "resolve_parents"): (_I32, _BOOL),
@@ -59,11 +60,12 @@ SIGNATURES: dict[tuple[str, str], tuple] = {
 #: :data:`SIGNATURES` (a test checks): the ahead-of-time build needs them, and typing every
 #: kernel to learn them cost seconds of that build.
 RETURN_TYPES: dict[tuple[str, str], types.Type] = {
+    ("distance", "distance_transform"): types.none,
     ("discs", "centre_rectangles"): _I64_2D,
     ("discs", "paint_discs"): types.none,
     ("discs", "lookup_bytes"): types.none,
     ("flat_zones", "label_flat_zones"): _I32_2D,
-    ("flat_zones", "label_flat_zones_counted"): types.Tuple((_I32_2D, _I32, _I64)),
+    ("flat_zones", "label_radii_zones_counted"): types.Tuple((_I32_2D, _I32, _I64)),
     ("flat_zones", "zone_values_and_sizes"): types.Tuple((_I32, _I64)),
     ("flat_zones", "first_pixels"): _I64,
     ("flat_zones", "resolve_parents"): types.none,
@@ -86,6 +88,7 @@ RETURN_TYPES: dict[tuple[str, str], types.Type] = {
 }
 
 _MODULES = {
+    "distance": distance,
     "discs": discs,
     "flat_zones": flat_zones,
     "adjacency": adjacency,
