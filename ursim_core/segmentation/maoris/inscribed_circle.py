@@ -215,7 +215,9 @@ def _quantization_table(radii: np.ndarray, quantum: int) -> tuple[int, np.ndarra
     2**21 px: the distance transform refuses sides of 2**20 px), so the table is at most 2 MB."""
     lookup = _lookup_table(radii, lambda values: quantize(_normalise_exactly(values), quantum=quantum), most=1 << 22)
     if lookup is None:
-        raise SegmentationError(f"radii must be a non-empty 2-D integer image of a range under 2**22, got {radii.shape}")
+        raise SegmentationError(
+            f"radii must be a non-empty 2-D integer image of a range under 2**22, got {radii.shape}"
+        )
     return lookup[0], np.ascontiguousarray(lookup[1], np.uint8)
 
 

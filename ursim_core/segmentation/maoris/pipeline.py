@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 
 from ursim_core.errors import ParameterError
+from ursim_core.segmentation.maoris.compiled import kernels
 from ursim_core.segmentation.maoris.inscribed_circle import (
     _as_free_mask,
     _free_bbox,
     _quantization_table,
     _radii_in_storage,
 )
-from ursim_core.segmentation.maoris.compiled import kernels
 from ursim_core.segmentation.maoris.params import PRESETS, MaorisParams
 from ursim_core.segmentation.maoris.steps import (
     mark_unbreakable_edges,
