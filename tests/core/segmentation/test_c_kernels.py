@@ -9,23 +9,6 @@ import numpy as np
 import pytest
 
 
-@pytest.fixture(scope="module")
-def c_module():
-    """The built C module, loaded on its own (not through the kernels' fallbacks)."""
-    import importlib.util
-
-    from ursim_core.segmentation.maoris import compile_kernels, compiled
-
-    compile_kernels()
-    path = compiled.ahead_module_path()
-    if path is None:
-        pytest.skip("the C kernels could not be built here (no C compiler?)")
-    spec = importlib.util.spec_from_file_location(compiled.MODULE_NAME, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_the_c_module_holds_every_kernel(c_module):
     from ursim_core.segmentation.maoris.compiled import ENTRY_KERNELS
 

@@ -78,21 +78,9 @@ def test_an_image_without_obstacles_and_an_empty_one():
         _numba(free, np.empty((4, 5), np.float32))
 
 
-@pytest.fixture(scope="module")
-def c_kernel():
-    """The built C module's kernel, loaded on its own (not through the kernels' fallbacks)."""
-    import importlib.util
-
-    from ursim_core.segmentation.maoris import compile_kernels, compiled
-
-    compile_kernels()
-    path = compiled.ahead_module_path()
-    if path is None:
-        pytest.skip("the C kernels could not be built here (no C compiler?)")
-    spec = importlib.util.spec_from_file_location(compiled.MODULE_NAME, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.distance_transform
+@pytest.fixture
+def c_kernel(c_module):
+    return c_module.distance_transform
 
 
 def test_the_c_kernel_is_numbas_in_bands_and_parts_of_columns(c_kernel):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ursim_core.segmentation.maoris.kernels.discs import lookup_bytes
 from ursim_core.segmentation.maoris.kernels.helpers import _filled, _grown, _zone_of, inner_kernel
 
 
@@ -95,12 +96,7 @@ def label_radii_zones_counted(radii, lo, table):
     at 8000 x 8000 px, is never made by the C kernel). IndexError when a radius is outside the
     table."""
     values = np.empty(radii.shape, np.uint8)
-    for row in range(radii.shape[0]):
-        for col in range(radii.shape[1]):
-            index = radii[row, col] - lo
-            if index < 0 or index >= len(table):
-                raise IndexError("label_radii_zones_counted: a radius is outside lo .. lo + len(table) - 1")
-            values[row, col] = table[index]
+    lookup_bytes(radii, lo, table, values)
     return label_flat_zones_counted(values, radii)
 
 
