@@ -18,9 +18,9 @@ Why C: numba's JIT costs every new process about a second before the first segme
 ahead of time with numba's ``pycc`` (deprecated by numba) took 16.6 s of a fresh install on
 two CPUs, most of it numba typing and lowering in Python. The C compiler builds the port in a
 few seconds (``ursim bench compile``). Every kernel releases the GIL: the contacts of large
-maps are counted in bands on threads, and the C kernels of the image-wide passes (disc
-centres and painting, flat zones, relabelling, the value lookup, first pixels) split large
-images into bands of rows, one thread each, with the results of one pass.
+maps are counted in bands on threads, and the C kernels of the image-wide passes (the distance
+transform, disc centres and painting, flat zones, relabelling, the value lookup, first pixels)
+split large images into bands of rows (or parts), one thread each, with the results of one pass.
 """
 
 from __future__ import annotations
