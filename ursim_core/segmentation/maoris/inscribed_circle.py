@@ -206,14 +206,20 @@ def _quantized_radii(radii: np.ndarray, quantum: int) -> np.ndarray:
     range of values gives the same image, without the two intermediate uint8 images
     (64 MB each at 8000 px; fresh memory costs about as much as the passes).
     """
-    return _by_lookup(radii, lambda values: quantize(_normalise_exactly(values), quantum=quantum))
+    return _by_lookup(radii, _quantized_normalised(quantum))
+
+
+def _quantized_normalised(quantum: int):
+    """The function of the radii that :func:`_quantized_radii` maps them by (step 2 of step 1's
+    image): the C++'s normalisation, then :func:`quantize`."""
+    return lambda values: quantize(_normalise_exactly(values), quantum=quantum)
 
 
 def _quantization_table(radii: np.ndarray, quantum: int) -> tuple[int, np.ndarray]:
     """``(lo, table)`` of :func:`_quantized_radii` for a non-empty 2-D int32 image of radii: its
     image is ``table[radii - lo]`` (uint8). The radii of a map are below its diagonal (under
     2**21 px: the distance transform refuses sides of 2**20 px), so the table is at most 2 MB."""
-    lookup = _lookup_table(radii, lambda values: quantize(_normalise_exactly(values), quantum=quantum), most=1 << 22)
+    lookup = _lookup_table(radii, _quantized_normalised(quantum), most=1 << 22)
     if lookup is None:
         raise SegmentationError(
             f"radii must be a non-empty 2-D integer image of a range under 2**22, got {radii.shape}"
