@@ -197,29 +197,19 @@ def inscribed_circle_image(free: np.ndarray, *, max_radius: int = 500) -> np.nda
 # Step 2: quantisation
 
 
-def _quantized_radii(radii: np.ndarray, quantum: int) -> np.ndarray:
-    """``quantize(_normalise_to_uint8(radii), quantum=quantum)`` in one pass over the image.
-
-    Both steps map each pixel by its value and the image's minimum and maximum only, and
-    the normalisation keeps the order of values, so the normalised image's minimum and
-    maximum are the normalised minimum and maximum: composing the two tables over the
-    range of values gives the same image, without the two intermediate uint8 images
-    (64 MB each at 8000 px; fresh memory costs about as much as the passes).
-    """
-    return _by_lookup(radii, _quantized_normalised(quantum))
-
-
-def _quantized_normalised(quantum: int):
-    """The function of the radii that :func:`_quantized_radii` maps them by (step 2 of step 1's
-    image): the C++'s normalisation, then :func:`quantize`."""
-    return lambda values: quantize(_normalise_exactly(values), quantum=quantum)
-
-
 def _quantization_table(radii: np.ndarray, quantum: int) -> tuple[int, np.ndarray]:
-    """``(lo, table)`` of :func:`_quantized_radii` for a non-empty 2-D int32 image of radii: its
-    image is ``table[radii - lo]`` (uint8). The radii of a map are below its diagonal (under
-    2**21 px: the distance transform refuses sides of 2**20 px), so the table is at most 2 MB."""
-    lookup = _lookup_table(radii, _quantized_normalised(quantum), most=1 << 22)
+    """``(lo, table)`` with ``table[radii - lo] == quantize(_normalise_to_uint8(radii),
+    quantum=quantum)`` (uint8) for a non-empty 2-D integer image of radii.
+
+    Both steps map each pixel by its value and the image's minimum and maximum only, and the
+    normalisation keeps the order of values, so the normalised image's minimum and maximum are
+    the normalised minimum and maximum: composing the two tables over the range of values gives
+    the same image, without the two intermediate uint8 images (64 MB each at 8000 px). The
+    segmentation reads the table while it labels the flat zones, so no value image is made at all.
+    The radii of a map are below its diagonal (under 2**21 px: the distance transform refuses
+    sides of 2**20 px), so the table is at most 2 MB.
+    """
+    lookup = _lookup_table(radii, lambda values: quantize(_normalise_exactly(values), quantum=quantum), most=1 << 22)
     if lookup is None:
         raise SegmentationError(
             f"radii must be a non-empty 2-D integer image of a range under 2**22, got {radii.shape}"

@@ -8,8 +8,8 @@ segmentation, and the step that builds them (``build_adjacency``) spent most of 
 their page faults: 0.72 s at 8000 px against 0.04 s at 4000 px, whose memory was reused.
 
 :func:`warm_memory` touches a block of about that size on a second thread while the first one
-computes the value image, and :meth:`Warming.release` frees it just before the graph is built:
-the graph's arrays then get pages that are already backed. The block's size is estimated from
+computes the radii and labels the flat zones, and :meth:`Warming.release` frees it just before
+the graph is built: the graph's arrays then get pages that are already backed. The block's size is estimated from
 the map's border before any zone exists (:func:`warm_bytes`), at most the graph's size plus a
 few per cent on the maps measured, so the peak memory stays that of the graph's build; where
 memory is cheap to touch (bare metal) the second thread's work is all it costs.

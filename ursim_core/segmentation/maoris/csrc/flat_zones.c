@@ -136,8 +136,9 @@ typedef struct {
  * numbered one after another (which keeps the raster order of their creation), the sets are
  * joined where equal values meet across a band's first row, and the roots (each set's smallest
  * label: the one its first pixel created) numbered in order, as one pass over the whole image
- * would. ``stats`` (or NULL): also the zones' values and sizes. Returns 0, or -1 when out of
- * memory. */
+ * would. ``stats`` (or NULL): also the zones' values and sizes. ``source`` (or NULL): the
+ * values come from radii through a table, and the labels are written over them (``values`` is
+ * then unused). Returns 0, -1 when out of memory, or -2 when a radius is outside the table. */
 static int label_zones(const uint8_t *values, int32_t *labels, int64_t rows, int64_t cols, ZoneStats *stats,
                        const ValueSource *source)
 {
