@@ -143,10 +143,16 @@ def _load_ahead(path: Path) -> SimpleNamespace:
 def _load_jit() -> SimpleNamespace:
     import importlib
 
+    from ursim_core.segmentation.maoris.kernels import signatures
+
     found = {}
     for module_name, names in ENTRY_KERNELS.items():
         module = importlib.import_module(f"ursim_core.segmentation.maoris.kernels.{module_name}")
-        found.update({name: getattr(module, name) for name in names})
+        for name in names:
+            key = (module_name, name)
+            # Kernels that take an array of any layout are held to their declared signature
+            # (signatures.takes_any_layout): the others' arrays are C-contiguous, as declared.
+            found[name] = signatures.declared_only(key) if signatures.takes_any_layout(key) else getattr(module, name)
     return SimpleNamespace(source="jit", path=None, **found)
 
 
