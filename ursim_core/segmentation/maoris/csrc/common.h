@@ -107,6 +107,18 @@ static inline int float_arg(PyObject *obj, const char *what, double *out)
     return 0;
 }
 
+/* ValueError "KERNEL: FIRST and SECOND differ in shape" unless the 2-D arrays ``a`` and ``b``
+ * have the same rows and columns. 0, or -1 with the error set. */
+static inline int check_same_shape(const char *kernel, const char *first, const Array *a, const char *second,
+                                   const Array *b)
+{
+    if (a->rows != b->rows || a->cols != b->cols) {
+        PyErr_Format(PyExc_ValueError, "%s: %s and %s differ in shape", kernel, first, second);
+        return -1;
+    }
+    return 0;
+}
+
 /* Check a fast call's argument count. */
 static inline int check_nargs(const char *kernel, Py_ssize_t nargs, Py_ssize_t wanted)
 {

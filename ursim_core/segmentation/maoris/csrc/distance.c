@@ -117,8 +117,7 @@ KERNEL(distance_transform)
         || array_arg(args[1], NPY_FLOAT32, 2, 0, "out", &out)) {
         return NULL;
     }
-    if (free_mask.rows != out.rows || free_mask.cols != out.cols) {
-        PyErr_SetString(PyExc_ValueError, "distance_transform: free and out differ in shape");
+    if (check_same_shape("distance_transform", "free", &free_mask, "out", &out)) {
         return NULL;
     }
     int64_t rows = out.rows, cols = out.cols;

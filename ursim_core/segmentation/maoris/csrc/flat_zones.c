@@ -292,8 +292,7 @@ KERNEL(label_flat_zones)
         || array_arg(args[1], NPY_INT32, 2, 0, "labels", &labels)) {
         return NULL;
     }
-    if (labels.rows != values.rows || labels.cols != values.cols) {
-        PyErr_SetString(PyExc_ValueError, "label_flat_zones: values and labels differ in shape");
+    if (check_same_shape("label_flat_zones", "values", &values, "labels", &labels)) {
         return NULL;
     }
     int failed;

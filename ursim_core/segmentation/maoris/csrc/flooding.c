@@ -400,8 +400,7 @@ KERNEL(clearance_levels)
         || array_arg(args[1], NPY_UINT8, 2, 0, "free", &free_mask)) {
         return NULL;
     }
-    if (free_mask.rows != clearance.rows || free_mask.cols != clearance.cols) {
-        PyErr_SetString(PyExc_ValueError, "clearance_levels: clearance and free differ in shape");
+    if (check_same_shape("clearance_levels", "clearance", &clearance, "free", &free_mask)) {
         return NULL;
     }
     int status;

@@ -42,8 +42,7 @@ KERNEL(lookup_bytes)
         || array_arg(args[3], NPY_UINT8, 2, 0, "out", &out)) {
         return NULL;
     }
-    if (out.rows != values.rows || out.cols != values.cols) {
-        PyErr_SetString(PyExc_ValueError, "lookup_bytes: values and out differ in shape");
+    if (check_same_shape("lookup_bytes", "values", &values, "out", &out)) {
         return NULL;
     }
     int64_t n = values.size;
