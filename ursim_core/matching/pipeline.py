@@ -31,6 +31,7 @@ import dataclasses
 
 import networkx as nx
 
+from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
@@ -64,7 +65,9 @@ def _graph_of(segmentation_or_graph) -> nx.Graph:
     return segmentation_or_graph.graph
 
 
-def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, progress=None) -> Prepared:
+def prepare(
+    sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, progress=None, constraints=None
+) -> Prepared:
     """Compute everything that does not depend on m, the sketch's orientation included.
 
     With ``config.orientation='any'`` (the default) every candidate orientation of
@@ -85,6 +88,16 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     config : MatchConfig
     progress : callable, optional
         ``progress(fraction, message)`` while the orientations are tried.
+    constraints : MatchConstraints, optional
+        Pairs every answer contains or avoids, regions it leaves alone
+        (:mod:`ursim_core.matching.constraints`): the planar and Hungarian matchers honour them
+        in every orientation and at every m, so a person's pairs also steer the orientation.
+
+    Raises
+    ------
+    ParameterError
+        ``constraints`` name a region the segmentations do not have, or the matcher cannot
+        take them (VF2, overlay).
 
     Examples
     --------
@@ -97,11 +110,22 @@ def prepare(sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, prog
     """
     config = config.resolved()
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
+    constraints = constraints or None
+    if constraints is not None:
+        constraints.check_regions(sketch_graph.nodes, metric_graph.nodes)
+        if config.matcher not in ("planar", "hungarian"):
+            raise ParameterError(
+                f"constraints (fixed, forbidden or excluded regions) need the planar or the hungarian matcher, "
+                f"not {config.matcher!r}",
+                field="constraints",
+            )
     if config.matcher == "overlay":
         return _prepare_overlay(sketch_seg, metric_seg, config)
     candidates = _orientations(config, sketch_seg, metric_seg)
     outlines = _outlines(sketch_seg, sketch_graph, candidates)
     base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
+    if constraints is not None:
+        base = dataclasses.replace(base, constraints=constraints)
     if len(candidates) == 1:
         if not _refits(config):
             return base
@@ -251,7 +275,6 @@ _SCREEN_BY_ASSIGNMENT = 60
 
 def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig) -> Prepared:
     """The overlay matcher's answer, found once: it does not depend on m."""
-    from ursim_core.errors import ParameterError
     from ursim_core.matching.overlay import fit_overlay, overlay_pairs
 
     sketch_labels = getattr(sketch_seg, "labels", None)
@@ -440,7 +463,9 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
     return match_at(prepared, m)
 
 
-def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig(), progress=None) -> MatchResult:
+def match(
+    sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig(), progress=None, constraints=None
+) -> MatchResult:
     """Match the regions of a sketch to the regions of a metric map.
 
     Parameters
@@ -449,6 +474,8 @@ def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig(), progre
     config : MatchConfig
     progress : callable, optional
         ``progress(fraction, message)`` during the automatic m's sweep.
+    constraints : MatchConstraints, optional
+        Pairs the answer must contain or avoid (see :func:`prepare`).
 
     Returns
     -------
@@ -464,4 +491,5 @@ def match(sketch_seg, metric_seg, *, config: MatchConfig = MatchConfig(), progre
     >>> sorted(result.pairs), result.reason
     ([(0, 0), (1, 1), (2, 2), (3, 3)], '')
     """
-    return match_prepared(prepare(sketch_seg, metric_seg, config, progress=progress), progress=progress)
+    prepared = prepare(sketch_seg, metric_seg, config, progress=progress, constraints=constraints)
+    return match_prepared(prepared, progress=progress)

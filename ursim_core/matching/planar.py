@@ -239,6 +239,7 @@ def planar_match(
     keep_alternatives: bool = False,
     pair_costs: Sequence[Sequence[float]] | None = None,
     pair_cost_weight: float = 0.0,
+    constraints=None,
 ) -> PlanarResult:
     """Algorithm 1: seed-and-expand planar matching of two region graphs.
 
@@ -264,6 +265,11 @@ def planar_match(
         Cost of matching sketch vertex i to metric vertex j, added to the score with
         weight ``pair_cost_weight`` (see the module docstring).
     pair_cost_weight : float
+    constraints : IndexConstraints, optional
+        :class:`~ursim_core.matching.constraints.IndexConstraints`: fixed pairs start every
+        hypothesis as locked pairs (their neighbour lists are aligned as a seed's are), forbidden
+        pairs and excluded vertices are never paired. With fixed pairs every hypothesis holds
+        them (the one-pair hypotheses are not scored), and the first fixed pair is a seed of its own.
 
     Returns
     -------
@@ -283,6 +289,20 @@ def planar_match(
         seeds = [(i, j) for i in range(first.n_vertices) for j in range(second.n_vertices) if same[i][j]]
     else:
         seeds = list(seeds)
+    fixed: tuple = ()
+    forbidden: frozenset = frozenset()
+    if constraints is not None:
+        fixed, forbidden = tuple(constraints.fixed), constraints.forbidden
+        # Vertices no seed or expansion may pair: the excluded ones and those of the fixed pairs.
+        closed_first = constraints.excluded_first | {a for a, _ in fixed}
+        closed_second = constraints.excluded_second | {b for _, b in fixed}
+        seeds = [
+            seed
+            for seed in seeds
+            if seed[0] not in closed_first and seed[1] not in closed_second and seed not in forbidden
+        ]
+        if fixed:
+            seeds.insert(0, fixed[0])
     if not seeds:
         return PlanarResult(pairs=[], cost=math.inf, hypotheses=0, seeds_expanded=0)
     n_first, n_second = first.n_vertices, second.n_vertices
@@ -325,6 +345,10 @@ def planar_match(
     best_structure = single_structure
     best_cost = single_structure + pair_term(best_pairs)
     hypotheses = len(seeds)
+    if fixed:
+        # No hypothesis goes without the fixed pairs: the one-pair hypotheses are not scored,
+        # every seed's expansion (the first fixed pair's own included) is.
+        best_pairs, best_cost, best_structure, hypotheses = list(fixed), math.inf, math.inf, 0
     consumed = set()
     seeds_expanded = 0
     first_sets = [set(order) for order in first.neighbours]
@@ -355,13 +379,30 @@ def planar_match(
         seen_first = {seed_first}
         seen_second = {seed_second}
         queue = deque()
-        for pair in aligned_pairs(alignment):
-            queue.append(pair)
-            seen_first.add(pair[0])
-            seen_second.add(pair[1])
-            consumed.add(pair)
         matched = {seed_first: seed_second}
         pairs = [seed]
+        alignments = [alignment]
+        if constraints is not None:
+            seen_first |= closed_first
+            seen_second |= closed_second
+            if fixed:
+                # The fixed pairs are locked from the start; their neighbour lists are aligned
+                # as a seed's are (in the seed's reading, mirrored or not).
+                matched.update(fixed)
+                pairs = list(fixed) + ([] if seed in fixed else [seed])
+                alignments += [
+                    cyclic_align(first_orders[a], second.neighbours[b], same, rotation_search=rotation_search)
+                    for a, b in fixed
+                    if (a, b) != seed
+                ]
+        for each in alignments:
+            for pair in aligned_pairs(each):
+                if pair[0] in seen_first or pair[1] in seen_second or pair in forbidden:
+                    continue
+                queue.append(pair)
+                seen_first.add(pair[0])
+                seen_second.add(pair[1])
+                consumed.add(pair)
         # The loop below runs for every pair of every hypothesis (hundreds of thousands per m
         # on a building map): bound methods and the pair tuples are reused, not looked up or
         # rebuilt each time.
@@ -386,7 +427,7 @@ def planar_match(
                 (vertex, partner, reflected),
             ):
                 a, b = candidate
-                if a not in seen_first and b not in seen_second:
+                if a not in seen_first and b not in seen_second and candidate not in forbidden:
                     push(candidate)
                     see_first(a)
                     see_second(b)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -9,6 +10,7 @@ import networkx as nx
 import numpy as np
 
 from ursim_core.matching.config import MatchConfig
+from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, index_constraints
 from ursim_core.matching.descriptors import PairDescriptors
 from ursim_core.matching.planar import PlanarGraph
 
@@ -32,6 +34,13 @@ class Prepared:
     orientation_scan: dict = field(default_factory=dict)
     #: The automatic-m answer found while choosing the orientation (reused by :func:`match_prepared`).
     chosen: Any = None
+    #: What a person has said about the pair (:class:`~ursim_core.matching.constraints.MatchConstraints`).
+    constraints: MatchConstraints | None = None
+
+    @functools.cached_property
+    def index_constraints(self) -> IndexConstraints | None:
+        """``constraints`` in the planar graphs' vertex indices (None when there are none)."""
+        return index_constraints(self.constraints, self.sketch_planar.nodes, self.metric_planar.nodes)
 
     @property
     def c_matrix(self) -> np.ndarray:

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from ursim_core.errors import ParameterError
 from ursim_core.matching.baselines import hungarian_match, vf2_match
 from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.planar import hypothesis_cost, planar_match
@@ -115,6 +116,25 @@ def pair_cost_matrix(config: MatchConfig, c_matrix: np.ndarray, m: float) -> np.
     return np.asarray(c_matrix, dtype=np.float64)
 
 
+def _constrained_costs(c_matrix: np.ndarray, m: float, constraints) -> np.ndarray:
+    """``c`` for the Hungarian baseline under ``constraints``: a fixed pair costs less than
+    anything (and nothing else in its row and column can be kept); forbidden pairs and excluded
+    regions cost more than any m, so they are never kept."""
+    if constraints is None:
+        return c_matrix
+    costs = np.array(c_matrix, dtype=np.float64)
+    above = max(float(m), float(np.nanmax(costs, initial=0.0))) + 1.0
+    for a, b in constraints.forbidden:
+        costs[a, b] = above
+    costs[list(constraints.excluded_first), :] = above
+    costs[:, list(constraints.excluded_second)] = above
+    for a, b in constraints.fixed:
+        costs[a, :] = above
+        costs[:, b] = above
+        costs[a, b] = min(0.0, float(m))
+    return costs
+
+
 def _cost_of(prepared: Prepared, index_pairs, pair_costs) -> tuple[float, float]:
     first, second = prepared.sketch_planar, prepared.metric_planar
     total = first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges)
@@ -139,7 +159,9 @@ def planar_seeds(prepared: Prepared, m: float, seed_selector: SeedSelector | Non
     return seed_pairs(c_matrix, m, max_seeds=cap)
 
 
-def planar_outcome(sketch_planar, metric_planar, c_matrix: np.ndarray, config: MatchConfig, m: float, seeds):
+def planar_outcome(
+    sketch_planar, metric_planar, c_matrix: np.ndarray, config: MatchConfig, m: float, seeds, constraints=None
+):
     """:func:`~ursim_core.matching.planar.planar_match` at m from these seeds, as :func:`match_at` runs it.
 
     Everything it reads is passed in (no :class:`Prepared`), so that a helper process of a sweep
@@ -156,6 +178,7 @@ def planar_outcome(sketch_planar, metric_planar, c_matrix: np.ndarray, config: M
         reflections=config.reflections,
         pair_costs=pair_cost_matrix(config, c_matrix, m),
         pair_cost_weight=config.score_weight,
+        constraints=constraints,
     )
 
 
@@ -195,22 +218,30 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
     seeds_count = 0
     hypotheses = 0
     pair_costs = pair_cost_matrix(config, c_matrix, m) if descriptors is not None else None
+    constraints = prepared.index_constraints
     if descriptors is not None:
         if config.matcher == "planar":
             seeds = planar_seeds(prepared, m, seed_selector)
             seeds_count = len(seeds)
-            if not seeds:
+            if not seeds and not (constraints and constraints.fixed):
                 reasons.append(f"no seeds: no pair of regions has c <= m = {m:g}")
             else:
                 if outcome is None:
-                    outcome = planar_outcome(prepared.sketch_planar, prepared.metric_planar, c_matrix, config, m, seeds)
+                    outcome = planar_outcome(
+                        prepared.sketch_planar, prepared.metric_planar, c_matrix, config, m, seeds, constraints
+                    )
                 index_pairs = outcome.pairs
                 hypotheses = outcome.hypotheses
         elif config.matcher == "hungarian":
-            index_pairs = hungarian_match(c_matrix, m)
+            index_pairs = hungarian_match(_constrained_costs(c_matrix, m, constraints), m)
             if not index_pairs:
                 reasons.append(f"no assigned pair has c <= m = {m:g}")
         else:
+            if constraints is not None:
+                raise ParameterError(
+                    "constraints (fixed, forbidden or excluded regions) need the planar or the hungarian matcher",
+                    field="constraints",
+                )
             sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
             found = vf2_match(prepared.sketch_graph, prepared.metric_graph, c_matrix, m, timeout=config.vf2_timeout)
             sketch_index = {n: i for i, n in enumerate(sketch_nodes)}

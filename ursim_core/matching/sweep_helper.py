@@ -73,6 +73,8 @@ def active(prepared, grid_length: int) -> Helper | None:
         return None
     if prepared.config.matcher != "planar" or prepared.descriptors is None:
         return None
+    if prepared.constraints:
+        return None  # the helper runs unconstrained matches: a person's review is matched here
     return helper if max(prepared.c_matrix.shape) >= MIN_REGIONS else None
 
 
