@@ -110,3 +110,26 @@ def test_two_georeferenced_maps_are_overlaid_at_the_scale_of_their_resolutions(w
     result = session.last_match
     assert (result.config.matcher, result.config.scale) == ("overlay", 2.0)
     assert sorted(result.pairs) == [(1, 1), (2, 2), (3, 3)]
+
+
+def test_matching_again_builds_on_the_review(window, qtbot):
+    """Accepted and rejected cliques used to be replaced by the next match (the review was lost)."""
+    session = window.session
+    with qtbot.waitSignal(session.correspondences_changed, timeout=60_000):
+        window.matching_panel.match_button.click()
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+    first, second = session.correspondences.cliques[:2]
+    session.set_status(first.id, "accepted")
+    session.set_status(second.id, "rejected")
+    rejected_pair = (second.sketch_regions[0], second.metric_regions[0])
+
+    with qtbot.waitSignal(session.correspondences_changed, timeout=60_000):
+        window.matching_panel.match_button.click()
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+
+    cliques = session.correspondences.cliques
+    assert [c.id for c in cliques if c.status == "accepted"] == [first.id]
+    assert [c.id for c in cliques if c.status == "rejected"] == [second.id]
+    assert rejected_pair not in session.last_match.pairs
+    assert (first.sketch_regions[0], first.metric_regions[0]) in session.last_match.pairs
+    assert "building on 2 reviewed pairs" in window.status.currentMessage()

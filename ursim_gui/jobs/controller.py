@@ -140,7 +140,9 @@ class JobController(QObject):
         if config is not None and sketch_map is not None and metric_map is not None:
             # As `ursim match`: two georeferenced maps (ROS YAML) tell their relative scale.
             config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
-        return MatchJob(sketch, metric, config)
+        # The person's manual, accepted and rejected cliques steer the answer (see
+        # AnnotationSession.review_constraints), read now: edits made while it was queued count.
+        return MatchJob(sketch, metric, config, constraints=self._session.review_constraints())
 
     def submit(self, job) -> None:
         """Queue any other job (``run(progress, cancelled)``); its result comes as ``result_ready``."""
@@ -171,7 +173,11 @@ class JobController(QObject):
                 self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
         elif isinstance(job, MatchJob):
             self._session.apply_match(result)
-            self._status.showMessage(f"Matched: {len(result.pairs)} pairs", 5000)
+            kept = ""
+            if job.constraints is not None:
+                reviewed = len(job.constraints.fixed) + len(job.constraints.forbidden)
+                kept = f" (building on {reviewed} reviewed pair{'s' if reviewed != 1 else ''})"
+            self._status.showMessage(f"Matched: {len(result.pairs)} pairs{kept}", 5000)
         else:
             self._status.showMessage(f"{job.description}: done", 5000)
             self.result_ready.emit(job, result)

@@ -15,7 +15,6 @@ then discarded instead of being applied.
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Callable
 from typing import Any
 
@@ -162,12 +161,16 @@ class MatchJob:
         The two segmented maps.
     config : ursim_core.matching.MatchConfig, optional
         Matching parameters; the core's defaults when None.
+    constraints : ursim_core.matching.MatchConstraints, optional
+        What the person has reviewed (``AnnotationSession.review_constraints``): the answer
+        contains their pairs and avoids the rejected ones.
     """
 
-    def __init__(self, sketch_seg: Any, metric_seg: Any, config: Any = None) -> None:
+    def __init__(self, sketch_seg: Any, metric_seg: Any, config: Any = None, constraints: Any = None) -> None:
         self.sketch_seg = sketch_seg
         self.metric_seg = metric_seg
         self.config = config
+        self.constraints = constraints
 
     @property
     def description(self) -> str:
@@ -210,11 +213,9 @@ class MatchJob:
 
             return report
 
-        # A core whose prepare() searches the sketch's orientation reports it too.
-        if "progress" in inspect.signature(prepare).parameters:
-            prepared = prepare(self.sketch_seg, self.metric_seg, config, progress=phase(0.0, 0.5))
-        else:
-            prepared = prepare(self.sketch_seg, self.metric_seg, config)
+        prepared = prepare(
+            self.sketch_seg, self.metric_seg, config, progress=phase(0.0, 0.5), constraints=self.constraints
+        )
         _check(cancelled, "matching")
         progress(max(reached[0], 0.05), "matching")
         sweep_progress = phase(max(reached[0], 0.05), 1.0)

@@ -200,13 +200,42 @@ class EditOperations:
             return
         self._commit(f"Label clique {clique.id}", self._corr.with_clique(with_clique_label(clique, text)))
 
-    def apply_match(self, result) -> None:
-        """Replace every automatic clique by one clique per pair of ``result`` (one undo step).
+    def review_constraints(self):
+        """What the person has reviewed so far, as constraints on the next match.
 
-        Manual cliques are kept, and a pair they already contain is not added again. New
-        cliques are ``source='auto'`` with status None (pending), anchored at the regions'
-        interior points, scored with the matcher's ``c`` value of the pair when available.
-        ``anchors`` and ``last_match`` are updated (they are not part of the undo history).
+        Manual and accepted cliques become pairs every answer contains, rejected ones pairs no
+        answer proposes again (:func:`ursim_core.matching.constraints_from_cliques`); pending
+        automatic cliques say nothing. Cliques naming a region the current segmentations do not
+        have are left out. None when there is nothing reviewed or a map is not segmented.
+        """
+        from ursim_core.matching import constraints_from_cliques
+
+        segmentations = [self._segmentations[side] for side in SIDES]
+        if any(segmentation is None for segmentation in segmentations):
+            return None
+        graphs = {side: self._segmentations[side].graph for side in SIDES}
+        reviewed = [
+            clique
+            for clique in self._corr.cliques
+            if _is_reviewed(clique)
+            and set(clique.sketch_regions) <= set(graphs["sketch"].nodes)
+            and set(clique.metric_regions) <= set(graphs["metric"].nodes)
+        ]
+        constraints = constraints_from_cliques(
+            reviewed, sizes={side: dict(graph.nodes(data="size", default=0)) for side, graph in graphs.items()}
+        )
+        return constraints or None
+
+    def apply_match(self, result) -> None:
+        """Replace the pending automatic cliques by one clique per new pair of ``result`` (one undo step).
+
+        Every clique a person made or reviewed is kept: manual, accepted and rejected ones. A
+        pair is not added when a kept clique already holds one of its regions (a region a
+        person vouched for gets no second, automatic partner) or when a rejected clique holds
+        the pair. New cliques are ``source='auto'`` with status None (pending), anchored at the
+        regions' interior points, scored with the matcher's ``c`` value of the pair when
+        available. ``anchors`` and ``last_match`` are updated (they are not part of the undo
+        history).
 
         Raises
         ------
@@ -221,9 +250,21 @@ class EditOperations:
         for sketch, metric in pairs:
             self._checked_regions("sketch", [sketch], stale_hint=True)
             self._checked_regions("metric", [metric], stale_hint=True)
-        kept = [clique for clique in self._corr.cliques if clique.source != "auto"]
-        covered = {pair for clique in kept for pair in product(clique.sketch_regions, clique.metric_regions)}
-        new_pairs = [pair for pair in dict.fromkeys(pairs) if pair not in covered]
+        kept = [clique for clique in self._corr.cliques if _is_reviewed(clique)]
+        rejected = {
+            pair
+            for clique in kept
+            if clique.status == "rejected"
+            for pair in product(clique.sketch_regions, clique.metric_regions)
+        }
+        vouched = [clique for clique in kept if clique.status != "rejected"]
+        taken_sketch = {region for clique in vouched for region in clique.sketch_regions}
+        taken_metric = {region for clique in vouched for region in clique.metric_regions}
+        new_pairs = [
+            pair
+            for pair in dict.fromkeys(pairs)
+            if pair not in rejected and pair[0] not in taken_sketch and pair[1] not in taken_metric
+        ]
         cliques = from_pairs(
             new_pairs,
             sketch_points_of=lambda region: self._interior_points("sketch", (region,))[0],
@@ -247,3 +288,9 @@ class EditOperations:
             return None
         value = float(matrix[sketch_ids.index(pair[0]), metric_ids.index(pair[1])])
         return value if value == value and abs(value) != float("inf") else None
+
+
+def _is_reviewed(clique: Clique) -> bool:
+    """True for a clique a person made or reviewed: manual, accepted or rejected (not a pending
+    automatic one, which the next match replaces)."""
+    return clique.source != "auto" or clique.status in ("accepted", "rejected")

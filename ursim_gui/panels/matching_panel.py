@@ -156,6 +156,10 @@ class MatchingPanel(QWidget):
         self._show_orientation()
         self.match_button = QPushButton("Match")
         self.match_button.setObjectName("match_button")
+        self.match_button.setToolTip(
+            "Run the matcher. Cliques you linked, accepted or rejected are kept: the answer contains "
+            "your pairs and never proposes a rejected one again; pending automatic cliques are replaced."
+        )
         self.match_button.clicked.connect(lambda: self.match_requested.emit(self.config()))
         form.addRow(self.match_button)
         self.summary = QLabel(describe_result(None))
