@@ -155,3 +155,43 @@ def test_match_a_metric_input_of_unknown_scale(tmp_path):
     config = document["matcher"]["config"]
     assert config["input_kind"] == "metric" and config["scale"] is None
     assert len(document["cliques"]) >= 3
+
+
+def test_match_again_on_a_review_keeps_it_and_builds_on_it(tmp_path, pair, capsys):
+    import dataclasses
+
+    from ursim_core.correspondences import save_correspondences
+
+    first = tmp_path / "first"
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(first)]) == 0
+    corr = load_correspondences(first / "correspondences.json")
+    accepted, rejected = corr.cliques[0], corr.cliques[1]
+    reviewed = corr.with_cliques(
+        [
+            dataclasses.replace(accepted, status="accepted", note="checked"),
+            dataclasses.replace(rejected, status="rejected"),
+            *corr.cliques[2:],
+        ]
+    )
+    save_correspondences(reviewed, tmp_path / "reviewed.json")
+
+    again = tmp_path / "again"
+    assert (
+        main(["match", str(pair[0]), str(pair[1]), "-o", str(again), "--review", str(tmp_path / "reviewed.json")]) == 0
+    )
+    cliques = load_correspondences(again / "correspondences.json").cliques
+    kept = [c for c in cliques if c.status in ("accepted", "rejected")]
+    assert [(c.id, c.status, c.note) for c in kept] == [
+        (accepted.id, "accepted", "checked"),
+        (rejected.id, "rejected", ""),
+    ]
+    new = [(c.sketch_regions, c.metric_regions) for c in cliques if c.status is None]
+    assert (rejected.sketch_regions, rejected.metric_regions) not in new
+    assert all(accepted.sketch_regions[0] not in s and accepted.metric_regions[0] not in m for s, m in new)
+    assert len({c.id for c in cliques}) == len(cliques)
+
+    capsys.readouterr()
+    assert (
+        main(["match", str(pair[0]), str(pair[1]), "-o", str(again), "--review", str(tmp_path / "nothere.json")]) == 1
+    )
+    assert "nothere.json: " in capsys.readouterr().err

@@ -55,6 +55,16 @@ def test_json_manifest_and_names(maps):
     pairs = read_manifest(maps / "pairs.json")
     assert [p["name"] for p in pairs] == ["001-sketch", "002-sketch"]
     assert pairs[0]["sketch"] == maps / "sketch.png" and pairs[0]["reference"] is None
+    assert pairs[0]["review"] is None
+
+
+def test_a_review_column_reaches_each_pair(maps):
+    (maps / "pairs.csv").write_text("sketch,metric,review\nsketch.png,metric.png,done/a.json\nsame.png,metric.png,\n")
+    assert [p["review"] for p in read_manifest(maps / "pairs.csv")] == [maps / "done" / "a.json", None]
+    out = maps / "out"
+    assert main(["match-batch", str(maps / "pairs.csv"), "-o", str(out), "--workers", "1"]) == 1
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert [r["status"] for r in rows] == ["failed", "ok"] and "a.json" in rows[0]["error"]
 
 
 @pytest.mark.parametrize(
@@ -65,6 +75,7 @@ def test_json_manifest_and_names(maps):
         ("c.json", "{}"),
         ("d.json", "[{'sketch': 1}]"),
         ("e.csv", "sketch,metric,name\na.png,b.png,x\nc.png,d.png,x\n"),
+        ("f.json", '[{"sketch": "a.png", "metric": "b.png", "review": 3}]'),
     ],
 )
 def test_bad_manifests_are_format_errors(tmp_path, name, text):

@@ -40,6 +40,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="ground truth of this pair (.dat or .json): print precision, recall, F1 and place accuracy",
     )
+    parser.add_argument(
+        "--review",
+        metavar="FILE",
+        help="a reviewed correspondence file of this pair (.json or .dat): its manual and accepted cliques "
+        "are kept and in the answer, its rejected pairs are never proposed; pending automatic cliques "
+        "are matched again",
+    )
     add_pair_options(parser)
 
 
@@ -172,6 +179,27 @@ def load_reference(path: str | Path):
     raise ParameterError("unknown ground-truth file type (expected .dat or .json)", path=path)
 
 
+def reviewed_cliques(review, sketch_seg, metric_seg):
+    """The reviewed cliques of a correspondence file, on this run's regions, and their constraints.
+
+    A clique a person made or reviewed (manual, accepted, rejected) keeps its points; its regions
+    are those under the points in these segmentations. Pending automatic cliques are dropped:
+    this run's answer replaces them. Returns ``([], None)`` without a file.
+    """
+    from ursim_core.correspondences import assign_regions
+    from ursim_core.matching import constraints_from_cliques
+
+    if review is None:
+        return [], None
+    review = assign_regions(review, sketch_seg.labels, metric_seg.labels, tolerance=10)
+    kept = [c for c in review.cliques if c.source != "auto" or c.status in ("accepted", "rejected")]
+    sizes = {
+        "sketch": dict(sketch_seg.graph.nodes(data="size", default=0)),
+        "metric": dict(metric_seg.graph.nodes(data="size", default=0)),
+    }
+    return kept, constraints_from_cliques(kept, sizes=sizes) or None
+
+
 def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, metric_preset: str, params: dict):
     """Pair score and place score of ``pairs`` against a ground truth with points."""
     from ursim_core.correspondences import assign_regions
@@ -260,12 +288,14 @@ def _return_freed_memory() -> None:
 
 
 def match_pair(
-    sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None, helper: bool = False
+    sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None, helper: bool = False, review_path=None
 ) -> dict[str, Any]:
     """Match one pair and write its outputs into ``out``; a record of what was done.
 
     The record has the counts, m, time and, with ``reference_path``, precision, recall, F1 and
     place accuracy against that ground truth. Errors propagate (the caller decides).
+    ``review_path``: a correspondence file of the pair whose reviewed cliques constrain the
+    answer and are written back with it (:func:`reviewed_cliques`).
     ``helper``: a building-sized pair shares the automatic m's sweep with a helper process
     (:mod:`ursim_core.matching.sweep_helper`; same answers). ``ursim match`` asks for it; the
     batch commands, which already run one pair per core, do not.
@@ -282,6 +312,7 @@ def match_pair(
     out = check_output_folder(out)
     # A bad ground-truth file is reported before any work.
     reference = None if reference_path is None else load_reference(reference_path)
+    review = None if review_path is None else load_reference(review_path)
     params = segmentation_params(args)
     # The sketch is segmented in its canonical pose unless the matcher is told it is upright.
     canonical = config.orientation != "upright"
@@ -314,18 +345,27 @@ def match_pair(
             pool.submit(save_label_image, sketch_seg, staging / "sketch.labels.png"),
             pool.submit(save_label_image, metric_seg, staging / "metric.labels.png"),
         ]
+        kept, constraints = reviewed_cliques(review, sketch_seg, metric_seg)
         with sweep_helper.helping(enabled=helper and large):
             started = time.perf_counter()
-            result = match(sketch_seg, metric_seg, config=config)
+            result = match(sketch_seg, metric_seg, config=config, constraints=constraints)
             elapsed = time.perf_counter() - started
         for job in jobs:
             job.result()
-        cliques = from_pairs(
-            result.pairs,
-            sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
-            metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
-            source="auto",
-        )
+        # A region a person vouched for gets no second, automatic partner (as in the app).
+        vouched = [c for c in kept if c.status != "rejected"]
+        taken_sketch = {r for c in vouched for r in c.sketch_regions}
+        taken_metric = {r for c in vouched for r in c.metric_regions}
+        cliques = [
+            *kept,
+            *from_pairs(
+                [(a, b) for a, b in result.pairs if a not in taken_sketch and b not in taken_metric],
+                sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
+                metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
+                source="auto",
+                first_id=max((c.id for c in kept), default=0) + 1,
+            ),
+        ]
         corr = Correspondences(
             sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
             metric=ref(metric_map, metric_seg, "metric.labels.png"),
@@ -374,7 +414,13 @@ def run(args: argparse.Namespace) -> int:
 
     keep_freed_memory()
     record = match_pair(
-        args.sketch, args.metric, Path(args.output), options_of(args), reference_path=args.reference, helper=True
+        args.sketch,
+        args.metric,
+        Path(args.output),
+        options_of(args),
+        reference_path=args.reference,
+        helper=True,
+        review_path=args.review,
     )
     out = record["out"]
     m = record["m"]

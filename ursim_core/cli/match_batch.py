@@ -1,7 +1,8 @@
 """``ursim match-batch``: match many sketch/metric pairs listed in a manifest, on a pool or a cluster.
 
-The manifest is a CSV with a header (columns ``sketch``, ``metric`` and optionally ``reference``
-and ``name``) or a JSON list of objects with those keys. Relative paths are taken from the
+The manifest is a CSV with a header (columns ``sketch``, ``metric`` and optionally ``reference``,
+``review`` and ``name``) or a JSON list of objects with those keys (``review``: a reviewed
+correspondence file of the pair, as ``ursim match --review`` takes it). Relative paths are taken from the
 manifest's folder. Each pair's outputs go to ``OUT/NAME/`` exactly as ``ursim match`` writes
 them; ``OUT/summary.csv`` has one row per pair, with its status and, for a failed pair, the
 error. A failed pair does not stop the others; the exit code is 1 when any failed.
@@ -53,7 +54,9 @@ SUMMARY_COLUMNS = (
 def configure(parser: argparse.ArgumentParser) -> None:
     from ursim_core.cli import match
 
-    parser.add_argument("manifest", metavar="MANIFEST", help="CSV (sketch,metric[,reference][,name]) or JSON list")
+    parser.add_argument(
+        "manifest", metavar="MANIFEST", help="CSV (sketch,metric[,reference][,review][,name]) or JSON list"
+    )
     parser.add_argument("-o", "--output", metavar="OUT", required=True, help="output folder")
     parser.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run the pairs on a Dask cluster instead")
@@ -62,7 +65,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def read_manifest(path: str | Path) -> list[dict[str, Any]]:
-    """The pairs of a manifest: dicts with ``name``, ``sketch``, ``metric``, ``reference`` (or None).
+    """The pairs of a manifest: dicts with ``name``, ``sketch``, ``metric``, ``reference`` and ``review`` (or None).
 
     Examples
     --------
@@ -98,9 +101,12 @@ def read_manifest(path: str | Path) -> list[dict[str, Any]]:
         for key in ("sketch", "metric"):
             if not isinstance(item.get(key), str) or not item[key].strip():
                 raise FormatError(f"pair {index}: '{key}' must be a path", path=path)
-        reference = item.get("reference")
-        if reference is not None and not isinstance(reference, str):
-            raise FormatError(f"pair {index}: 'reference' must be a path", path=path)
+        optional = {}
+        for key in ("reference", "review"):
+            value = item.get(key)
+            if value is not None and not isinstance(value, str):
+                raise FormatError(f"pair {index}: '{key}' must be a path", path=path)
+            optional[key] = path.parent / value.strip() if value and value.strip() else None
         sketch = path.parent / item["sketch"].strip()
         name = str(item.get("name") or "").strip() or f"{index:03d}-{sketch.stem}"
         if name in names or "/" in name or name in (".", ".."):
@@ -111,7 +117,7 @@ def read_manifest(path: str | Path) -> list[dict[str, Any]]:
                 "name": name,
                 "sketch": sketch,
                 "metric": path.parent / item["metric"].strip(),
-                "reference": path.parent / reference.strip() if reference and reference.strip() else None,
+                **optional,
             }
         )
     return pairs
@@ -124,7 +130,12 @@ def run_pair(pair: dict[str, Any], out: Path, options: dict[str, Any]) -> dict[s
     record: dict[str, Any] = {"name": pair["name"], "sketch": str(pair["sketch"]), "metric": str(pair["metric"])}
     try:
         result = match_pair(
-            pair["sketch"], pair["metric"], out / pair["name"], options, reference_path=pair["reference"]
+            pair["sketch"],
+            pair["metric"],
+            out / pair["name"],
+            options,
+            reference_path=pair["reference"],
+            review_path=pair.get("review"),
         )
     except UrsimError as error:
         return {**record, "status": "failed", "error": str(error)}
