@@ -54,3 +54,20 @@ def test_counts_below_one_are_usage_errors(option, value, capsys):
         main(["bench", "invariance", option, value])
     assert stopped.value.code == 2
     assert "at least 1" in capsys.readouterr().err
+
+
+def test_review_without_the_kth_dataset_says_what_is_missing(tmp_path, capsys):
+    assert runner.run_bench("review", datasets=tmp_path) == 1
+    assert "'ursim bench review' needs ursim_kth_sketches" in capsys.readouterr().err
+
+
+def test_review_table_has_a_row_per_review_and_the_totals(capsys):
+    from ursim_core.bench.review import print_review
+
+    row = {"sketch": "03", "annotator": "a", "cliques": 5}
+    for workflow, edits in (("by hand", 4), ("links first", 2), ("every edit", 6)):
+        row.update({workflow: edits, f"{workflow} rounds": 1, f"{workflow} finished": workflow != "every edit"})
+    print_review([row])
+    out = capsys.readouterr().out
+    assert "total edits: by hand 4, links first 2 (-50%), every edit 6 (+50%) over 1 reviews of 5 cliques" in out
+    assert "6*" in out and "1 not finished" in out

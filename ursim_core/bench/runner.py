@@ -37,7 +37,8 @@ def run_bench(
     every preset on maoris_segmentation, :mod:`ursim_core.bench.quality`; ``csv``: also the rows)
     or 'invariance' (matching accuracy on ``seeds`` generated pairs turned, mirrored, cropped and
     rescaled, :mod:`ursim_core.bench.invariance`; ``first_seed``: the first of them, so that pairs not
-    looked at while tuning can be held out, e.g. seeds 8-15).
+    looked at while tuning can be held out, e.g. seeds 8-15) or 'review' (edits of a simulated
+    annotator on the KTH sketches, :mod:`ursim_core.bench.review`).
     ``sizes``: the building sides of 'scale' (default :data:`SCALE_SIZES`).
     Returns the exit code: 1 when the benchmark is not available.
     """
@@ -65,6 +66,20 @@ def run_bench(
         from ursim_core.bench.quality import bench_quality
 
         bench_quality(root, csv_path=csv)
+        return 0
+    if what == "review":
+        import sys
+
+        if root is None or not (root / "ursim_kth_sketches").is_dir():
+            print(f"error: 'ursim bench review' needs ursim_kth_sketches ({MISSING_REASON})", file=sys.stderr)
+            return 1
+        from ursim_core.bench.review import bench_review, print_review
+
+        print(
+            "== simulated review of the KTH sketches: rejections + links until the answer is each annotator's "
+            "(by hand; matched again on the review after each link, then rejecting; after every edit)"
+        )
+        print_review(bench_review(root))
         return 0
     if what == "invariance":
         from ursim_core.bench.invariance import bench_invariance, print_invariance

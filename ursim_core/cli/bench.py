@@ -11,10 +11,11 @@ EXAMPLES = """examples:
   ursim bench scale --sizes 1000 2000 4000
   ursim bench invariance --seeds 12
   ursim bench invariance --seeds 8 --first-seed 8
+  ursim bench review
   ursim bench all --datasets ../shared/datasets"""
 
 #: Benchmarks by name; "all" runs segment, scale and match (the others on request).
-BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "quality", "invariance", "all")
+BENCHMARKS = ("segment", "scale", "match", "startup", "compile", "files", "quality", "invariance", "review", "all")
 
 
 def _count(text: str) -> int:
@@ -48,7 +49,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="startup: whole-process times of ursim --help / match / segment; compile: first-run kernel "
         "compilation; files: correspondence file load/save; quality: segmentation F1 of every preset, "
         "in-sample and leave-one-map-out; invariance: matching F1 and place accuracy on generated pairs turned, "
-        "mirrored, cropped and rescaled; all: segment, scale and match",
+        "mirrored, cropped and rescaled; review: edits of a simulated annotator on the KTH sketches, with and "
+        "without matching again on the review; all: segment, scale and match",
     )
     parser.add_argument("--datasets", help="datasets folder (default: $URSIM_DATASETS or ../shared/datasets)")
     parser.add_argument("--repeats", type=_count, default=5)

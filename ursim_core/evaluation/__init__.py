@@ -8,7 +8,8 @@ process pool :mod:`~ursim_core.evaluation.pool` and scored tasks :mod:`~ursim_co
 the values it produces and their summaries (:mod:`~ursim_core.evaluation.results`), the ceiling of a
 one-to-one matcher against the annotators (:mod:`~ursim_core.evaluation.ceiling`), the KTH protocol
 of the matching benchmark (:mod:`~ursim_core.evaluation.kth_protocol`), turned and mirrored
-sketches with their ground truth (:mod:`~ursim_core.evaluation.augment`) and the report
+sketches with their ground truth (:mod:`~ursim_core.evaluation.augment`), a simulated annotator's
+review (:mod:`~ursim_core.evaluation.review`) and the report
 (:mod:`~ursim_core.evaluation.report`: CSV and markdown; :mod:`~ursim_core.evaluation.tables`,
 :mod:`~ursim_core.evaluation.plots`, :mod:`~ursim_core.evaluation.published`).
 
@@ -33,6 +34,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "published",
         "report",
         "results",
+        "review",
         "runner",
         "scoring",
         "tables",
