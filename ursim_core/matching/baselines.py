@@ -114,11 +114,13 @@ def vf2_match(
     if max(len(sketch_nodes), len(metric_nodes)) > max_vertices:
         return Vf2Result([], f"graphs larger than max_vertices={max_vertices}: VF2 not run")
     compatible = np.asarray(c_matrix) <= m
-    sketch_index = {node: i for i, node in enumerate(sketch_nodes)}
-    metric_index = {node: i for i, node in enumerate(metric_nodes)}
-    # Tag nodes so that node_match knows which graph a node comes from.
-    sketch_tagged = nx.relabel_nodes(sketch_graph, {n: ("s", n) for n in sketch_graph.nodes})
-    metric_tagged = nx.relabel_nodes(metric_graph, {n: ("m", n) for n in metric_graph.nodes})
+    # Nodes are renamed to integers: sketch node i of ``sketch_nodes`` is i, metric node j is
+    # n_sketch + j. GraphMatcher iterates sets of nodes, so nodes whose hash depends on the
+    # interpreter's string-hash seed (tuples with a tag string, as before) made the first
+    # isomorphism found, and so the answer, differ from one process to the next.
+    n_sketch = len(sketch_nodes)
+    sketch_tagged = nx.relabel_nodes(sketch_graph, {n: i for i, n in enumerate(sketch_nodes)})
+    metric_tagged = nx.relabel_nodes(metric_graph, {n: n_sketch + j for j, n in enumerate(metric_nodes)})
     for graph in (sketch_tagged, metric_tagged):
         for node in graph.nodes:
             graph.nodes[node].clear()
@@ -132,7 +134,7 @@ def vf2_match(
             raise _OutOfTime
         a, b = big_attributes["key"], small_attributes["key"]
         sketch_node, metric_node = (b, a) if sketch_is_pattern else (a, b)
-        return bool(compatible[sketch_index[sketch_node[1]], metric_index[metric_node[1]]])
+        return bool(compatible[sketch_node, metric_node - n_sketch])
 
     from networkx.algorithms import isomorphism
 
@@ -146,5 +148,5 @@ def vf2_match(
     pairs = []
     for big_node, small_node in mapping.items():
         sketch_node, metric_node = (small_node, big_node) if sketch_is_pattern else (big_node, small_node)
-        pairs.append((sketch_node[1], metric_node[1]))
-    return Vf2Result(sorted(pairs, key=lambda p: sketch_index[p[0]]), "")
+        pairs.append((sketch_node, metric_node - n_sketch))
+    return Vf2Result([(sketch_nodes[i], metric_nodes[j]) for i, j in sorted(pairs)], "")

@@ -47,3 +47,25 @@ def test_vf2_no_isomorphism_and_guards():
     assert gave_up.pairs == [] and "gave up" in gave_up.gave_up
     capped = vf2_match(triangle, star, np.zeros((3, 4)), 0.1, max_vertices=3)
     assert "max_vertices" in capped.gave_up
+
+
+def test_vf2_finds_the_same_isomorphism_in_every_process():
+    """The answer depended on the interpreter's string-hash seed (nodes were tagged with strings),
+    so `ursim evaluate` on a process pool and on a Dask cluster disagreed on the VF2 rows."""
+    import subprocess
+    import sys
+
+    script = (
+        "import networkx as nx, numpy as np\n"
+        "from ursim_core.matching.baselines import vf2_match\n"
+        "small, big = nx.cycle_graph(range(10, 16)), nx.cycle_graph(range(20, 26))\n"
+        "big.add_edges_from([(20, 30), (30, 31)])\n"
+        "print(vf2_match(small, big, np.zeros((6, 8)), 0.5).pairs)\n"
+    )
+    answers = set()
+    for seed in ("1", "2", "3", "4", "5"):
+        env = {**__import__("os").environ, "PYTHONHASHSEED": seed}
+        answers.add(
+            subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True).stdout
+        )
+    assert len(answers) == 1 and "(10, " in answers.pop()
