@@ -192,7 +192,7 @@ def reviewed_cliques(review, sketch_seg, metric_seg):
     if review is None:
         return [], None
     review = assign_regions(review, sketch_seg.labels, metric_seg.labels, tolerance=10)
-    kept = [c for c in review.cliques if c.source != "auto" or c.status in ("accepted", "rejected")]
+    kept = [c for c in review.cliques if c.is_reviewed]
     sizes = {
         "sketch": dict(sketch_seg.graph.nodes(data="size", default=0)),
         "metric": dict(metric_seg.graph.nodes(data="size", default=0)),

@@ -217,6 +217,12 @@ class Clique:
         return "pending" if self.source == "auto" else "accepted"
 
     @property
+    def is_reviewed(self) -> bool:
+        """True for a clique a person made (manual) or reviewed (accepted or rejected); a pending
+        automatic clique is a matcher's proposal, which the next match replaces."""
+        return self.source != "auto" or self.status in ("accepted", "rejected")
+
+    @property
     def is_empty(self) -> bool:
         """True when the clique has no point and no region on either side."""
         return not (self.sketch_points or self.metric_points or self.sketch_regions or self.metric_regions)

@@ -142,9 +142,7 @@ def constraints_from_cliques(cliques, *, sizes: Mapping[str, Mapping[int, float]
 
     Parameters
     ----------
-    cliques : iterable of Clique
-        :class:`ursim_core.correspondences.Clique` (or anything with its region, source and
-        status attributes).
+    cliques : iterable of :class:`ursim_core.correspondences.Clique`
     sizes : {'sketch': {region: size}, 'metric': {...}}, optional
 
     Examples
@@ -169,10 +167,9 @@ def constraints_from_cliques(cliques, *, sizes: Mapping[str, Mapping[int, float]
     vouched: list = []
     for clique in cliques:
         sketch, metric = list(clique.sketch_regions), list(clique.metric_regions)
-        status = clique.status
-        if status == "rejected":
+        if clique.status == "rejected":
             forbidden.update((a, b) for a in sketch for b in metric)
-        elif clique.source != "auto" or status == "accepted":
+        elif clique.is_reviewed:
             vouched.append((sketch, metric))
     taken_sketch, taken_metric = set(), set()
     for sketch, metric in vouched:

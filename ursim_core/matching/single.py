@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 
-from ursim_core.errors import ParameterError
 from ursim_core.matching.baselines import hungarian_match, vf2_match
 from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.planar import hypothesis_cost, planar_match
@@ -236,12 +235,7 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
             index_pairs = hungarian_match(_constrained_costs(c_matrix, m, constraints), m)
             if not index_pairs:
                 reasons.append(f"no assigned pair has c <= m = {m:g}")
-        else:
-            if constraints is not None:
-                raise ParameterError(
-                    "constraints (fixed, forbidden or excluded regions) need the planar or the hungarian matcher",
-                    field="constraints",
-                )
+        else:  # VF2: prepare() refuses constraints for it
             sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
             found = vf2_match(prepared.sketch_graph, prepared.metric_graph, c_matrix, m, timeout=config.vf2_timeout)
             sketch_index = {n: i for i, n in enumerate(sketch_nodes)}

@@ -210,16 +210,16 @@ class EditOperations:
         """
         from ursim_core.matching import constraints_from_cliques
 
-        segmentations = [self._segmentations[side] for side in SIDES]
-        if any(segmentation is None for segmentation in segmentations):
+        if any(self._segmentations[side] is None for side in SIDES):
             return None
         graphs = {side: self._segmentations[side].graph for side in SIDES}
+        sketch_regions, metric_regions = set(graphs["sketch"].nodes), set(graphs["metric"].nodes)
         reviewed = [
             clique
             for clique in self._corr.cliques
-            if _is_reviewed(clique)
-            and set(clique.sketch_regions) <= set(graphs["sketch"].nodes)
-            and set(clique.metric_regions) <= set(graphs["metric"].nodes)
+            if clique.is_reviewed
+            and set(clique.sketch_regions) <= sketch_regions
+            and set(clique.metric_regions) <= metric_regions
         ]
         constraints = constraints_from_cliques(
             reviewed, sizes={side: dict(graph.nodes(data="size", default=0)) for side, graph in graphs.items()}
@@ -250,7 +250,7 @@ class EditOperations:
         for sketch, metric in pairs:
             self._checked_regions("sketch", [sketch], stale_hint=True)
             self._checked_regions("metric", [metric], stale_hint=True)
-        kept = [clique for clique in self._corr.cliques if _is_reviewed(clique)]
+        kept = [clique for clique in self._corr.cliques if clique.is_reviewed]
         rejected = {
             pair
             for clique in kept
@@ -288,9 +288,3 @@ class EditOperations:
             return None
         value = float(matrix[sketch_ids.index(pair[0]), metric_ids.index(pair[1])])
         return value if value == value and abs(value) != float("inf") else None
-
-
-def _is_reviewed(clique: Clique) -> bool:
-    """True for a clique a person made or reviewed: manual, accepted or rejected (not a pending
-    automatic one, which the next match replaces)."""
-    return clique.source != "auto" or clique.status in ("accepted", "rejected")
