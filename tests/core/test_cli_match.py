@@ -195,3 +195,22 @@ def test_match_again_on_a_review_keeps_it_and_builds_on_it(tmp_path, pair, capsy
         main(["match", str(pair[0]), str(pair[1]), "-o", str(again), "--review", str(tmp_path / "nothere.json")]) == 1
     )
     assert "nothere.json: " in capsys.readouterr().err
+
+
+def test_a_review_with_a_matcher_that_takes_no_constraints_is_kept_as_it_is(tmp_path, pair, capsys):
+    import dataclasses
+
+    from ursim_core.correspondences import save_correspondences
+
+    first = tmp_path / "first"
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(first)]) == 0
+    corr = load_correspondences(first / "correspondences.json")
+    reviewed = corr.with_cliques([dataclasses.replace(corr.cliques[0], status="accepted")])
+    save_correspondences(reviewed, tmp_path / "reviewed.json")
+    capsys.readouterr()
+    out = tmp_path / "vf2"
+    args = ["match", str(pair[0]), str(pair[1]), "-o", str(out), "--matcher", "vf2", "--review"]
+    assert main([*args, str(tmp_path / "reviewed.json")]) == 0
+    assert "the vf2 matcher does not take the review's pairs" in capsys.readouterr().err
+    cliques = load_correspondences(out / "correspondences.json").cliques
+    assert [(c.id, c.status) for c in cliques if c.status] == [(corr.cliques[0].id, "accepted")]

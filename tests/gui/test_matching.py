@@ -133,3 +133,24 @@ def test_matching_again_builds_on_the_review(window, qtbot):
     assert rejected_pair not in session.last_match.pairs
     assert (first.sketch_regions[0], first.metric_regions[0]) in session.last_match.pairs
     assert "building on 2 reviewed pairs" in window.status.currentMessage()
+
+
+def test_a_matcher_without_constraints_still_keeps_the_review(window, qtbot):
+    from conftest import error_boxes
+
+    session = window.session
+    with qtbot.waitSignal(session.correspondences_changed, timeout=60_000):
+        window.matching_panel.match_button.click()
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+    accepted = session.correspondences.cliques[0]
+    session.set_status(accepted.id, "accepted")
+    panel = window.matching_panel
+    panel.matcher.setCurrentIndex(panel.matcher.findData("vf2"))
+
+    with qtbot.waitSignal(session.correspondences_changed, timeout=60_000):
+        panel.match_button.click()
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+
+    assert not error_boxes(window)
+    assert session.last_match.config.matcher == "vf2"
+    assert [c.id for c in session.correspondences.cliques if c.status == "accepted"] == [accepted.id]

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -303,7 +304,7 @@ def match_pair(
     from types import SimpleNamespace
 
     from ursim_core.correspondences import Correspondences, MapRef, from_pairs, save_correspondences
-    from ursim_core.matching import match, sweep_helper
+    from ursim_core.matching import CONSTRAINED_MATCHERS, match, sweep_helper
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -346,6 +347,13 @@ def match_pair(
             pool.submit(save_label_image, metric_seg, staging / "metric.labels.png"),
         ]
         kept, constraints = reviewed_cliques(review, sketch_seg, metric_seg)
+        if constraints is not None and config.resolved().matcher not in CONSTRAINED_MATCHERS:
+            print(
+                f"note: the {config.resolved().matcher} matcher does not take the review's pairs; "
+                "its reviewed cliques are kept as they are",
+                file=sys.stderr,
+            )
+            constraints = None
         with sweep_helper.helping(enabled=helper and large):
             started = time.perf_counter()
             result = match(sketch_seg, metric_seg, config=config, constraints=constraints)

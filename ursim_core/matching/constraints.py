@@ -25,7 +25,17 @@ from dataclasses import dataclass, field
 
 from ursim_core.errors import ParameterError
 
-__all__ = ["MatchConstraints", "IndexConstraints", "constraints_from_cliques", "index_constraints"]
+__all__ = [
+    "CONSTRAINED_MATCHERS",
+    "MatchConstraints",
+    "IndexConstraints",
+    "constraints_from_cliques",
+    "index_constraints",
+]
+
+#: The matchers that honour constraints (``MatchConfig.resolved().matcher``); VF2 and the overlay
+#: matcher do not: ``prepare`` refuses constraints for them.
+CONSTRAINED_MATCHERS = ("planar", "hungarian")
 
 
 @dataclass(frozen=True)

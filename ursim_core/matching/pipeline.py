@@ -34,6 +34,7 @@ import networkx as nx
 from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
+from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines
 from ursim_core.matching.planar import planar_graph
@@ -113,7 +114,7 @@ def prepare(
     constraints = constraints or None
     if constraints is not None:
         constraints.check_regions(sketch_graph.nodes, metric_graph.nodes)
-        if config.matcher not in ("planar", "hungarian"):
+        if config.matcher not in CONSTRAINED_MATCHERS:
             raise ParameterError(
                 f"constraints (fixed, forbidden or excluded regions) need the planar or the hungarian matcher, "
                 f"not {config.matcher!r}",

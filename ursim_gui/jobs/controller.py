@@ -142,7 +142,12 @@ class JobController(QObject):
             config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
         # The person's manual, accepted and rejected cliques steer the answer (see
         # AnnotationSession.review_constraints), read now: edits made while it was queued count.
-        return MatchJob(sketch, metric, config, constraints=self._session.review_constraints())
+        # The overlay matcher (robot maps) and VF2 take no constraints: the session still keeps
+        # the review when it applies their answer.
+        from ursim_core.matching import CONSTRAINED_MATCHERS, MatchConfig
+
+        steered = (config or MatchConfig()).resolved().matcher in CONSTRAINED_MATCHERS
+        return MatchJob(sketch, metric, config, constraints=self._session.review_constraints() if steered else None)
 
     def submit(self, job) -> None:
         """Queue any other job (``run(progress, cancelled)``); its result comes as ``result_ready``."""
