@@ -154,3 +154,15 @@ def test_a_matcher_without_constraints_still_keeps_the_review(window, qtbot):
     assert not error_boxes(window)
     assert session.last_match.config.matcher == "vf2"
     assert [c.id for c in session.correspondences.cliques if c.status == "accepted"] == [accepted.id]
+
+
+def test_ctrl_m_matches_again_after_a_link(window, qtbot):
+    session = window.session
+    assert window.actions["match"].isEnabled()
+    session.link([1], [2])
+    with qtbot.waitSignal(session.correspondences_changed, timeout=60_000):
+        qtbot.keyClick(window, Qt.Key.Key_M, Qt.KeyboardModifier.ControlModifier)
+        assert not window.actions["match"].isEnabled()  # one job at a time
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+    assert (1, 2) in session.last_match.pairs
+    assert window.actions["match"].isEnabled()

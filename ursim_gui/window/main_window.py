@@ -252,6 +252,7 @@ class MainWindow(QMainWindow):
             )
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
+        self.actions["match"].triggered.connect(lambda: self.jobs.match(self.matching_panel.config()))
         self.matching_panel.orientation_changed.connect(
             lambda o: self.views["sketch"].set_orientation(o.angle or 0.0, o.mirrored)
         )
@@ -340,6 +341,7 @@ class MainWindow(QMainWindow):
     def _update_ready(self) -> None:
         segmented = all(self.session.segmentation(side) is not None for side in SIDES)
         self.matching_panel.set_ready(segmented and not self.jobs.busy)
+        self.actions["match"].setEnabled(segmented and not self.jobs.busy)
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
 

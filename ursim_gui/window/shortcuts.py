@@ -77,6 +77,14 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Edit",
     ),
     ActionSpec("accept_all", "Accept a&ll", ("Ctrl+Shift+Y",), "Accept every clique not yet reviewed", "Edit"),
+    ActionSpec(
+        "match",
+        "&Match again",
+        ("Ctrl+M",),
+        "Run the matcher with the panel's settings; the cliques you linked, accepted or rejected are kept "
+        "and steer the answer (best after linking what it missed)",
+        "Edit",
+    ),
     ActionSpec("clear_selection", "Clear selection", ("Esc",), "Deselect all regions", "Edit"),
     ActionSpec("fit", "&Fit to window", ("F",), "Fit both maps to their views", "View"),
     ActionSpec("zoom_clique", "&Zoom to clique", ("Z",), "Zoom both views to the selected clique", "View"),
