@@ -266,10 +266,10 @@ def planar_match(
         weight ``pair_cost_weight`` (see the module docstring).
     pair_cost_weight : float
     constraints : IndexConstraints, optional
-        :class:`~ursim_core.matching.constraints.IndexConstraints`: fixed pairs start every
-        hypothesis as locked pairs (their neighbour lists are aligned as a seed's are), forbidden
-        pairs and excluded vertices are never paired. With fixed pairs every hypothesis holds
-        them (the one-pair hypotheses are not scored), and the first fixed pair is a seed of its own.
+        :class:`~ursim_core.matching.constraints.IndexConstraints`: fixed pairs are in every
+        hypothesis from the start, as locks, and are expanded from after the seed's own pairs
+        (the one-pair hypotheses are not scored); with no seed left, the first fixed pair is the
+        seed. Forbidden pairs and excluded vertices are never paired.
 
     Returns
     -------
@@ -301,8 +301,8 @@ def planar_match(
             for seed in seeds
             if seed[0] not in closed_first and seed[1] not in closed_second and seed not in forbidden
         ]
-        if fixed:
-            seeds.insert(0, fixed[0])
+        if fixed and not seeds:
+            seeds = [fixed[0]]  # the fixed pairs and what they imply, with no seed of their own
     if not seeds:
         return PlanarResult(pairs=[], cost=math.inf, hypotheses=0, seeds_expanded=0)
     n_first, n_second = first.n_vertices, second.n_vertices
@@ -381,28 +381,27 @@ def planar_match(
         queue = deque()
         matched = {seed_first: seed_second}
         pairs = [seed]
-        alignments = [alignment]
         if constraints is not None:
             seen_first |= closed_first
             seen_second |= closed_second
             if fixed:
-                # The fixed pairs are locked from the start; their neighbour lists are aligned
-                # as a seed's are (in the seed's reading, mirrored or not).
+                # The fixed pairs are locks from the start, and are in the hypothesis already.
                 matched.update(fixed)
                 pairs = list(fixed) + ([] if seed in fixed else [seed])
-                alignments += [
-                    cyclic_align(first_orders[a], second.neighbours[b], same, rotation_search=rotation_search)
-                    for a, b in fixed
-                    if (a, b) != seed
-                ]
-        for each in alignments:
-            for pair in aligned_pairs(each):
-                if pair[0] in seen_first or pair[1] in seen_second or pair in forbidden:
-                    continue
-                queue.append(pair)
-                seen_first.add(pair[0])
-                seen_second.add(pair[1])
-                consumed.add(pair)
+        for pair in aligned_pairs(alignment):
+            if pair[0] in seen_first or pair[1] in seen_second or pair in forbidden:
+                continue
+            queue.append(pair)
+            seen_first.add(pair[0])
+            seen_second.add(pair[1])
+            consumed.add(pair)
+        # The other fixed pairs are expanded from (between their locks, as any pair of the
+        # hypothesis) after the seed's own pairs; they are not aligned as seeds, which would put
+        # every unlocked rotation of their neighbour lists in every hypothesis.
+        queue.extend(pair for pair in fixed if pair != seed)
+        # What the fixed pairs imply is in every hypothesis, so it consumes no seed: a seed that
+        # one hypothesis reached only through them still starts a hypothesis of its own.
+        implied = set(fixed)
         # The loop below runs for every pair of every hypothesis (hundreds of thousands per m
         # on a building map): bound methods and the pair tuples are reused, not looked up or
         # rebuilt each time.
@@ -411,11 +410,13 @@ def planar_match(
         reflected = alignment.reflected
         while queue:
             pair = pop()
-            keep(pair)
             vertex, partner = pair
-            matched[vertex] = partner
+            if vertex not in matched:  # a fixed pair is in the hypothesis from the start
+                keep(pair)
+                matched[vertex] = partner
             if not branching_first[vertex] or not branching_second[partner]:
                 continue  # one neighbour on either side: every arc between locks is empty
+            from_fixed = pair in implied
             for candidate in expand_locked(
                 first_orders[vertex],
                 second_neighbours[partner],
@@ -431,7 +432,10 @@ def planar_match(
                     push(candidate)
                     see_first(a)
                     see_second(b)
-                    consume(candidate)
+                    if from_fixed:
+                        implied.add(candidate)
+                    else:
+                        consume(candidate)
         hypotheses += 1
         inner_first = _inner_edges(first_ends, n_first, matched.keys(), first_sets)
         inner_second = _inner_edges(second_ends, n_second, matched.values(), second_sets)

@@ -136,3 +136,22 @@ def test_constraints_from_a_review():
     assert constraints.forbidden == {(2, 3)}
     assert constraints.excluded_sketch == {5, 7} and constraints.excluded_metric == {8}
     assert not constraints_from_cliques(cliques[2:3])
+
+
+def test_right_fixed_pairs_keep_the_answer_right():
+    """Pairs reached only through the fixed pairs used to consume the seeds they met, so the seed
+    of the best hypothesis never started one: ten right pairs fixed cut 983 right pairs to 908."""
+    from ursim_core.bench.matching import perturbed_copy, random_region_graph
+
+    sketch = random_region_graph(1000, seed=3)
+    metric, truth = perturbed_copy(sketch, seed=3)
+    config = MatchConfig(m=0.2, orientation="upright")
+
+    def right(constraints):
+        pairs = match(sketch, metric, config=config, constraints=constraints).pairs
+        return sum(truth.get(a) == b for a, b in pairs)
+
+    alone = right(None)
+    assert alone > 950
+    for count in (10, 100):
+        assert right(MatchConstraints(fixed=sorted(truth.items())[:count])) >= alone - 5
