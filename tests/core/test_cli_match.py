@@ -214,3 +214,17 @@ def test_a_review_with_a_matcher_that_takes_no_constraints_is_kept_as_it_is(tmp_
     assert "the vf2 matcher does not take the review's pairs" in capsys.readouterr().err
     cliques = load_correspondences(out / "correspondences.json").cliques
     assert [(c.id, c.status) for c in cliques if c.status] == [(corr.cliques[0].id, "accepted")]
+
+
+def test_a_review_or_reference_of_another_pair_is_named_as_such(tmp_path, pair, capsys):
+    first = tmp_path / "first"
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(first)]) == 0
+    other = tmp_path / "other.png"
+    cv2.imwrite(str(other), building(1.1))
+    for option in ("--review", "--reference"):
+        capsys.readouterr()
+        args = ["match", str(other), str(pair[1]), "-o", str(tmp_path / "x"), option]
+        assert main([*args, str(first / "correspondences.json")]) == 1
+        err = capsys.readouterr().err
+        assert "correspondences.json: made on a sketch map of 338x546 px (sketch.png)" in err
+        assert "a file of another pair?" in err

@@ -303,7 +303,7 @@ def match_pair(
     """
     from types import SimpleNamespace
 
-    from ursim_core.correspondences import Correspondences, MapRef, from_pairs, save_correspondences
+    from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
     from ursim_core.matching import CONSTRAINED_MATCHERS, match, sweep_helper
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
@@ -320,6 +320,10 @@ def match_pair(
     sketch_map, metric_map, sketch_seg, metric_seg = load_and_segment(
         sketch, metric, args, params=params, canonical=canonical
     )
+    for loaded, loaded_path in ((reference, reference_path), (review, review_path)):
+        if loaded is not None:
+            # A file of another pair is named as such, not by its label image's size.
+            check_maps(loaded, sketch_map, metric_map, loaded_path)
     # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
     config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
     large = max(sketch_seg.n_regions, metric_seg.n_regions) >= sweep_helper.MIN_REGIONS

@@ -35,7 +35,13 @@ __getattr__, __dir__, __all__ = _lazy.attach(
     submod_attrs={
         "values": ["SOURCES", "STATUSES", "MapRef", "Clique", "Correspondences", "utc_timestamp"],
         "schema": ["FORMAT_NAME", "CURRENT_VERSION", "correspondences_schema"],
-        "json_codec": ["SUPPORTED_VERSIONS", "load_correspondences", "save_correspondences", "correspondences_to_json"],
+        "json_codec": [
+            "SUPPORTED_VERSIONS",
+            "check_maps",
+            "load_correspondences",
+            "save_correspondences",
+            "correspondences_to_json",
+        ],
         "dat_codec": ["load_dat", "save_dat"],
         "assignment": ["regions_at_points", "assign_regions", "from_pairs"],
         "exporters": [

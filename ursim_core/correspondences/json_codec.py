@@ -45,10 +45,11 @@ from ursim_core.correspondences.values import (
     MapRef,
     utc_timestamp,
 )
-from ursim_core.errors import FormatError, MapChangedWarning
+from ursim_core.errors import FormatError, MapChangedWarning, ParameterError
 
 __all__ = [
     "SUPPORTED_VERSIONS",
+    "check_maps",
     "load_correspondences",
     "save_correspondences",
     "correspondences_to_json",
@@ -110,6 +111,40 @@ def load_correspondences(path: str | os.PathLike, *, sketch_map=None, metric_map
     for side, ref, loaded in (("sketch", corr.sketch, sketch_map), ("metric", corr.metric, metric_map)):
         _warn_if_changed(side, ref, loaded, path)
     return corr
+
+
+def check_maps(corr: Correspondences, sketch_map, metric_map, path: str | os.PathLike) -> None:
+    """Refuse correspondences of another pair of maps; warn when a map of the pair was edited.
+
+    Parameters
+    ----------
+    corr : Correspondences
+        As loaded from ``path``.
+    sketch_map, metric_map : Map
+        The maps in use (their ``shape`` and ``sha256``).
+    path : str or path-like
+        The file, named in the error.
+
+    Raises
+    ------
+    ParameterError
+        A map's size differs from the one the file recorded for that side.
+
+    Warns
+    -----
+    MapChangedWarning
+        Same size, other SHA-256 (as :func:`load_correspondences` with the maps).
+    """
+    for side, ref, loaded in (("sketch", corr.sketch, sketch_map), ("metric", corr.metric, metric_map)):
+        shape = tuple(getattr(loaded, "shape", ())[:2])
+        if ref is not None and ref.size is not None and shape and tuple(ref.size) != shape:
+            made_on = f" ({Path(ref.path).name})" if ref.path else ""
+            raise ParameterError(
+                f"made on a {side} map of {ref.size[0]}x{ref.size[1]} px{made_on}, not this one of "
+                f"{shape[0]}x{shape[1]} px: a file of another pair?",
+                path=path,
+            )
+        _warn_if_changed(side, ref, loaded, Path(path))
 
 
 def _warn_if_changed(side: str, ref: MapRef, loaded, path: Path) -> None:
