@@ -228,6 +228,10 @@ def _inner_edges(ends, n_vertices: int, vertices, neighbour_sets) -> int:
 _LISTED_COSTS = 4096
 
 
+#: The pairs the fixed pairs imply when there are none (shared: never written).
+_NOTHING: frozenset = frozenset()
+
+
 def planar_match(
     first: PlanarGraph,
     second: PlanarGraph,
@@ -398,10 +402,12 @@ def planar_match(
         # The other fixed pairs are expanded from (between their locks, as any pair of the
         # hypothesis) after the seed's own pairs; they are not aligned as seeds, which would put
         # every unlocked rotation of their neighbour lists in every hypothesis.
-        queue.extend(pair for pair in fixed if pair != seed)
         # What the fixed pairs imply is in every hypothesis, so it consumes no seed: a seed that
         # one hypothesis reached only through them still starts a hypothesis of its own.
-        implied = set(fixed)
+        implied = _NOTHING
+        if fixed:
+            queue.extend(pair for pair in fixed if pair != seed)
+            implied = set(fixed)
         # The loop below runs for every pair of every hypothesis (hundreds of thousands per m
         # on a building map): bound methods and the pair tuples are reused, not looked up or
         # rebuilt each time.
@@ -416,7 +422,7 @@ def planar_match(
                 matched[vertex] = partner
             if not branching_first[vertex] or not branching_second[partner]:
                 continue  # one neighbour on either side: every arc between locks is empty
-            from_fixed = pair in implied
+            from_fixed = implied and pair in implied
             for candidate in expand_locked(
                 first_orders[vertex],
                 second_neighbours[partner],
@@ -428,7 +434,7 @@ def planar_match(
                 (vertex, partner, reflected),
             ):
                 a, b = candidate
-                if a not in seen_first and b not in seen_second and candidate not in forbidden:
+                if a not in seen_first and b not in seen_second and not (forbidden and candidate in forbidden):
                     push(candidate)
                     see_first(a)
                     see_second(b)
