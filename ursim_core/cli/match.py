@@ -304,7 +304,7 @@ def match_pair(
     from types import SimpleNamespace
 
     from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
-    from ursim_core.matching import CONSTRAINED_MATCHERS, match, sweep_helper
+    from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review, sweep_helper
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -364,14 +364,10 @@ def match_pair(
             elapsed = time.perf_counter() - started
         for job in jobs:
             job.result()
-        # A region a person vouched for gets no second, automatic partner (as in the app).
-        vouched = [c for c in kept if c.status != "rejected"]
-        taken_sketch = {r for c in vouched for r in c.sketch_regions}
-        taken_metric = {r for c in vouched for r in c.metric_regions}
         cliques = [
             *kept,
             *from_pairs(
-                [(a, b) for a, b in result.pairs if a not in taken_sketch and b not in taken_metric],
+                pairs_beside_review(result.pairs, kept),
                 sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
                 metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
                 source="auto",

@@ -49,7 +49,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "descriptors": ["DEFAULT_TIMES", "SIZE_WEIGHT_FLOOR", "VARIANTS", "PairDescriptors", "pair_descriptors"],
         "baselines": ["hungarian_match", "vf2_match"],
         "planar": ["PlanarGraph", "planar_graph", "planar_match"],
-        "constraints": ["CONSTRAINED_MATCHERS", "MatchConstraints", "constraints_from_cliques"],
+        "constraints": ["CONSTRAINED_MATCHERS", "MatchConstraints", "constraints_from_cliques", "pairs_beside_review"],
         "lsap": ["linear_sum_assignment"],
     },
 )

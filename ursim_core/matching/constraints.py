@@ -31,6 +31,7 @@ __all__ = [
     "IndexConstraints",
     "constraints_from_cliques",
     "index_constraints",
+    "pairs_beside_review",
 ]
 
 #: The matchers that honour constraints (``MatchConfig.resolved().matcher``); VF2 and the overlay
@@ -198,3 +199,36 @@ def constraints_from_cliques(cliques, *, sizes: Mapping[str, Mapping[int, float]
         excluded_sketch=excluded_sketch - taken_sketch,
         excluded_metric=excluded_metric - taken_metric,
     )
+
+
+def pairs_beside_review(pairs, cliques) -> list:
+    """The pairs of an answer that a review of ``cliques`` leaves to add, in order, once each.
+
+    A pair is left out when a rejected clique holds it, or when a clique a person made or
+    accepted already holds one of its regions (that region gets no second, automatic partner).
+    Pending automatic cliques do not count: the answer replaces them.
+
+    Examples
+    --------
+    >>> from ursim_core.correspondences import Clique
+    >>> review = [Clique(id=1, sketch_regions=(1,), metric_regions=(1,), source="manual"),
+    ...           Clique(id=2, sketch_regions=(2,), metric_regions=(2,), source="auto", status="rejected")]
+    >>> pairs_beside_review([(1, 1), (1, 3), (2, 2), (2, 4), (2, 4)], review)
+    [(2, 4)]
+    """
+    reviewed = [clique for clique in cliques if clique.is_reviewed]
+    rejected = {
+        (a, b)
+        for clique in reviewed
+        if clique.status == "rejected"
+        for a in clique.sketch_regions
+        for b in clique.metric_regions
+    }
+    vouched = [clique for clique in reviewed if clique.status != "rejected"]
+    taken_sketch = {region for clique in vouched for region in clique.sketch_regions}
+    taken_metric = {region for clique in vouched for region in clique.metric_regions}
+    return [
+        (a, b)
+        for a, b in dict.fromkeys((int(a), int(b)) for a, b in pairs)
+        if (a, b) not in rejected and a not in taken_sketch and b not in taken_metric
+    ]

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterable
-from itertools import product
 
 from ursim_core.correspondences import STATUSES, Clique, from_pairs, regions_at_points
+from ursim_core.matching.constraints import pairs_beside_review
 from ursim_gui.model.session_values import REFERENCE_TOLERANCE, SIDES, _check_side, _regions_text
 
 __all__ = ["EditOperations"]
@@ -251,20 +251,7 @@ class EditOperations:
             self._checked_regions("sketch", [sketch], stale_hint=True)
             self._checked_regions("metric", [metric], stale_hint=True)
         kept = [clique for clique in self._corr.cliques if clique.is_reviewed]
-        rejected = {
-            pair
-            for clique in kept
-            if clique.status == "rejected"
-            for pair in product(clique.sketch_regions, clique.metric_regions)
-        }
-        vouched = [clique for clique in kept if clique.status != "rejected"]
-        taken_sketch = {region for clique in vouched for region in clique.sketch_regions}
-        taken_metric = {region for clique in vouched for region in clique.metric_regions}
-        new_pairs = [
-            pair
-            for pair in dict.fromkeys(pairs)
-            if pair not in rejected and pair[0] not in taken_sketch and pair[1] not in taken_metric
-        ]
+        new_pairs = pairs_beside_review(pairs, kept)
         cliques = from_pairs(
             new_pairs,
             sketch_points_of=lambda region: self._interior_points("sketch", (region,))[0],
