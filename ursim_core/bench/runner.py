@@ -73,13 +73,19 @@ def run_bench(
         if root is None or not (root / "ursim_kth_sketches").is_dir():
             print(f"error: 'ursim bench review' needs ursim_kth_sketches ({MISSING_REASON})", file=sys.stderr)
             return 1
-        from ursim_core.bench.review import bench_review, print_review
+        from ursim_core.bench.review import bench_review, bench_review_halmstad, print_review
 
         print(
             "== simulated review of the KTH sketches: rejections + links until the answer is each annotator's "
             "(by hand; matched again on the review after each link, then rejecting; after every edit)"
         )
         print_review(bench_review(root))
+        e5 = root / "ursim_halmstad_robot_maps" / "E5"
+        if e5.is_dir():
+            print("== the same on the Halmstad E5 robot maps (the overlay matcher; two linked places lay a map)")
+            print_review(bench_review_halmstad(e5))
+        else:
+            print(f"review on Halmstad E5: skipped ({e5} not found)")
         return 0
     if what == "invariance":
         from ursim_core.bench.invariance import bench_invariance, print_invariance

@@ -34,9 +34,9 @@ __all__ = [
     "pairs_beside_review",
 ]
 
-#: The matchers that honour constraints (``MatchConfig.resolved().matcher``); VF2 and the overlay
-#: matcher do not: ``prepare`` refuses constraints for them.
-CONSTRAINED_MATCHERS = ("planar", "hungarian")
+#: The matchers that honour constraints (``MatchConfig.resolved().matcher``); VF2 does not:
+#: ``prepare`` refuses constraints for it.
+CONSTRAINED_MATCHERS = ("planar", "hungarian", "overlay")
 
 
 @dataclass(frozen=True)

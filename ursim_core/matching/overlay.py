@@ -18,6 +18,12 @@ the input may cover any part of the metric map. With no known scale it is estima
 (:func:`estimate_scale`: both maps laid on each other, the input at s and the metric map at 1 / s,
 over 0.5 to 2), then searched within 20 % as a known one.
 
+Pairs a person gave (:mod:`ursim_core.matching.constraints`, two fixed pairs or more): the placement
+is the similarity (turn, scale, shift) that carries their regions' centroids onto their partners'
+(:func:`fit_to_pairs`, least squares), the mirror flag the one whose placement agrees better, as a
+georeferencer's control points do; the fixed pairs are then in the answer and the forbidden ones are
+not (:func:`constrained_pairs`).
+
 Sketches are drawn out of proportion: for them the planar matcher is better (KTH: F1 0.72 against
 0.63). On Halmstad E5 (robot maps of unknown, unequal scales) it gives F1 0.69 held out (README).
 """
@@ -31,7 +37,15 @@ import numpy as np
 
 from ursim_core.matching.alignment import Alignment, free_box_corners, orientation_matrix
 
-__all__ = ["fit_overlay", "estimate_scale", "overlay_pairs", "SCALE_SPREAD", "SCALE_SEARCH"]
+__all__ = [
+    "fit_overlay",
+    "fit_to_pairs",
+    "estimate_scale",
+    "overlay_pairs",
+    "constrained_pairs",
+    "SCALE_SPREAD",
+    "SCALE_SEARCH",
+]
 
 #: Relative scales tried around a known scale: a robot map's resolution is known to a few percent.
 SCALE_SPREAD = (0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15, 1.2)
@@ -235,3 +249,100 @@ def overlay_pairs(sketch_labels, metric_labels, matrix: np.ndarray, *, min_iou: 
         if iou[i, j] >= min_iou:
             pairs.add((i + 1, int(j) + 1))
     return sorted(pairs)
+
+
+def _similarity(source: np.ndarray, target: np.ndarray, *, mirrored: bool) -> np.ndarray | None:
+    """The least-squares similarity (row, col) -> (row, col) with or without a reflection (Umeyama)."""
+    source_mean, target_mean = source.mean(axis=0), target.mean(axis=0)
+    centred_source, centred_target = source - source_mean, target - target_mean
+    spread = float((centred_source**2).sum())
+    if spread <= 0:
+        return None
+    u, values, vt = np.linalg.svd(centred_target.T @ centred_source)
+    sign = np.sign(np.linalg.det(u) * np.linalg.det(vt)) or 1.0
+    fix = np.diag([1.0, sign * (-1.0 if mirrored else 1.0)])
+    rotation = u @ fix @ vt
+    scale = float(np.trace(np.diag(values) @ fix)) / spread
+    if scale <= 0:
+        return None
+    linear = scale * rotation
+    return np.hstack([linear, (target_mean - linear @ source_mean)[:, None]])
+
+
+def _agreement(sketch_free: np.ndarray, metric_free: np.ndarray, matrix: np.ndarray) -> float:
+    """Intersection over union of the input's free space laid by ``matrix`` and the metric map's."""
+    import cv2
+
+    opencv = np.array([[matrix[1, 1], matrix[1, 0], matrix[1, 2]], [matrix[0, 1], matrix[0, 0], matrix[0, 2]]])
+    laid = cv2.warpAffine(sketch_free.astype(np.uint8), opencv, metric_free.shape[::-1], flags=cv2.INTER_NEAREST) != 0
+    union = int(np.count_nonzero(laid | metric_free))
+    return int(np.count_nonzero(laid & metric_free)) / union if union else 0.0
+
+
+def fit_to_pairs(sketch_free, metric_free, pairs, sketch_graph, metric_graph, *, mirror_flags=(False, True)):
+    """The placement that carries the pairs' sketch centroids onto their partners' (two pairs or more).
+
+    Parameters
+    ----------
+    sketch_free, metric_free : ndarray, shape (rows, cols)
+        Free space (or label images) of the two maps, to choose the mirror flag by.
+    pairs : sequence of (sketch region, metric region)
+    sketch_graph, metric_graph : networkx.Graph
+        Region graphs with ``centroid`` (row, col).
+    mirror_flags : sequence of bool, keyword-only
+        The readings allowed; the one whose placement agrees better with the metric map is kept.
+
+    Returns
+    -------
+    Alignment or None
+        None with fewer than two pairs, or centroids that do not span a placement.
+
+    Examples
+    --------
+    >>> import networkx as nx
+    >>> free = np.zeros((60, 90), bool); free[10:50, 10:40] = True; free[25:35, 40:85] = True
+    >>> g = nx.Graph(); g.add_node(1, centroid=(30.0, 25.0)); g.add_node(2, centroid=(30.0, 62.5))
+    >>> turned = np.rot90(free, 2)  # the same map turned by 180 degrees
+    >>> h = nx.Graph(); h.add_node(1, centroid=(29.0, 64.0)); h.add_node(2, centroid=(29.0, 26.5))
+    >>> fit = fit_to_pairs(free, turned, [(1, 1), (2, 2)], g, h)
+    >>> round(fit.degrees), fit.mirrored, round(fit.overlap, 2)
+    (180, False, 1.0)
+    """
+    pairs = list(pairs)
+    if len(pairs) < 2:
+        return None
+    sketch_free, metric_free = np.asarray(sketch_free) != 0, np.asarray(metric_free) != 0
+    source = np.array([sketch_graph.nodes[a]["centroid"] for a, _ in pairs], float)
+    target = np.array([metric_graph.nodes[b]["centroid"] for _, b in pairs], float)
+    best = None
+    for mirrored in dict.fromkeys(bool(flag) for flag in mirror_flags):
+        matrix = _similarity(source, target, mirrored=mirrored)
+        if matrix is None:
+            continue
+        agreement = _agreement(sketch_free, metric_free, matrix)
+        if best is None or agreement > best.overlap:
+            degrees = math.degrees(math.atan2(matrix[1, 0], matrix[0, 0])) % 360.0
+            best = Alignment(agreement, matrix, degrees, mirrored)
+    return best
+
+
+def constrained_pairs(pairs, constraints) -> list[tuple[int, int]]:
+    """``pairs`` under ``constraints`` (region ids): the fixed pairs in, nothing else for their regions
+    or the excluded ones, no forbidden pair.
+
+    Examples
+    --------
+    >>> from ursim_core.matching.constraints import MatchConstraints
+    >>> constrained_pairs([(1, 1), (2, 2), (3, 3)], MatchConstraints(fixed=[(1, 2)], forbidden=[(3, 3)]))
+    [(1, 2)]
+    """
+    if not constraints:
+        return list(pairs)
+    taken_sketch = constraints.excluded_sketch | {a for a, _ in constraints.fixed}
+    taken_metric = constraints.excluded_metric | {b for _, b in constraints.fixed}
+    kept = {
+        (a, b)
+        for a, b in pairs
+        if a not in taken_sketch and b not in taken_metric and (a, b) not in constraints.forbidden
+    }
+    return sorted(kept | set(constraints.fixed))

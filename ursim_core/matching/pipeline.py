@@ -116,12 +116,12 @@ def prepare(
         constraints.check_regions(sketch_graph.nodes, metric_graph.nodes)
         if config.matcher not in CONSTRAINED_MATCHERS:
             raise ParameterError(
-                f"constraints (fixed, forbidden or excluded regions) need the planar or the hungarian matcher, "
-                f"not {config.matcher!r}",
+                f"constraints (fixed, forbidden or excluded regions) need the planar, Hungarian or overlay "
+                f"matcher, not {config.matcher!r}",
                 field="constraints",
             )
     if config.matcher == "overlay":
-        return _prepare_overlay(sketch_seg, metric_seg, config)
+        return _prepare_overlay(sketch_seg, metric_seg, config, constraints)
     candidates = _orientations(config, sketch_seg, metric_seg)
     outlines = _outlines(sketch_seg, sketch_graph, candidates)
     base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
@@ -274,21 +274,34 @@ _FINALISTS = 3
 _SCREEN_BY_ASSIGNMENT = 60
 
 
-def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig) -> Prepared:
-    """The overlay matcher's answer, found once: it does not depend on m."""
-    from ursim_core.matching.overlay import fit_overlay, overlay_pairs
+def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=None) -> Prepared:
+    """The overlay matcher's answer, found once: it does not depend on m.
+
+    With two fixed pairs or more, they lay the input map (:func:`~ursim_core.matching.overlay.fit_to_pairs`,
+    in the mirror readings of the orientation candidates) instead of the search; the answer then
+    holds the fixed pairs and avoids the forbidden ones.
+    """
+    from ursim_core.matching.overlay import constrained_pairs, fit_overlay, fit_to_pairs, overlay_pairs
 
     sketch_labels = getattr(sketch_seg, "labels", None)
     metric_labels = getattr(metric_seg, "labels", None)
     if sketch_labels is None or metric_labels is None:
         raise ParameterError("the overlay matcher needs segmentations (label images), not bare graphs", field="matcher")
     candidates = _orientations(config, sketch_seg, metric_seg)
-    fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
+    sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
+    fit = None
+    if constraints is not None and len(constraints.fixed) >= 2:
+        flags = [mirrored for _, mirrored in candidates]
+        fit = fit_to_pairs(
+            sketch_labels, metric_labels, constraints.fixed, sketch_graph, metric_graph, mirror_flags=flags
+        )
+    if fit is None:
+        fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
     orientation = (fit.degrees, fit.mirrored)
-    sketch_graph = _graph_of(sketch_seg)
     outlines = _outlines(sketch_seg, sketch_graph, [orientation])
-    base = _prepare_oriented(sketch_graph, _graph_of(metric_seg), config, orientation, outlines)
+    base = _prepare_oriented(sketch_graph, metric_graph, config, orientation, outlines)
     pairs = overlay_pairs(sketch_labels, metric_labels, fit.matrix, min_iou=config.overlay_min_iou)
+    pairs = constrained_pairs(pairs, constraints)
     descriptors = base.descriptors
     reasons = list(base.notes)
     if not pairs:
@@ -310,7 +323,7 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig) -> Prepared:
         config=config,
         orientation=orientation,
     )
-    return dataclasses.replace(base, chosen=result)
+    return dataclasses.replace(base, chosen=result, constraints=constraints)
 
 
 def _candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates, indices) -> dict[int, float]:

@@ -142,8 +142,7 @@ class JobController(QObject):
             config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
         # The person's manual, accepted and rejected cliques steer the answer (see
         # AnnotationSession.review_constraints), read now: edits made while it was queued count.
-        # The overlay matcher (robot maps) and VF2 take no constraints: the session still keeps
-        # the review when it applies their answer.
+        # VF2 takes no constraints: the session still keeps the review when it applies its answer.
         from ursim_core.matching import CONSTRAINED_MATCHERS, MatchConfig
 
         steered = (config or MatchConfig()).resolved().matcher in CONSTRAINED_MATCHERS

@@ -90,9 +90,8 @@ def test_constraints_name_unknown_regions_and_matchers_that_cannot_take_them(pai
         match(*pair, constraints=MatchConstraints(fixed=[(42, 1)]))
     with pytest.raises(ParameterError, match=r"metric region\(s\) 8 not in the metric segmentation"):
         match(*pair, constraints=MatchConstraints(excluded_metric=[8]))
-    for matcher in ("vf2", "overlay"):
-        with pytest.raises(ParameterError, match="need the planar or the hungarian matcher"):
-            match(*pair, config=MatchConfig(matcher=matcher), constraints=MatchConstraints(fixed=[(1, 1)]))
+    with pytest.raises(ParameterError, match="need the planar, Hungarian or overlay matcher, not 'vf2'"):
+        match(*pair, config=MatchConfig(matcher="vf2"), constraints=MatchConstraints(fixed=[(1, 1)]))
 
 
 @pytest.mark.parametrize(
@@ -155,3 +154,28 @@ def test_right_fixed_pairs_keep_the_answer_right():
     assert alone > 950
     for count in (10, 100):
         assert right(MatchConstraints(fixed=sorted(truth.items())[:count])) >= alone - 5
+
+
+def test_two_fixed_pairs_lay_a_robot_map_as_control_points_do():
+    # The same plan turned by 180 degrees, shifted and cut; told (wrongly) that it is upright, the
+    # overlay search cannot find it. Two pairs a person gives lay it right, and every room follows.
+    labels = grid(room=24)
+    labels[labels == 8] = 9
+    turned = np.zeros((labels.shape[0] + 30, labels.shape[1] + 20), labels.dtype)
+    turned[20 : 20 + labels.shape[0], 5 : 5 + labels.shape[1]] = np.rot90(labels, 2)
+    sketch = Segmentation(labels=labels, graph=region_graph(labels), method="label-image")
+    metric_graph = region_graph(turned)
+    metric = Segmentation(labels=turned, graph=metric_graph, method="label-image")
+    # A room of the sketch is the metric region at its centroid turned by 180 degrees.
+    partner = {}
+    for region, (row, col) in sketch.graph.nodes(data="centroid"):
+        spot = (20 + labels.shape[0] - 1 - round(row), 5 + labels.shape[1] - 1 - round(col))
+        partner[region] = int(turned[spot])
+    config = MatchConfig(matcher="overlay", orientation=0, mirrored=False, scale=1.0)
+    told_upright = set(match(sketch, metric, config=config).pairs)
+    assert len(told_upright & set(partner.items())) < len(partner) // 2
+    fixed = [(1, partner[1]), (9, partner[9])]
+    result = match(sketch, metric, config=config, constraints=MatchConstraints(fixed=fixed))
+    assert set(result.pairs) == set(partner.items()) and round(result.orientation[0]) == 180
+    forbidden = MatchConstraints(fixed=fixed, forbidden=[(5, partner[5])])
+    assert (5, partner[5]) not in match(sketch, metric, config=config, constraints=forbidden).pairs
