@@ -163,3 +163,33 @@ def test_leaving_a_pair_saves_it_and_reopening_restores_status_and_position(plai
     assert reopened.campaigns.campaign.current == 0 and (out / "s1.json").read_bytes() == s1
     assert reopened.preferences.annotator() == "tester"  # asked once, remembered
     assert load_correspondences(out / "s1.json").annotator == "tester"
+
+
+def test_a_campaign_of_robot_maps_is_matched_as_robot_maps(qtbot, tmp_path):
+    """The app matched the Halmstad robot maps as sketches (planar), where `ursim evaluate` overlays them."""
+    root = dataset_root()
+    folder = None if root is None else root / "ursim_halmstad_robot_maps" / "E5"
+    if folder is None or not folder.is_dir():
+        pytest.skip(MISSING_REASON)
+    campaign = open_campaign(folder, output_dir=tmp_path / "out")
+    assert {pair.input_kind for pair in campaign.pairs} == {"metric"}
+    kth = dataset_root() / "ursim_kth_sketches"
+    if kth.is_dir():
+        assert {pair.input_kind for pair in open_campaign(kth, output_dir=tmp_path / "kth").pairs} == {"sketch"}
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        assert window.campaigns.open(folder, output_dir=tmp_path / "out")
+    assert window.matching_panel.config().input_kind == "metric"
+    assert window.session.last_match.config.resolved().matcher == "overlay"
+    window.close()
+
+
+def test_the_matching_panel_says_what_the_input_map_is(window):
+    panel = window.matching_panel
+    assert panel.config().input_kind is None
+    panel.set_input_kind("metric")
+    assert panel.config().input_kind == "metric" and panel.config().resolved().matcher == "overlay"
+    panel.matcher.setCurrentIndex(panel.matcher.findData("planar"))
+    assert not panel.input_kind.isEnabled() and panel.config().input_kind is None
+    panel.set_input_kind(None)
+    assert panel.input_kind.currentData() is None

@@ -66,6 +66,10 @@ class CampaignPair:
     metric: Path
     output: Path
     reference: Path | None = None
+    #: What the input map is, when the source says so (``MatchConfig.input_kind``): 'metric' for
+    #: the Halmstad robot maps, so that the automatic matcher overlays them as ``ursim evaluate``
+    #: does; None = unknown.
+    input_kind: str | None = None
 
 
 @dataclass
@@ -183,9 +187,14 @@ def open_campaign(
     output_dir = Path(output_dir)
     pairs = tuple(
         CampaignPair(
-            name=pair_name, sketch=sketch, metric=metric, output=output_dir / f"{pair_name}.json", reference=ref
+            name=pair_name,
+            sketch=sketch,
+            metric=metric,
+            output=output_dir / f"{pair_name}.json",
+            reference=ref,
+            input_kind=kind,
         )
-        for pair_name, sketch, metric, ref, _gt in pairs_in
+        for pair_name, sketch, metric, ref, _gt, kind in pairs_in
     )
     if not pairs:
         raise FormatError("the campaign has no map pairs", path=source)
@@ -195,7 +204,7 @@ def open_campaign(
         pairs=pairs,
         output_dir=output_dir,
         annotator=annotator,
-        ground_truth={pair_name: gt for pair_name, _s, _m, _r, gt in pairs_in if gt},
+        ground_truth={pair_name: gt for pair_name, _s, _m, _r, gt, _k in pairs_in if gt},
     )
     campaign._load_state()
     return campaign
@@ -251,7 +260,7 @@ def _manifest_pairs(path: Path, manifest: dict):
         sketch = (folder / entry).absolute()
         name = _unique(sketch.stem, seen)
         ref = references.get(sketch.stem) if isinstance(references, dict) else None
-        pairs.append((name, sketch, metric, (folder / ref).absolute() if isinstance(ref, str) else None, {}))
+        pairs.append((name, sketch, metric, (folder / ref).absolute() if isinstance(ref, str) else None, {}, None))
     return pairs
 
 
@@ -266,7 +275,9 @@ def _folder_pairs(folder: Path):
         pairs, seen = [], set()
         for experiment in experiments:
             name = _unique(experiment.name, seen)
-            pairs.append((name, experiment.sketch, experiment.metric, None, dict(experiment.ground_truth)))
+            pairs.append(
+                (name, experiment.sketch, experiment.metric, None, dict(experiment.ground_truth), experiment.input_kind)
+            )
         return pairs
     files = sorted(
         p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in _IMAGE_SUFFIXES | {".yaml", ".yml"}
@@ -288,7 +299,7 @@ def _folder_pairs(folder: Path):
     )
     seen: set[str] = set()
     return [
-        (_unique(p.stem, seen), p, metric, None, {})
+        (_unique(p.stem, seen), p, metric, None, {}, None)
         for p in files
         if p != metric and p not in image_of_yaml and p.suffix.lower() in _IMAGE_SUFFIXES
     ]

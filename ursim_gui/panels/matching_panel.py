@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
 
 from ursim_gui.model.orientation import SketchOrientation
 
-__all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "describe_result"]
+__all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "INPUT_KINDS", "describe_result"]
 
 #: Descriptor variants (paper Table 1; T4 = URSIM) and matchers, as ``MatchConfig`` names them.
 VARIANTS = (
@@ -42,6 +42,12 @@ MATCHERS = (
     ("hungarian", "Hungarian"),
     ("vf2", "VF2"),
     ("overlay", "overlay (two metric maps)"),
+)
+#: What the input map is, for the automatic matcher (``MatchConfig.input_kind``).
+INPUT_KINDS = (
+    (None, "unknown (a sketch, unless the scale is known)"),
+    ("sketch", "a sketch (drawn by hand)"),
+    ("metric", "a robot map or a plan to scale"),
 )
 #: The matchers that use a known scale.
 _SCALED_MATCHERS = ("auto", "overlay")
@@ -123,6 +129,18 @@ class MatchingPanel(QWidget):
             lambda _: self.scale.setEnabled(self.matcher.currentData() in _SCALED_MATCHERS)
         )
         form.addRow("Scale", self.scale)
+        # What the input map is: a robot map makes the automatic matcher overlay the maps (a
+        # campaign of robot maps says so for each pair).
+        self.input_kind = _combo("match_input_kind", INPUT_KINDS)
+        self.input_kind.setToolTip(
+            "What the input (left) map is: a robot map or a plan drawn to scale makes the automatic "
+            "matcher lay the maps on each other (overlay); a sketch is matched by its structure (planar)"
+        )
+        self.input_kind.setEnabled(self.matcher.currentData() == "auto")
+        self.matcher.currentIndexChanged.connect(
+            lambda _: self.input_kind.setEnabled(self.matcher.currentData() == "auto")
+        )
+        form.addRow("Input", self.input_kind)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
         self.turn_left.setObjectName("orient_left")
@@ -180,6 +198,8 @@ class MatchingPanel(QWidget):
         extra = {}
         if matcher in _SCALED_MATCHERS and self.scale.value() > 0:
             extra["scale"] = float(self.scale.value())
+        if matcher == "auto" and self.input_kind.currentData() is not None:
+            extra["input_kind"] = self.input_kind.currentData()
         return MatchConfig(
             variant=self.variant.currentData(),
             matcher=matcher,
@@ -207,6 +227,10 @@ class MatchingPanel(QWidget):
         else:
             mirrored = ", mirrored" if orientation.mirrored else ""
             self.orientation_label.setText(f"known: turned {orientation.angle:g}° counter-clockwise{mirrored}")
+
+    def set_input_kind(self, kind: str | None) -> None:
+        """Say what the input map is (None = unknown; see :data:`INPUT_KINDS`)."""
+        self.input_kind.setCurrentIndex(max(0, self.input_kind.findData(kind)))
 
     def set_ready(self, ready: bool) -> None:
         """Enable Match only when both maps are segmented and no job runs."""

@@ -142,6 +142,8 @@ class CampaignController(QObject):
         except OSError as error:
             _log.warning("campaign state not written: %s", error)
         self._awaiting_match = None
+        # What the source says the input map is (the Halmstad robot maps), for every match of the pair.
+        window.matching_panel.set_input_kind(pair.input_kind)
         try:
             if pair.output.is_file():
                 session.open(pair.output)
