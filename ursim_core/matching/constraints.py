@@ -31,6 +31,7 @@ __all__ = [
     "IndexConstraints",
     "constraints_from_cliques",
     "index_constraints",
+    "allowed_pairs",
     "pairs_beside_review",
 ]
 
@@ -201,12 +202,35 @@ def constraints_from_cliques(cliques, *, sizes: Mapping[str, Mapping[int, float]
     )
 
 
+def allowed_pairs(pairs, constraints: MatchConstraints | None) -> list[tuple[int, int]]:
+    """The pairs that ``constraints`` leave, in order, once each: none that is forbidden or holds a
+    region of a fixed pair or an excluded region (the fixed pairs themselves are not added).
+
+    Examples
+    --------
+    >>> allowed_pairs([(1, 1), (2, 2), (3, 3), (4, 4), (4, 4)], MatchConstraints(fixed=[(1, 2)], forbidden=[(3, 3)]))
+    [(4, 4)]
+    """
+    pairs = list(dict.fromkeys((int(a), int(b)) for a, b in pairs))
+    if not constraints:
+        return pairs
+    taken_sketch = constraints.excluded_sketch | {a for a, _ in constraints.fixed}
+    taken_metric = constraints.excluded_metric | {b for _, b in constraints.fixed}
+    return [
+        (a, b)
+        for a, b in pairs
+        if a not in taken_sketch and b not in taken_metric and (a, b) not in constraints.forbidden
+    ]
+
+
 def pairs_beside_review(pairs, cliques) -> list:
     """The pairs of an answer that a review of ``cliques`` leaves to add, in order, once each.
 
     A pair is left out when a rejected clique holds it, or when a clique a person made or
-    accepted already holds one of its regions (that region gets no second, automatic partner).
-    Pending automatic cliques do not count: the answer replaces them.
+    accepted already holds one of its regions (that region gets no second, automatic partner):
+    :func:`allowed_pairs` under :func:`constraints_from_cliques`, whose fixed and excluded regions
+    are all the regions of those cliques. Pending automatic cliques do not count: the answer
+    replaces them.
 
     Examples
     --------
@@ -216,19 +240,4 @@ def pairs_beside_review(pairs, cliques) -> list:
     >>> pairs_beside_review([(1, 1), (1, 3), (2, 2), (2, 4), (2, 4)], review)
     [(2, 4)]
     """
-    reviewed = [clique for clique in cliques if clique.is_reviewed]
-    rejected = {
-        (a, b)
-        for clique in reviewed
-        if clique.status == "rejected"
-        for a in clique.sketch_regions
-        for b in clique.metric_regions
-    }
-    vouched = [clique for clique in reviewed if clique.status != "rejected"]
-    taken_sketch = {region for clique in vouched for region in clique.sketch_regions}
-    taken_metric = {region for clique in vouched for region in clique.metric_regions}
-    return [
-        (a, b)
-        for a, b in dict.fromkeys((int(a), int(b)) for a, b in pairs)
-        if (a, b) not in rejected and a not in taken_sketch and b not in taken_metric
-    ]
+    return allowed_pairs(pairs, constraints_from_cliques(cliques))

@@ -36,6 +36,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ursim_core.matching.alignment import Alignment, free_box_corners, orientation_matrix
+from ursim_core.matching.constraints import allowed_pairs
 
 __all__ = [
     "fit_overlay",
@@ -328,7 +329,7 @@ def fit_to_pairs(sketch_free, metric_free, pairs, sketch_graph, metric_graph, *,
 
 def constrained_pairs(pairs, constraints) -> list[tuple[int, int]]:
     """``pairs`` under ``constraints`` (region ids): the fixed pairs in, nothing else for their regions
-    or the excluded ones, no forbidden pair.
+    or the excluded ones, no forbidden pair (:func:`~ursim_core.matching.constraints.allowed_pairs`).
 
     Examples
     --------
@@ -338,11 +339,4 @@ def constrained_pairs(pairs, constraints) -> list[tuple[int, int]]:
     """
     if not constraints:
         return list(pairs)
-    taken_sketch = constraints.excluded_sketch | {a for a, _ in constraints.fixed}
-    taken_metric = constraints.excluded_metric | {b for _, b in constraints.fixed}
-    kept = {
-        (a, b)
-        for a, b in pairs
-        if a not in taken_sketch and b not in taken_metric and (a, b) not in constraints.forbidden
-    }
-    return sorted(kept | set(constraints.fixed))
+    return sorted({*allowed_pairs(pairs, constraints), *constraints.fixed})

@@ -92,13 +92,14 @@ def prepare(
     constraints : MatchConstraints, optional
         Pairs every answer contains or avoids, regions it leaves alone
         (:mod:`ursim_core.matching.constraints`): the planar and Hungarian matchers honour them
-        in every orientation and at every m, so a person's pairs also steer the orientation.
+        in every orientation and at every m, so a person's pairs also steer the orientation; two
+        fixed pairs or more lay the map for the overlay matcher.
 
     Raises
     ------
     ParameterError
         ``constraints`` name a region the segmentations do not have, or the matcher cannot
-        take them (VF2, overlay).
+        take them (VF2).
 
     Examples
     --------
