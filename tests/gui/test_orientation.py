@@ -44,3 +44,42 @@ def test_the_orientation_goes_to_the_match_config(window):
     assert not panel.orientation.known and window.views["sketch"].orientation == (0.0, False)
     if "orientation" in fields:
         assert panel.config().orientation == "any"
+
+
+def test_another_sketch_is_matched_with_its_orientation_unknown(window, map_files, tmp_path):
+    """A known orientation belongs to its drawing: the next sketch (a campaign's next pair) must
+    not be matched as if turned like the last one, while the same drawing keeps it."""
+    import cv2
+    import numpy as np
+
+    panel, sketch = window.matching_panel, window.views["sketch"]
+    panel.turn_left.click()
+    window.documents.open_map("metric", map_files["metric"])  # the other side: kept
+    assert panel.orientation.angle == 90.0 and sketch.orientation == (90.0, False)
+    other = tmp_path / "another_sketch.png"
+    cv2.imwrite(str(other), np.rot90(cv2.imread(str(map_files["sketch"]), cv2.IMREAD_GRAYSCALE)))
+    window.documents.open_map("sketch", other)
+    assert not panel.orientation.known and sketch.orientation == (0.0, False)
+    if "orientation" in {field.name for field in dataclasses.fields(MatchConfig)}:
+        assert panel.config().orientation == "any"
+    panel.turn_right.click()
+    window.session.load_map("sketch", other)  # the same drawing again
+    assert panel.orientation.angle == 270.0 and sketch.orientation == (270.0, False)
+
+
+def test_the_orientation_the_matcher_read_can_be_kept(window, qtbot):
+    panel, sketch = window.matching_panel, window.views["sketch"]
+    assert not panel.keep_found.isVisible()  # nothing matched yet
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        panel.match_button.click()
+    result = window.session.last_match
+    found = (float(round(result.orientation[0] % 360.0, 1) % 360.0), result.orientation[1])
+    assert "read the sketch" in panel.summary.text()
+    assert panel.keep_found.isVisible() and panel.found_orientation.describe() in panel.keep_found.text()
+    panel.keep_found.click()
+    assert (panel.orientation.angle, panel.orientation.mirrored) == found == sketch.orientation
+    assert not panel.keep_found.isVisible()  # it is the orientation set now
+    config = panel.config()
+    assert (config.orientation, config.mirrored) == found
+    panel.unknown.click()
+    assert panel.keep_found.isVisible()  # offered again while the last answer stands

@@ -52,3 +52,42 @@ class SketchOrientation:
         if "mirrored" in fields:
             options["mirrored"] = None if self.angle is None and not self.mirrored else bool(self.mirrored)
         return options
+
+    def describe(self) -> str:
+        """The orientation in words.
+
+        Examples
+        --------
+        >>> SketchOrientation().describe(), SketchOrientation(angle=0).describe()
+        ('unknown', 'upright')
+        >>> SketchOrientation(angle=0, mirrored=True).describe(), SketchOrientation(angle=90, mirrored=True).describe()
+        ('mirrored', 'turned 90° counter-clockwise, mirrored')
+        """
+        if not self.known:
+            return "unknown"
+        if self.angle == 0:
+            return "mirrored" if self.mirrored else "upright"
+        return f"turned {self.angle:g}° counter-clockwise" + (", mirrored" if self.mirrored else "")
+
+    @classmethod
+    def found_in(cls, result) -> SketchOrientation | None:
+        """The orientation the matcher chose for ``result`` when it was not told one; else None.
+
+        ``result`` is a ``MatchResult``: its ``orientation`` is the (degrees, mirrored) it laid the
+        sketch in, the same convention as ``MatchConfig(orientation=, mirrored=)``, so telling the
+        matcher this orientation asks it for the reading it found. The angle is rounded to the
+        tenth of a degree the panel shows.
+
+        Examples
+        --------
+        >>> from types import SimpleNamespace as Result
+        >>> SketchOrientation.found_in(Result(config=Result(orientation="any"), orientation=(359.96, True)))
+        SketchOrientation(angle=0.0, mirrored=True)
+        >>> SketchOrientation.found_in(Result(config=Result(orientation=90.0), orientation=(90.0, False))) is None
+        True
+        """
+        config = getattr(result, "config", None)
+        if result is None or getattr(config, "orientation", None) != "any":
+            return None
+        degrees, mirrored = result.orientation
+        return cls(angle=float(round(float(degrees) % 360.0, 1) % 360.0), mirrored=bool(mirrored))

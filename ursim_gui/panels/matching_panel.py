@@ -71,6 +71,9 @@ def describe_result(result, *, automatic_cliques: int = 0) -> str:
     text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
     if math.isfinite(result.cost):
         text += f", cost {result.cost:.3g}"
+    found = SketchOrientation.found_in(result)
+    if found is not None:
+        text += f"\nread the sketch {found.describe()}"
     if result.reason:
         text += f"\n{result.reason}"
     return text
@@ -166,6 +169,16 @@ class MatchingPanel(QWidget):
         self.orientation_label = QLabel("")
         self.orientation_label.setObjectName("orient_summary")
         form.addRow(self.orientation_label)
+        # The orientation the last match found, offered as the known one: the view turns to it and
+        # the next match is told it (shown only while it differs from the orientation set).
+        self.found_orientation: SketchOrientation | None = None
+        self.keep_found = QPushButton("")
+        self.keep_found.setObjectName("orient_keep_found")
+        self.keep_found.setToolTip(
+            "Turn the sketch view to the orientation the matcher read and tell the matcher it from now on"
+        )
+        self.keep_found.clicked.connect(lambda: self.set_orientation(self.found_orientation or self.orientation))
+        form.addRow(self.keep_found)
         self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
         self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
         self.angle.editingFinished.connect(lambda: self.set_orientation(self.orientation.at(self.angle.value())))
@@ -225,8 +238,11 @@ class MatchingPanel(QWidget):
         if not orientation.known:
             self.orientation_label.setText("orientation unknown: the matcher tries them")
         else:
-            mirrored = ", mirrored" if orientation.mirrored else ""
-            self.orientation_label.setText(f"known: turned {orientation.angle:g}° counter-clockwise{mirrored}")
+            self.orientation_label.setText(f"known: {orientation.describe()}")
+        found = self.found_orientation
+        self.keep_found.setVisible(found is not None and found != orientation)
+        if found is not None:
+            self.keep_found.setText(f"Keep the orientation read: {found.describe()}")
 
     def set_input_kind(self, kind: str | None) -> None:
         """Say what the input map is (None = unknown; see :data:`INPUT_KINDS`)."""
@@ -238,6 +254,8 @@ class MatchingPanel(QWidget):
 
     def show_result(self, result, *, automatic_cliques: int = 0) -> None:
         self.summary.setText(describe_result(result, automatic_cliques=automatic_cliques))
+        self.found_orientation = SketchOrientation.found_in(result)
+        self._show_orientation()
 
 
 def _combo(name: str, items) -> QComboBox:

@@ -23,6 +23,7 @@ from PySide6.QtWidgets import (
 )
 
 from ursim_gui.jobs.controller import JobController
+from ursim_gui.model.orientation import SketchOrientation
 from ursim_gui.model.session import AnnotationSession
 from ursim_gui.panels.agreement_panel import AgreementPanel
 from ursim_gui.panels.anchors_list import AnchorsList
@@ -261,6 +262,8 @@ class MainWindow(QMainWindow):
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
         self.session.segmentation_changed.connect(self._show_summary)
         self.session.map_changed.connect(self._show_map_title)
+        self._sketch_digest = self._digest_of_sketch()
+        self.session.map_changed.connect(self._forget_orientation_of_another_sketch)
         self.session.correspondences_changed.connect(lambda *_: self._show_match_summary())
         self.tools = WindowTools(self)
         self._update_ready()
@@ -344,6 +347,21 @@ class MainWindow(QMainWindow):
         self.actions["match"].setEnabled(segmented and not self.jobs.busy)
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
+
+    def _digest_of_sketch(self) -> str | None:
+        sketch = self.session.map("sketch")
+        return None if sketch is None else sketch.sha256
+
+    def _forget_orientation_of_another_sketch(self, side: str) -> None:
+        # The orientation belongs to a drawing: another sketch (the next pair of a campaign, say) is
+        # matched with its orientation unknown, not told the last sketch's. The same drawing opened
+        # again, or a drawing from the canvas (no file digest), keeps it.
+        if side != "sketch":
+            return
+        digest = self._digest_of_sketch()
+        if digest != self._sketch_digest:
+            self._sketch_digest = digest
+            self.matching_panel.set_orientation(SketchOrientation())
 
     def _show_match_summary(self) -> None:
         automatic = sum(1 for clique in self.session.correspondences.cliques if clique.source == "auto")
