@@ -354,8 +354,8 @@ class MainWindow(QMainWindow):
 
     def _forget_orientation_of_another_sketch(self, side: str) -> None:
         # The orientation belongs to a drawing: another sketch (the next pair of a campaign, say) is
-        # matched with its orientation unknown, not told the last sketch's. The same drawing opened
-        # again, or a drawing from the canvas (no file digest), keeps it.
+        # matched with its orientation unknown, not told the last sketch's. The same file opened
+        # again keeps it, and so does the canvas's drawing used again after an edit (no file digest).
         if side != "sketch":
             return
         digest = self._digest_of_sketch()
