@@ -83,3 +83,17 @@ def test_the_orientation_the_matcher_read_can_be_kept(window, qtbot):
     assert (config.orientation, config.mirrored) == found
     panel.unknown.click()
     assert panel.keep_found.isVisible()  # offered again while the last answer stands
+
+
+def test_a_file_opened_again_offers_the_orientation_its_match_read(window, qtbot, tmp_path):
+    panel = window.matching_panel
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        panel.match_button.click()
+    offered = panel.keep_found.text()
+    window.documents.save_as(tmp_path / "pair.json")
+    window.documents.open_correspondences(tmp_path / "pair.json")
+    assert window.session.last_match is None  # no result in memory: the file's record speaks
+    assert "automatic cliques from the file" in panel.summary.text() and "read the sketch" in panel.summary.text()
+    assert panel.keep_found.isVisible() and panel.keep_found.text() == offered
+    panel.keep_found.click()
+    assert window.views["sketch"].orientation == (panel.orientation.angle, panel.orientation.mirrored)

@@ -9,7 +9,6 @@ place accuracy (:func:`ursim_core.evaluation.scoring.place_accuracy`, places in 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -144,27 +143,6 @@ def match_config(args: argparse.Namespace):
     if getattr(args, "input_kind", None) is not None:
         overrides["input_kind"] = args.input_kind
     return base.replace(**overrides)
-
-
-def matcher_record(config, result) -> dict[str, Any]:
-    """What produced the automatic cliques, JSON-safe (kept in the file as an unknown key)."""
-    import dataclasses
-    import math
-
-    def safe(value: Any) -> Any:
-        if isinstance(value, float) and not math.isfinite(value):
-            return None
-        return value
-
-    return {
-        "config": json.loads(json.dumps(dataclasses.asdict(config), default=str)),
-        "m": safe(float(result.m)) if result.m is not None else None,
-        "cost": safe(float(result.cost)) if result.cost is not None else None,
-        "anchors": [[int(a), int(b)] for a, b in result.anchors],
-        "reason": result.reason or "",
-        # How the sketch was turned to match (chosen when config.orientation is 'any').
-        "orientation": {"degrees": round(float(result.orientation[0]), 6), "mirrored": bool(result.orientation[1])},
-    }
 
 
 def load_reference(path: str | Path):
@@ -305,6 +283,7 @@ def match_pair(
 
     from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
     from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review, sweep_helper
+    from ursim_core.matching.results import match_record
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -378,7 +357,7 @@ def match_pair(
             sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
             metric=ref(metric_map, metric_seg, "metric.labels.png"),
             cliques=cliques,
-            extra={"matcher": matcher_record(config, result)},
+            extra={"matcher": match_record(config, result)},
         )
         figure = side_by_side_matches(
             (sketch_seg.labels, sketch_seg.graph, sketch_map.image),

@@ -14,7 +14,7 @@ from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, 
 from ursim_core.matching.descriptors import PairDescriptors
 from ursim_core.matching.planar import PlanarGraph
 
-__all__ = ["Prepared", "MatchResult"]
+__all__ = ["Prepared", "MatchResult", "match_record"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,3 +103,38 @@ class MatchResult:
     m_scan: dict = field(default_factory=dict)
     orientation: tuple = (0.0, False)
     orientation_scan: dict = field(default_factory=dict)
+
+
+def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
+    """What produced a file's automatic cliques, JSON-safe: the record ``ursim match`` and the app
+    keep in a correspondence file under ``matcher`` (an unknown key to the format, written back).
+
+    ``orientation`` is how the sketch was turned to match; with ``config.orientation == 'any'``
+    the matcher chose it, and a reader can offer it as the sketch's orientation.
+
+    Examples
+    --------
+    >>> result = MatchResult([(1, 2)], [], [], [], 0.1, 3.0, 0.2, None, np.zeros((1, 1)), 1, 1, "",
+    ...                      MatchConfig(), orientation=(180.0, False))
+    >>> record = match_record(result.config, result)
+    >>> record["config"]["orientation"], record["orientation"]
+    ('any', {'degrees': 180.0, 'mirrored': False})
+    """
+    import dataclasses
+    import json
+    import math
+
+    def safe(value: Any) -> Any:
+        if isinstance(value, float) and not math.isfinite(value):
+            return None
+        return value
+
+    return {
+        "config": json.loads(json.dumps(dataclasses.asdict(config), default=str)),
+        "m": safe(float(result.m)) if result.m is not None else None,
+        "cost": safe(float(result.cost)) if result.cost is not None else None,
+        "anchors": [[int(a), int(b)] for a, b in result.anchors],
+        "reason": result.reason or "",
+        # How the sketch was turned to match (chosen when config.orientation is 'any').
+        "orientation": {"degrees": round(float(result.orientation[0]), 6), "mirrored": bool(result.orientation[1])},
+    }

@@ -9,6 +9,7 @@ has those fields.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 __all__ = ["SketchOrientation"]
@@ -75,8 +76,7 @@ class SketchOrientation:
 
         ``result`` is a ``MatchResult``: its ``orientation`` is the (degrees, mirrored) it laid the
         sketch in, the same convention as ``MatchConfig(orientation=, mirrored=)``, so telling the
-        matcher this orientation asks it for the reading it found. The angle is rounded to the
-        tenth of a degree the panel shows.
+        matcher this orientation asks it for the reading it found.
 
         Examples
         --------
@@ -90,4 +90,30 @@ class SketchOrientation:
         if result is None or getattr(config, "orientation", None) != "any":
             return None
         degrees, mirrored = result.orientation
+        return cls._read(degrees, mirrored)
+
+    @classmethod
+    def found_in_record(cls, record) -> SketchOrientation | None:
+        """:meth:`found_in` for a correspondence file's ``matcher`` record (what ``ursim match`` and
+        the app write beside the automatic cliques); None when the record says no such thing.
+
+        Examples
+        --------
+        >>> record = {"config": {"orientation": "any"}, "orientation": {"degrees": 90.0, "mirrored": False}}
+        >>> SketchOrientation.found_in_record(record), SketchOrientation.found_in_record({"m": 0.1})
+        (SketchOrientation(angle=90.0, mirrored=False), None)
+        """
+        try:
+            if record["config"]["orientation"] != "any":
+                return None
+            degrees, mirrored = float(record["orientation"]["degrees"]), record["orientation"]["mirrored"]
+        except (KeyError, TypeError, ValueError):
+            return None  # an older file, or one a person or another tool wrote
+        if not isinstance(mirrored, bool) or not math.isfinite(degrees):
+            return None
+        return cls._read(degrees, mirrored)
+
+    @classmethod
+    def _read(cls, degrees: float, mirrored: bool) -> SketchOrientation:
+        # Rounded to the tenth of a degree the panel shows: 359.96 is upright.
         return cls(angle=float(round(float(degrees) % 360.0, 1) % 360.0), mirrored=bool(mirrored))

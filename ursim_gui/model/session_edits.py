@@ -234,8 +234,9 @@ class EditOperations:
         person vouched for gets no second, automatic partner) or when a rejected clique holds
         the pair. New cliques are ``source='auto'`` with status None (pending), anchored at the
         regions' interior points, scored with the matcher's ``c`` value of the pair when
-        available. ``anchors`` and ``last_match`` are updated (they are not part of the undo
-        history).
+        available. The file's ``matcher`` record says what produced them
+        (:func:`ursim_core.matching.results.match_record`). ``anchors`` and ``last_match`` are
+        updated (they are not part of the undo history).
 
         Raises
         ------
@@ -262,7 +263,14 @@ class EditOperations:
         )
         self._last_match = result
         self._anchors = [(int(sketch), int(metric)) for sketch, metric in getattr(result, "anchors", [])]
-        if not self._commit(f"Apply match ({len(new_pairs)} pairs)", self._corr.with_cliques([*kept, *cliques])):
+        value = self._corr.with_cliques([*kept, *cliques])
+        if getattr(result, "config", None) is not None:
+            from ursim_core.matching.results import match_record
+
+            # What produced the automatic cliques, as ``ursim match`` writes it: the file says how
+            # the sketch was read when it is opened again.
+            value = dataclasses.replace(value, extra={**value.extra, "matcher": match_record(result.config, result)})
+        if not self._commit(f"Apply match ({len(new_pairs)} pairs)", value):
             # The cliques are the same, but anchors and last_match are new: views still refresh.
             self.correspondences_changed.emit()
 

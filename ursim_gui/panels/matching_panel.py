@@ -53,11 +53,12 @@ INPUT_KINDS = (
 _SCALED_MATCHERS = ("auto", "overlay")
 
 
-def describe_result(result, *, automatic_cliques: int = 0) -> str:
+def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
     """One-paragraph summary of a ``MatchResult`` for the panel.
 
     Without a result in memory (a document reopened from its file), ``automatic_cliques`` says
-    whether the file already holds the matcher's answer.
+    whether the file already holds the matcher's answer, and ``record`` (the file's ``matcher``
+    record) how the matcher read the sketch.
 
     Examples
     --------
@@ -66,7 +67,9 @@ def describe_result(result, *, automatic_cliques: int = 0) -> str:
     """
     if result is None:
         if automatic_cliques:
-            return f"{automatic_cliques} automatic cliques from the file (press Match to run the matcher again)"
+            text = f"{automatic_cliques} automatic cliques from the file (press Match to run the matcher again)"
+            found = SketchOrientation.found_in_record(record)
+            return text + (f"\nread the sketch {found.describe()}" if found is not None else "")
         return "not matched yet"
     text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
     if math.isfinite(result.cost):
@@ -252,9 +255,13 @@ class MatchingPanel(QWidget):
         """Enable Match only when both maps are segmented and no job runs."""
         self.match_button.setEnabled(ready)
 
-    def show_result(self, result, *, automatic_cliques: int = 0) -> None:
-        self.summary.setText(describe_result(result, automatic_cliques=automatic_cliques))
-        self.found_orientation = SketchOrientation.found_in(result)
+    def show_result(self, result, *, automatic_cliques: int = 0, record=None) -> None:
+        """Summarise the last match, or the file's (``record``: its ``matcher`` record) without one."""
+        self.summary.setText(describe_result(result, automatic_cliques=automatic_cliques, record=record))
+        if result is not None:
+            self.found_orientation = SketchOrientation.found_in(result)
+        else:
+            self.found_orientation = SketchOrientation.found_in_record(record) if automatic_cliques else None
         self._show_orientation()
 
 

@@ -365,7 +365,8 @@ class MainWindow(QMainWindow):
 
     def _show_match_summary(self) -> None:
         automatic = sum(1 for clique in self.session.correspondences.cliques if clique.source == "auto")
-        self.matching_panel.show_result(self.session.last_match, automatic_cliques=automatic)
+        record = self.session.correspondences.extra.get("matcher")
+        self.matching_panel.show_result(self.session.last_match, automatic_cliques=automatic, record=record)
 
     def _show_summary(self, side: str) -> None:
         segmentation = self.session.segmentation(side)

@@ -269,6 +269,28 @@ def test_apply_match_replaces_auto_cliques_and_keeps_manual_ones(session):
     assert session.correspondences == after_first
 
 
+def test_apply_match_records_what_produced_the_cliques_and_the_file_keeps_it(tmp_path):
+    """As ``ursim match`` does, the file says which matcher made its automatic cliques and how it
+    read the sketch, so that the app can offer that orientation when the file is opened again."""
+    from ursim_core.matching import match
+    from ursim_core.matching.results import match_record
+    from ursim_gui.model.orientation import SketchOrientation
+
+    author = write_document_files(tmp_path / "doc")
+    result = match(author.segmentation("sketch"), author.segmentation("metric"))
+    author.apply_match(result)
+    record = author.correspondences.extra["matcher"]
+    assert record == match_record(result.config, result)
+    assert SketchOrientation.found_in_record(record) == SketchOrientation.found_in(result) is not None
+    author.undo()
+    assert "matcher" not in author.correspondences.extra  # the record is part of the edit
+    author.redo()
+    author.save(tmp_path / "doc" / "pair.json")
+    session = AnnotationSession(timestamp=lambda: NOW)
+    session.open(tmp_path / "doc" / "pair.json")
+    assert session.correspondences.extra["matcher"] == record and session.last_match is None
+
+
 def test_apply_match_records_the_matcher_score_of_each_pair(session):
     scores = np.arange(81, dtype=float).reshape(9, 9)
     session.apply_match(types.SimpleNamespace(pairs=[(2, 3)], anchors=[], c_matrix=scores))
