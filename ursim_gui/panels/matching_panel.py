@@ -53,6 +53,14 @@ INPUT_KINDS = (
 _SCALED_MATCHERS = ("auto", "overlay")
 
 
+def orientation_read(result, *, automatic_cliques: int = 0, record=None):
+    """How the matcher read the sketch: from the result in memory, else from the file's ``matcher``
+    record while the file holds automatic cliques; None when it was told the orientation."""
+    if result is not None:
+        return SketchOrientation.found_in(result)
+    return SketchOrientation.found_in_record(record) if automatic_cliques else None
+
+
 def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
     """One-paragraph summary of a ``MatchResult`` for the panel.
 
@@ -66,18 +74,17 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
     ('not matched yet', '6 automatic cliques from the file (press Match to run the matcher again)')
     """
     if result is None:
-        if automatic_cliques:
-            text = f"{automatic_cliques} automatic cliques from the file (press Match to run the matcher again)"
-            found = SketchOrientation.found_in_record(record)
-            return text + (f"\nread the sketch {found.describe()}" if found is not None else "")
-        return "not matched yet"
-    text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
-    if math.isfinite(result.cost):
-        text += f", cost {result.cost:.3g}"
-    found = SketchOrientation.found_in(result)
+        if not automatic_cliques:
+            return "not matched yet"
+        text = f"{automatic_cliques} automatic cliques from the file (press Match to run the matcher again)"
+    else:
+        text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
+        if math.isfinite(result.cost):
+            text += f", cost {result.cost:.3g}"
+    found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
         text += f"\nread the sketch {found.describe()}"
-    if result.reason:
+    if result is not None and result.reason:
         text += f"\n{result.reason}"
     return text
 
@@ -258,10 +265,7 @@ class MatchingPanel(QWidget):
     def show_result(self, result, *, automatic_cliques: int = 0, record=None) -> None:
         """Summarise the last match, or the file's (``record``: its ``matcher`` record) without one."""
         self.summary.setText(describe_result(result, automatic_cliques=automatic_cliques, record=record))
-        if result is not None:
-            self.found_orientation = SketchOrientation.found_in(result)
-        else:
-            self.found_orientation = SketchOrientation.found_in_record(record) if automatic_cliques else None
+        self.found_orientation = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
         self._show_orientation()
 
 
