@@ -137,8 +137,8 @@ def run_bench(
         from ursim_core.bench.scale import bench_match_process
         from ursim_core.bench.segmentation import bench_scale, print_table
 
-        print("== segmentation scale (generated buildings; targets at 8000 px: 5 s, 1.5 GB)")
-        print_table(bench_scale(sizes or SCALE_SIZES))
+        print(f"== segmentation scale (generated buildings, median of {repeats} runs; targets at 8000 px: 5 s, 1.5 GB)")
+        print_table(bench_scale(sizes or SCALE_SIZES, repeats=repeats))
         print("== whole-process `ursim match` of two different buildings of each size (targets at 8000 px: 30 s, 3 GB)")
         print_table(bench_match_process(sizes or SCALE_SIZES))
         print("time_ratio: wall time over the previous size's (each step is 4x the pixels; target <= 4.5)")

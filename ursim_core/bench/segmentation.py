@@ -53,6 +53,12 @@ _BENCH_MAPS = (
 
 
 def _time(function: Callable[[], object], repeats: int) -> tuple[float, float, object]:
+    walls, cpus, result = _times(function, repeats)
+    return statistics.median(walls), statistics.median(cpus), result
+
+
+def _times(function: Callable[[], object], repeats: int) -> tuple[list[float], list[float], object]:
+    """Wall and CPU seconds of each of ``repeats`` runs of ``function``, and its last result."""
     walls, cpus, result = [], [], None
     for _ in range(max(1, repeats)):
         gc.collect()
@@ -60,7 +66,7 @@ def _time(function: Callable[[], object], repeats: int) -> tuple[float, float, o
         result = function()
         walls.append(time.perf_counter() - wall)
         cpus.append(time.process_time() - cpu)
-    return statistics.median(walls), statistics.median(cpus), result
+    return walls, cpus, result
 
 
 def _timed_row(name: str, free: np.ndarray, preset: str, segmenter: Callable[[], np.ndarray], repeats: int) -> dict:
@@ -151,17 +157,17 @@ def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, 
     Returns
     -------
     list of dict
-        ``size``, ``pixels``, ``regions``, ``wall_s``, ``cpu_s``,
-        ``peak_traced_mb`` (tracemalloc: numpy and Python allocations),
-        ``maxrss_mb`` (process peak resident size so far; it only grows),
-        ``time_ratio`` (wall time over the previous size's) and
-        ``pixel_ratio``.
+        ``size``, ``pixels``, ``regions``, ``wall_s`` and ``cpu_s`` (medians of ``repeats``
+        runs), ``wall_range_s`` (the fastest and slowest run), ``peak_traced_mb`` (tracemalloc:
+        numpy and Python allocations), ``maxrss_mb`` (process peak resident size so far; it only
+        grows), ``time_ratio`` (median wall time over the previous size's) and ``pixel_ratio``.
     """
     rows: list[dict] = []
     previous: tuple[int, float] | None = None
     for size in sizes:
         free = make_large_building(int(size)).free
-        wall, cpu, labels = _time(lambda: maoris_labels(free, PRESETS[preset]), repeats)
+        walls, cpus, labels = _times(lambda: maoris_labels(free, PRESETS[preset]), repeats)
+        wall, cpu = statistics.median(walls), statistics.median(cpus)
         gc.collect()
         tracemalloc.start()
         maoris_labels(free, PRESETS[preset])
@@ -172,6 +178,8 @@ def bench_scale(sizes: Iterable[int] = (1000, 2000, 4000), *, repeats: int = 1, 
             "pixels": int(size) ** 2,
             "regions": int(labels.max()),
             "wall_s": round(wall, 3),
+            # The spread of the runs: on a shared machine one run's growth ratio varies by +-20 %.
+            "wall_range_s": f"{min(walls):.3f}-{max(walls):.3f}",
             "cpu_s": round(cpu, 3),
             "peak_traced_mb": round(peak / 2**20, 1),
             "maxrss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
