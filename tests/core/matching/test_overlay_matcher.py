@@ -10,7 +10,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.evaluation import augment
 from ursim_core.matching import MatchConfig, match, match_prepared, prepare
 from ursim_core.matching.overlay import fit_overlay, overlay_pairs
-from ursim_core.segmentation import segment
+from ursim_core.segmentation import segment, segment_canonical
 from ursim_core.synth import make_pair
 
 OVERLAY = MatchConfig(matcher="overlay", scale=1.0, mirrored=False)
@@ -53,6 +53,31 @@ def test_a_cropped_turned_copy_is_laid_back_where_it_came_from(plan, plan_segmen
     full_rows, full_cols = np.mgrid[window[0], window[1]]
     share = _identity_share(result.pairs, back, plan_segmentation.labels, full_rows, full_cols)
     assert share >= 0.9, (share, result.pairs)
+
+
+@pytest.mark.parametrize("seed", [1, 15])
+def test_a_cropped_copy_with_no_scale_given_is_laid_where_it_came_from(seed):
+    # The placements are ranked by the normalised cross-correlation of the signed images; ranked by
+    # the share of the input that agrees, these copies were laid turned by a half turn at 1.09-1.13
+    # times their scale (F1 0.14 and 0.11 in `ursim bench invariance`'s robot-map copies).
+    from ursim_core.bench.invariance import _parameters, transformed_sketch
+
+    plan, _ = make_pair(seed=seed)
+    kept = _parameters(seed, "cropped")[3]
+    part, _ = transformed_sketch(plan.free, [], kept=kept, seed=seed)
+    part_seg, plan_seg = segment_canonical(part, preset="default"), segment_canonical(plan.free, preset="default")
+    fit = fit_overlay(part_seg.labels, plan_seg.labels, orientations=[(0.0, False), (180.0, False)])
+    assert fit.degrees == 0.0
+    np.testing.assert_allclose(fit.matrix[:, :2], np.eye(2), atol=0.08)
+    result = match(part_seg, plan_seg, config=MatchConfig(input_kind="metric"))
+    # Where the crop was cut from (transformed_sketch draws it from the same generator).
+    rows, cols = np.nonzero(plan.free)
+    low, high = np.array([rows.min(), cols.min()]), np.array([rows.max(), cols.max()]) + 1
+    side = np.maximum(1, np.round((high - low) * np.sqrt(kept))).astype(int)
+    rng = np.random.default_rng([seed, 7])
+    start = low + np.array([rng.integers(0, max(1, high[k] - low[k] - side[k] + 1)) for k in range(2)])
+    full_rows, full_cols = np.mgrid[start[0] : start[0] + side[0], start[1] : start[1] + side[1]]
+    assert _identity_share(result.pairs, part_seg.labels, plan_seg.labels, full_rows, full_cols) >= 0.9
 
 
 def test_the_shift_of_a_crop_is_found_at_full_resolution(plan):
