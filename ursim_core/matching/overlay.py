@@ -79,9 +79,15 @@ def _template(free: np.ndarray, corners: np.ndarray, linear: np.ndarray):
     size = (int(math.ceil(high[1] - low[1])) + 1, int(math.ceil(high[0] - low[0])) + 1)
     offset = -low
     opencv = np.array([[linear[1, 1], linear[1, 0], offset[1]], [linear[0, 1], linear[0, 0], offset[0]]])
-    shrinking = abs(np.linalg.det(linear)) < 1
-    warped = cv2.warpAffine(free, opencv, size, flags=cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR).clip(0, 1)
-    return warped, _wall_band((warped > 0.25).astype(np.uint8)), offset
+    flags = cv2.INTER_AREA if abs(np.linalg.det(linear)) < 1 else cv2.INTER_LINEAR
+    warped = cv2.warpAffine(free, opencv, size, flags=flags).clip(0, 1)
+    # A map cut at its image's edge (free space touching it) goes on beyond the edge: no wall is
+    # there. The band is drawn around the free space with its edge pixels repeated outward, so a cut
+    # adds none (without this, cropped copies of generated plans were laid at the right scale and
+    # turn 18 times in 32 as free-space masks, against 32 as label images, whose slivers at the cut
+    # MAORIS leaves unlabelled).
+    extended = cv2.warpAffine(free, opencv, size, flags=flags, borderMode=cv2.BORDER_REPLICATE)
+    return warped, _wall_band((extended > 0.25).astype(np.uint8)), offset
 
 
 def _wall_band(solid: np.ndarray) -> np.ndarray:

@@ -80,6 +80,22 @@ def test_a_cropped_copy_with_no_scale_given_is_laid_where_it_came_from(seed):
     assert _identity_share(result.pairs, part_seg.labels, plan_seg.labels, full_rows, full_cols) >= 0.9
 
 
+@pytest.mark.parametrize("seed", [6, 11])
+def test_a_copy_cut_at_its_image_edge_is_laid_at_its_own_scale_as_a_free_space_mask(seed):
+    # Free space touching the image's edge was cut there: no wall band is drawn beyond it. With one,
+    # these crops (as bool masks; MAORIS drops the slivers at the cut from a label image) were laid
+    # at 0.47 and 0.50 times their scale.
+    from ursim_core.bench.invariance import _parameters, transformed_sketch
+
+    plan, _ = make_pair(seed=seed)
+    part, _ = transformed_sketch(plan.free, [], kept=_parameters(seed, "cropped")[3], seed=seed)
+    assert part[:, 0].any() or part[:, -1].any() or part[0].any() or part[-1].any()
+    quarter_turns = [(90.0 * k, False) for k in range(4)]
+    fit = fit_overlay(part, plan.free, orientations=quarter_turns)
+    assert fit.degrees == 0.0
+    np.testing.assert_allclose(fit.matrix[:, :2], np.eye(2), atol=0.08)
+
+
 def test_the_shift_of_a_crop_is_found_at_full_resolution(plan):
     rows, cols = plan.free.shape
     part = plan.free[40 : 40 + rows // 2, 60 : 60 + cols // 2]
