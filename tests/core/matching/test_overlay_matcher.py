@@ -63,20 +63,18 @@ def test_a_cropped_copy_with_no_scale_given_is_laid_where_it_came_from(seed):
     from ursim_core.bench.invariance import _parameters, transformed_sketch
 
     plan, _ = make_pair(seed=seed)
-    kept = _parameters(seed, "cropped")[3]
-    part, _ = transformed_sketch(plan.free, [], kept=kept, seed=seed)
+    # Points on a grid of the plan: the crop moves those it keeps by minus its origin.
+    grid = [(r, c) for r in range(0, plan.free.shape[0], 10) for c in range(0, plan.free.shape[1], 10)]
+    part, moved = transformed_sketch(plan.free, grid, kept=_parameters(seed, "cropped")[3], seed=seed)
     part_seg, plan_seg = segment_canonical(part, preset="default"), segment_canonical(plan.free, preset="default")
     fit = fit_overlay(part_seg.labels, plan_seg.labels, orientations=[(0.0, False), (180.0, False)])
     assert fit.degrees == 0.0
     np.testing.assert_allclose(fit.matrix[:, :2], np.eye(2), atol=0.08)
     result = match(part_seg, plan_seg, config=MatchConfig(input_kind="metric"))
-    # Where the crop was cut from (transformed_sketch draws it from the same generator).
-    rows, cols = np.nonzero(plan.free)
-    low, high = np.array([rows.min(), cols.min()]), np.array([rows.max(), cols.max()]) + 1
-    side = np.maximum(1, np.round((high - low) * np.sqrt(kept))).astype(int)
-    rng = np.random.default_rng([seed, 7])
-    start = low + np.array([rng.integers(0, max(1, high[k] - low[k] - side[k] + 1)) for k in range(2)])
-    full_rows, full_cols = np.mgrid[start[0] : start[0] + side[0], start[1] : start[1] + side[1]]
+    # Where the crop was cut from.
+    point, kept_point = next((p, q) for p, q in zip(grid, moved) if q is not None)
+    start = np.subtract(point, kept_point)
+    full_rows, full_cols = np.mgrid[start[0] : start[0] + part.shape[0], start[1] : start[1] + part.shape[1]]
     assert _identity_share(result.pairs, part_seg.labels, plan_seg.labels, full_rows, full_cols) >= 0.9
 
 
