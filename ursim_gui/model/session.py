@@ -84,6 +84,9 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         ``(dirty: bool)``, only when the value flips.
     path_changed : Signal
         ``(path: Path | None)``.
+    document_opened : Signal
+        ``(correspondences)``: a document was opened from a file or recovered, after its maps
+        and cliques are in place (what the file says about how it was made can be read back).
     error : Signal
         ``(message: str)`` for problems found while an operation still succeeded (e.g. a
         map file that changed since the correspondences were saved). Failures of an
@@ -104,6 +107,7 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self.selection_changed = Signal("selection_changed")
         self.dirty_changed = Signal("dirty_changed")
         self.path_changed = Signal("path_changed")
+        self.document_opened = Signal("document_opened")
         self.reference_changed = Signal("reference_changed")
         self.history_changed = Signal("history_changed")
         self.error = Signal("error")

@@ -228,6 +228,7 @@ class DocumentOperations:
         self.selection_changed.emit()
         self._announce_value_change(was_dirty)
         self.history_changed.emit()
+        self.document_opened.emit(current)
         for warning in warnings:
             self.error.emit(warning)
 

@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
 )
 
 from ursim_gui.model.orientation import SketchOrientation
+from ursim_gui.model.pair_settings import MAX_SCALE
 
 __all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "INPUT_KINDS", "describe_result"]
 
@@ -127,7 +128,7 @@ class MatchingPanel(QWidget):
         # The known scale (metric pixels per input pixel; 0 = unknown): with it, 'auto' overlays.
         self.scale = QDoubleSpinBox()
         self.scale.setObjectName("match_scale")
-        self.scale.setRange(0.0, 100.0)
+        self.scale.setRange(0.0, MAX_SCALE)
         self.scale.setDecimals(3)
         self.scale.setSingleStep(0.05)
         self.scale.setSpecialValueText("unknown (estimated)")
@@ -257,6 +258,10 @@ class MatchingPanel(QWidget):
     def set_input_kind(self, kind: str | None) -> None:
         """Say what the input map is (None = unknown; see :data:`INPUT_KINDS`)."""
         self.input_kind.setCurrentIndex(max(0, self.input_kind.findData(kind)))
+
+    def set_scale(self, scale: float | None) -> None:
+        """Say the known scale (metric pixels per input pixel; None = unknown, estimated)."""
+        self.scale.setValue(0.0 if scale is None else float(scale))
 
     def set_ready(self, ready: bool) -> None:
         """Enable Match only when both maps are segmented and no job runs."""

@@ -142,8 +142,6 @@ class CampaignController(QObject):
         except OSError as error:
             _log.warning("campaign state not written: %s", error)
         self._awaiting_match = None
-        # What the source says the input map is (the Halmstad robot maps), for every match of the pair.
-        window.matching_panel.set_input_kind(pair.input_kind)
         try:
             if pair.output.is_file():
                 session.open(pair.output)
@@ -163,6 +161,10 @@ class CampaignController(QObject):
         except _FAILURES as error:
             dialogs.show_error(window, f"Cannot open pair {pair.name}", str(error))
             return False
+        # What the source says the input map is (the Halmstad robot maps), for every match of the
+        # pair: set once its maps are in, since opening another map forgets the last pair's settings.
+        if pair.input_kind is not None:
+            window.matching_panel.set_input_kind(pair.input_kind)
         if pair.reference is not None:
             window.documents.load_reference(pair.reference)
         window.fit_views()

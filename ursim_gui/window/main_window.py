@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
 
 from ursim_gui.jobs.controller import JobController
 from ursim_gui.model.orientation import SketchOrientation
+from ursim_gui.model.pair_settings import MapIdentities, recorded_settings
 from ursim_gui.model.session import AnnotationSession
 from ursim_gui.panels.agreement_panel import AgreementPanel
 from ursim_gui.panels.anchors_list import AnchorsList
@@ -262,8 +263,9 @@ class MainWindow(QMainWindow):
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
         self.session.segmentation_changed.connect(self._show_summary)
         self.session.map_changed.connect(self._show_map_title)
-        self._sketch_digest = self._digest_of_sketch()
-        self.session.map_changed.connect(self._forget_orientation_of_another_sketch)
+        self._identities = MapIdentities({side: self._digest_of(side) for side in SIDES})
+        self.session.map_changed.connect(self._forget_settings_of_another_map)
+        self.session.document_opened.connect(self._use_recorded_settings)
         self.session.correspondences_changed.connect(lambda *_: self._show_match_summary())
         self.tools = WindowTools(self)
         self._update_ready()
@@ -348,20 +350,30 @@ class MainWindow(QMainWindow):
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
 
-    def _digest_of_sketch(self) -> str | None:
-        sketch = self.session.map("sketch")
-        return None if sketch is None else sketch.sha256
+    def _digest_of(self, side: str) -> str | None:
+        loaded = self.session.map(side)
+        return None if loaded is None else loaded.sha256
 
-    def _forget_orientation_of_another_sketch(self, side: str) -> None:
-        # The orientation belongs to a drawing: another sketch (the next pair of a campaign, say) is
-        # matched with its orientation unknown, not told the last sketch's. The same file opened
-        # again keeps it, and so does the canvas's drawing used again after an edit (no file digest).
-        if side != "sketch":
-            return
-        digest = self._digest_of_sketch()
-        if digest != self._sketch_digest:
-            self._sketch_digest = digest
-            self.matching_panel.set_orientation(SketchOrientation())
+    def _forget_settings_of_another_map(self, side: str) -> None:
+        # The orientation, input kind and scale belong to the maps open (see model.pair_settings):
+        # another sketch (the next pair of a campaign, say) is matched with them unknown, not told
+        # the last pair's. The same file opened again keeps them, and so does the canvas's drawing
+        # used again after an edit (no file digest).
+        forget = self._identities.settings_to_forget(side, self._digest_of(side))
+        panel = self.matching_panel
+        if "orientation" in forget:
+            panel.set_orientation(SketchOrientation())
+        if "input_kind" in forget:
+            panel.set_input_kind(None)
+        if "scale" in forget:
+            panel.set_scale(None)
+
+    def _use_recorded_settings(self, correspondences) -> None:
+        # A file opened again is matched again with the input kind and scale its cliques were made with.
+        settings = recorded_settings(correspondences.extra.get("matcher"))
+        if settings:
+            self.matching_panel.set_input_kind(settings["input_kind"])
+            self.matching_panel.set_scale(settings["scale"])
 
     def _show_match_summary(self) -> None:
         automatic = sum(1 for clique in self.session.correspondences.cliques if clique.source == "auto")
