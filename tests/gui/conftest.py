@@ -1,14 +1,23 @@
-"""Shared fixtures of the GUI tests: offscreen Qt, small synthetic maps and segmentations."""
+"""Shared fixtures and helpers of the GUI tests: offscreen Qt, synthetic maps, model sessions, window clicks, keys."""
 
 from __future__ import annotations
 
 import os
+import types
+from pathlib import Path
 
 # Must happen before QApplication exists (pytest-qt creates it lazily in the qapp fixture).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
+import cv2
 import numpy as np
 import pytest
+from PySide6.QtCore import Qt
+
+from ursim_core.io.maps import map_from_array
+from ursim_core.segmentation import Segmentation, load_label_image, save_label_image
+from ursim_core.segmentation.graph import region_graph
+from ursim_gui.model.session import AnnotationSession
 
 
 def two_room_free(rows: int = 60, cols: int = 130) -> np.ndarray:
@@ -176,3 +185,153 @@ def simulate_crash(autosaver) -> None:
     """Leave ``autosaver``'s copy as a crashed run would: its lock names a dead process."""
     lock = autosaver.folder / f"{autosaver._instance_id}.lock"
     lock.write_text(f"{dead_pid()}\n", encoding="ascii")
+
+
+# ---- sessions of the model tests -----------------------------------------------------------------
+
+
+NOW = "2024-05-01T12:00:00Z"
+
+
+def grid_labels(n_rows: int = 3, n_cols: int = 3, *, room: int = 20, wall: int = 2) -> np.ndarray:
+    """Rooms 1..n_rows*n_cols in raster order, separated by walls (0)."""
+    labels = np.zeros((n_rows * room + (n_rows + 1) * wall, n_cols * room + (n_cols + 1) * wall), np.int32)
+    for index in range(n_rows * n_cols):
+        row, col = divmod(index, n_cols)
+        top, left = wall + row * (room + wall), wall + col * (room + wall)
+        labels[top : top + room, left : left + room] = index + 1
+    return labels
+
+
+def seg_of(labels: np.ndarray, *, source=None) -> Segmentation:
+    return Segmentation(labels=labels, graph=region_graph(labels), method="label-image", source=source)
+
+
+def map_of(labels: np.ndarray, *, path=None):
+    return map_from_array(np.where(labels > 0, 255, 0).astype(np.uint8), path=path)
+
+
+def interior(labels: np.ndarray, region: int) -> tuple[int, int]:
+    return region_graph(labels).nodes[region]["interior"]
+
+
+class Recorder:
+    """Counts the emissions of every session signal."""
+
+    NAMES = (
+        "map_changed",
+        "segmentation_changed",
+        "correspondences_changed",
+        "selection_changed",
+        "dirty_changed",
+        "path_changed",
+        "reference_changed",
+        "history_changed",
+        "error",
+    )
+
+    def __init__(self, session):
+        self.calls = {name: [] for name in self.NAMES}
+        for name in self.NAMES:
+            getattr(session, name).connect(lambda *args, name=name: self.calls[name].append(args))
+
+    def count(self, name):
+        return len(self.calls[name])
+
+    def reset(self):
+        for calls in self.calls.values():
+            calls.clear()
+
+
+SKETCH_LABELS = grid_labels(room=20)
+METRIC_LABELS = grid_labels(room=30)
+
+
+@pytest.fixture
+def session():
+    session = AnnotationSession(annotator="tester", timestamp=lambda: NOW)
+    session.set_map("sketch", map_of(SKETCH_LABELS))
+    session.set_map("metric", map_of(METRIC_LABELS))
+    session.set_segmentation("sketch", seg_of(SKETCH_LABELS))
+    session.set_segmentation("metric", seg_of(METRIC_LABELS))
+    return session
+
+
+def write_document_files(folder, *, label_images: bool = True):
+    """Map PNGs (and label images) of the grid pair in ``folder``; returns a ready session."""
+    folder.mkdir(parents=True, exist_ok=True)
+    session = AnnotationSession(timestamp=lambda: NOW)
+    for side, labels in (("sketch", SKETCH_LABELS), ("metric", METRIC_LABELS)):
+        cv2.imwrite(str(folder / f"{side}.png"), np.where(labels > 0, 255, 0).astype(np.uint8))
+        session.load_map(side, folder / f"{side}.png")
+        if label_images:
+            save_label_image(seg_of(labels), folder / f"{side}-labels.png")
+            session.set_segmentation(side, load_label_image(folder / f"{side}-labels.png", shape=labels.shape))
+        else:
+            session.set_segmentation(side, seg_of(labels))
+    return session
+
+
+def fake_match(pairs, *, anchors=()):
+    """The parts of a MatchResult the session reads."""
+    return types.SimpleNamespace(pairs=list(pairs), anchors=list(anchors), c_matrix=None)
+
+
+# ---- driving the main window ---------------------------------------------------------------------
+
+
+def click(qtbot, view, region, modifier=Qt.KeyboardModifier.NoModifier):
+    """Click a region of a map view (with ``modifier``)."""
+    qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, modifier, region_point(view, region))
+
+
+def key(qtbot, window, name, modifier=Qt.KeyboardModifier.NoModifier):
+    """Press a key on the window's sketch view."""
+    qtbot.keyClick(window.views["sketch"], name, modifier)
+
+
+def link_by_clicks(qtbot, window, sketch: int, metric: int) -> None:
+    window.session.clear_selection()
+    click(qtbot, window.views["sketch"], sketch)
+    # Ctrl: a plain click on a matched region would select its clique instead.
+    click(qtbot, window.views["metric"], metric, Qt.KeyboardModifier.ControlModifier)
+    key(qtbot, window, Qt.Key.Key_L)
+
+
+def answer_file_dialogs(monkeypatch, path: Path) -> None:
+    """Every open or save dialog answers ``path``."""
+    from ursim_gui.views import file_dialogs
+
+    monkeypatch.setattr(file_dialogs, "ask_open_path", lambda *a, **k: Path(path))
+    monkeypatch.setattr(file_dialogs, "ask_save_path", lambda *a, **k: Path(path))
+
+
+@pytest.fixture
+def empty_window(qtbot, tmp_path):
+    from ursim_gui.window.main_window import MainWindow
+
+    win = MainWindow(data_dir=tmp_path / "userdata")
+    qtbot.addWidget(win)
+    win.show()
+    return win
+
+
+def new_window(qtbot, data_dir):
+    from ursim_gui.window.main_window import MainWindow
+
+    window = MainWindow(data_dir=data_dir)
+    qtbot.addWidget(window)
+    window.show()
+    qtbot.waitExposed(window)
+    return window
+
+
+@pytest.fixture
+def plain_campaign(tmp_path, labels3):
+    """A plain folder: metric.png and three sketches (the three-room map and two copies)."""
+    folder = tmp_path / "plain"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "metric.png"), np.where(scaled(labels3, 2) > 0, 255, 0).astype(np.uint8))
+    for name in ("s1", "s2", "s3"):
+        cv2.imwrite(str(folder / f"{name}.png"), np.where(labels3 > 0, 255, 0).astype(np.uint8))
+    return folder

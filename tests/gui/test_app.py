@@ -1,5 +1,4 @@
-"""Feature 11 and the app shell: ``--screenshot`` renders the window to a PNG and exits 0;
-uncaught errors are logged and shown, never fatal; the bundled example opens by default."""
+"""The app entry point (ursim_gui.app): --screenshot writes a PNG, errors are shown, never fatal; the example opens."""
 
 from __future__ import annotations
 
@@ -95,45 +94,3 @@ def test_without_arguments_the_example_is_opened_segmented_matched_and_scored(qt
     assert session.segmentation("sketch") is not None and session.segmentation("metric") is not None
     assert session.correspondences.cliques and session.evaluation is not None
     assert window.evaluation.values["f1"].text() != "–"
-
-
-def test_dark_theme_follows_into_the_map_views_and_is_remembered(window, tmp_path, qtbot):
-    from PySide6.QtWidgets import QApplication
-
-    from ursim_gui.window.main_window import MainWindow
-
-    light = window.views["sketch"].backgroundBrush().color().lightness()
-    window.actions["dark_theme"].setChecked(True)
-    QApplication.processEvents()
-    try:
-        assert QApplication.instance().palette().window().color().lightness() < 100
-        assert window.views["sketch"].backgroundBrush().color().lightness() < light
-        window.close()
-        again = MainWindow(data_dir=tmp_path / "userdata")
-        qtbot.addWidget(again)
-        assert again.actions["dark_theme"].isChecked()
-        again.actions["dark_theme"].setChecked(False)
-        again.jobs.runner.shutdown()
-    finally:
-        window.actions["dark_theme"].setChecked(False)
-        QApplication.processEvents()
-
-
-def test_the_window_fits_1366x768(window, qtbot):
-    window.resize(1366, 768)
-    qtbot.wait(50)
-    assert window.width() <= 1366 and window.height() <= 768
-    assert window.minimumSizeHint().width() <= 1366 and window.minimumSizeHint().height() <= 768
-
-
-def test_recent_files_are_remembered_and_offered(window, tmp_path, qtbot):
-    from ursim_gui.window.main_window import MainWindow
-
-    window.session.link([1], [1])
-    window.documents.save_as(tmp_path / "doc.json")
-    window.close()
-    again = MainWindow(data_dir=tmp_path / "userdata")
-    qtbot.addWidget(again)
-    again._fill_recent_menu()
-    assert str(tmp_path / "doc.json") in [action.text() for action in again.recent_menu.actions()]
-    again.jobs.runner.shutdown()

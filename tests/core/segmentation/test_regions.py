@@ -145,3 +145,19 @@ def cv2_resize_nearest(coarse, shape):
     import cv2
 
     return cv2.resize(coarse.astype(np.int32), (shape[1], shape[0]), interpolation=cv2.INTER_NEAREST)
+
+
+# The bounding boxes of the region table.
+def test_region_graph_boxes_are_those_of_scipy_find_objects():
+    from scipy import ndimage
+
+    from ursim_core.segmentation.regions import _bounding_boxes
+
+    rng = np.random.default_rng(0)
+    for shape in ((1, 1), (7, 1), (1, 9), (40, 33)):
+        labels = rng.choice(np.array([0, 1, 2, 5], np.int32), size=shape)  # ids 3 and 4 absent
+        count = int(labels.max()) + 1
+        boxes = _bounding_boxes(labels, count)
+        for index, box in enumerate(ndimage.find_objects(labels), start=1):
+            if box is not None:
+                assert tuple(boxes[index]) == (box[0].start, box[1].start, box[0].stop, box[1].stop)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from test_session import METRIC_LABELS, NOW, SKETCH_LABELS, fake_match, map_of, seg_of
+from conftest import METRIC_LABELS, NOW, SKETCH_LABELS, fake_match, map_of, seg_of
 
 from ursim_core.matching import MatchConfig
 from ursim_gui.model.jobs import MatchJob

@@ -1,0 +1,78 @@
+"""``ursim goal`` (ursim_core.cli.goal): a sketch point as a goal pose, registered by its add_parser function."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from cli_helpers import correspondences_file, rooms_image, ursim
+from PIL import Image
+
+from ursim_core.io.maps import load_map, world_to_pixel
+from ursim_core.io.occupancy_grid import save_map_yaml
+
+
+# The same fixture in test_cli_goal.py and test_cli_route.py.
+@pytest.fixture
+def maps(tmp_path):
+    sketch = tmp_path / "sketch.png"
+    Image.fromarray(rooms_image()).save(sketch)
+    metric_png = tmp_path / "metric.png"
+    big = rooms_image(width=90, height=70)
+    Image.fromarray(big).save(metric_png)
+    metric_yaml = tmp_path / "metric.yaml"
+    save_map_yaml(load_map(metric_png), metric_yaml, resolution=0.05, origin=(-1.0, 2.0, 0.0))
+    return sketch, metric_png, metric_yaml
+
+
+def test_goal_prints_a_pose_stamped_in_the_map_frame(tmp_path, maps, capsys):
+    sketch, _, metric_yaml = maps
+    corr = correspondences_file(tmp_path, sketch, metric_yaml)
+    code = ursim(["goal", str(sketch), str(metric_yaml), "--at", "20,100", "--correspondences", str(corr)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    document = json.loads(captured.out)
+    assert document["header"]["frame_id"] == "map"
+    assert document["ursim"]["clique"] == 2 and document["ursim"]["label"] == "lab"
+    position = document["pose"]["position"]
+    row, col = world_to_pixel(load_map(metric_yaml), position["x"], position["y"])
+    assert (round(row), round(col)) == tuple(document["ursim"]["pixel"])
+    assert 95 <= col <= 185  # inside the middle metric room
+
+
+def test_goal_on_an_image_gives_pixels_and_a_note(maps, capsys, tmp_path):
+    sketch, metric_png, _ = maps
+    out = tmp_path / "goal.json"
+    code = ursim(["goal", str(sketch), str(metric_png), "--at", "20,30", "-o", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0
+    assert json.loads(out.read_text()) == json.loads(captured.out)
+    assert json.loads(captured.out)["pose"] is None
+    assert "no resolution" in captured.err
+
+
+def test_goal_off_every_region_says_why_and_offers_the_nearest(tmp_path, maps, capsys):
+    sketch, _, metric_yaml = maps
+    corr = correspondences_file(tmp_path, sketch, metric_yaml)
+    code = ursim(["goal", str(sketch), str(metric_yaml), "--at", "200,5", "--correspondences", str(corr)])
+    captured = capsys.readouterr()
+    assert code == 1
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: sketch point (200, 5): no sketch region")
+    assert "nearest matched region" in lines[0]
+
+
+def test_goal_with_several_points_prints_a_list(tmp_path, maps, capsys):
+    sketch, _, metric_yaml = maps
+    corr = correspondences_file(tmp_path, sketch, metric_yaml)
+    code = ursim(["goal", str(sketch), str(metric_yaml), "--correspondences", str(corr), "--at=20,30", "--at=20,160"])
+    documents = json.loads(capsys.readouterr().out)
+    assert code == 0 and [d["ursim"]["clique"] for d in documents] == [1, 3]
+
+
+def test_bad_point_is_a_usage_error(maps, capsys):
+    sketch, _, metric_yaml = maps
+    with pytest.raises(SystemExit) as exit_info:
+        ursim(["goal", str(sketch), str(metric_yaml), "--at", "12"])
+    assert exit_info.value.code == 2
+    assert "ROW,COL" in capsys.readouterr().err

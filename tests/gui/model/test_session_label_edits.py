@@ -1,0 +1,53 @@
+"""Edited segmentations (ursim_gui.model.session_label_edits): saved beside the document and in the autosave copy."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ursim_gui.model.session import AnnotationSession
+
+
+def test_an_edited_segmentation_is_saved_beside_the_file_and_reopened_exactly(window, qtbot, tmp_path):
+    session = window.session
+    session.link([1], [1])
+    session.merge_regions("sketch", 2, 3)
+    edited = session.segmentation("sketch").labels.copy()
+    document = tmp_path / "doc.json"
+    session.save(document)
+    labels_file = tmp_path / "doc.sketch.labels.png"
+    raw = json.loads(document.read_text())
+    sketch_ref = raw["maps"]["sketch"] if "maps" in raw else raw["sketch"]
+    text = json.dumps(sketch_ref)
+    assert labels_file.is_file() and "doc.sketch.labels.png" in text and '"edited"' in text
+    assert "label-image" in text  # the method it started from
+    assert not session.dirty
+
+    reopened = AnnotationSession()
+    reopened.open(document)
+    assert np.array_equal(reopened.segmentation("sketch").labels, edited)
+    assert reopened.correspondences.cliques == session.correspondences.cliques and not reopened.dirty
+
+
+def test_an_edited_segmentation_survives_a_crash_through_the_autosave_copy(window, tmp_path):
+    """The autosave copy carries the edited label image, so recovering it restores the edit."""
+    from ursim_gui.model.autosave import Autosaver, discard, recover
+
+    session = window.session
+    session.link([1], [1])
+    session.merge_regions("sketch", 2, 3)
+    edited = session.segmentation("sketch").labels.copy()
+    saver = Autosaver(session, tmp_path / "autosave")
+    saver.flush()
+    copy = saver.path
+    labels_copy = copy.with_name(f"{copy.stem}.sketch.labels.png")
+    assert copy.is_file() and labels_copy.is_file()
+    assert session.path is None or session.path.parent != copy.parent  # the document is untouched
+
+    recovered = AnnotationSession()
+    recovered.restore(recover(copy))
+    assert np.array_equal(recovered.segmentation("sketch").labels, edited)
+    discard(copy)
+    assert not copy.exists() and not labels_copy.exists()
+    saver.close()

@@ -1,0 +1,42 @@
+"""What the views draw from the session's state (ursim_gui.model.view_state): side colours, connector ends, badges."""
+
+from __future__ import annotations
+
+from conftest import three_room_labels
+
+from ursim_core.correspondences import Clique, Correspondences
+from ursim_gui.model.region_style import (
+    NEUTRAL_REGION,
+    clique_colour,
+    palette_colour,
+)
+from ursim_gui.model.view_state import eval_badges, first_regions, side_colour_table
+
+
+def _corr():
+    return Correspondences(
+        cliques=(
+            Clique(id=1, sketch_regions=(1,), metric_regions=(3,), source="auto"),
+            Clique(id=2, sketch_regions=(2,), metric_regions=(2,), status="rejected"),
+        )
+    )
+
+
+def test_side_colours_follow_cliques_and_match_across_views():
+    labels = three_room_labels()
+    corr = _corr()
+    sketch = side_colour_table(corr, "sketch", labels, clique_colour)
+    metric = side_colour_table(corr, "metric", labels, clique_colour)
+    assert tuple(sketch[1, :3]) == clique_colour(1) == tuple(metric[3, :3])
+    assert tuple(sketch[2, :3]) == NEUTRAL_REGION  # rejected clique is not coloured
+    assert tuple(metric[1, :3]) == NEUTRAL_REGION
+    plain = side_colour_table(Correspondences(), "sketch", labels, clique_colour)
+    assert tuple(plain[1, :3]) == palette_colour(1)
+
+
+def test_connector_ends_and_badges():
+    corr = Correspondences(cliques=(*_corr().cliques, Clique(id=3, sketch_regions=(3,))))
+    assert first_regions(corr) == [(1, 1, 3)]  # rejected and one-sided cliques: no line
+    marks = {1: "tp", 2: "fp"}
+    assert eval_badges(corr, "sketch", marks.get) == {1: "TP", 2: "FP"}
+    assert eval_badges(corr, "metric", marks.get) == {3: "TP", 2: "FP"}

@@ -1,0 +1,124 @@
+"""The matching panel: Match with its settings, input kind and scale, sketch orientation, the last result's summary."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+from PySide6.QtCore import Qt, QTimer
+
+from ursim_core.matching import MatchConfig
+
+
+def test_match_button_runs_in_the_worker_and_applies_the_result(window, qtbot):
+    panel = window.matching_panel
+    panel.m_auto.setChecked(False)
+    panel.m_value.setValue(0.2)
+    panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
+    assert panel.config().m == 0.2 and panel.config().matcher == "hungarian"
+    ticks = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(10)
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+        assert not panel.match_button.isEnabled()  # one job at a time
+    timer.stop()
+    session = window.session
+    assert session.last_match is not None and session.last_match.config.matcher == "hungarian"
+    assert {c.source for c in session.correspondences.cliques} == {"auto"}
+    assert window.table.model.rowCount() == len(session.correspondences.cliques) > 0
+    assert "pairs" in panel.summary.text()
+    qtbot.waitUntil(lambda: panel.match_button.isEnabled())
+    assert max((b - a for a, b in zip(ticks, ticks[1:])), default=0) < 0.5
+
+
+def test_a_document_reopened_from_its_file_says_its_automatic_cliques_are_there(window, tmp_path):
+    """Reopened pairs said 'not matched yet' although the file held the matcher's cliques."""
+    from types import SimpleNamespace
+
+    session = window.session
+    session.apply_match(SimpleNamespace(pairs=[(1, 1), (2, 2)], anchors=[(1, 1)], m=0.1, cost=0.0, reason=""))
+    automatic = sum(1 for clique in session.correspondences.cliques if clique.source == "auto")
+    assert automatic == 2 and window.matching_panel.summary.text().startswith("2 pairs")
+    path = tmp_path / "doc.json"
+    session.save(path)
+    session.open(path)
+    assert session.last_match is None
+    assert window.matching_panel.summary.text().startswith(f"{automatic} automatic cliques from the file")
+
+
+def test_the_overlay_matcher_with_a_known_scale_runs_from_the_panel(window, qtbot):
+    panel = window.matching_panel
+    assert panel.matcher.currentData() == "auto" and panel.scale.isEnabled()
+    panel.matcher.setCurrentIndex(panel.matcher.findData("planar"))
+    assert not panel.scale.isEnabled()  # the planar matcher has no use for it
+    panel.matcher.setCurrentIndex(panel.matcher.findData("auto"))
+    assert panel.scale.isEnabled() and panel.config().scale is None  # 0 = unknown
+    panel.scale.setValue(1.0)
+    # A known scale: the automatic matcher lays the maps on each other.
+    assert panel.config().matcher == "auto" and panel.config().scale == 1.0
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    result = window.session.last_match
+    assert result.config.matcher == "overlay" and result.pairs
+    assert "pairs" in panel.summary.text()
+
+
+def test_the_matching_panel_says_what_the_input_map_is(window):
+    panel = window.matching_panel
+    assert panel.config().input_kind is None
+    panel.set_input_kind("metric")
+    assert panel.config().input_kind == "metric" and panel.config().resolved().matcher == "overlay"
+    panel.matcher.setCurrentIndex(panel.matcher.findData("planar"))
+    assert not panel.input_kind.isEnabled() and panel.config().input_kind is None
+    panel.set_input_kind(None)
+    assert panel.input_kind.currentData() is None
+
+
+def test_the_orientation_goes_to_the_match_config(window):
+    panel = window.matching_panel
+    fields = {field.name for field in dataclasses.fields(MatchConfig)}
+    assert panel.config().matcher == "auto"
+    panel.turn_right.click()
+    panel.angle.setValue(30.0)
+    panel.angle.editingFinished.emit()
+    config = panel.config()
+    if "orientation" in fields:  # the core's MatchConfig has the fields (added this round)
+        assert config.orientation == 30.0 and config.mirrored is False
+    panel.unknown.click()
+    assert not panel.orientation.known and window.views["sketch"].orientation == (0.0, False)
+    if "orientation" in fields:
+        assert panel.config().orientation == "any"
+
+
+def test_the_orientation_the_matcher_read_can_be_kept(window, qtbot):
+    panel, sketch = window.matching_panel, window.views["sketch"]
+    assert not panel.keep_found.isVisible()  # nothing matched yet
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        panel.match_button.click()
+    result = window.session.last_match
+    found = (float(round(result.orientation[0] % 360.0, 1) % 360.0), result.orientation[1])
+    assert "read the sketch" in panel.summary.text()
+    assert panel.keep_found.isVisible() and panel.found_orientation.describe() in panel.keep_found.text()
+    panel.keep_found.click()
+    assert (panel.orientation.angle, panel.orientation.mirrored) == found == sketch.orientation
+    assert not panel.keep_found.isVisible()  # it is the orientation set now
+    config = panel.config()
+    assert (config.orientation, config.mirrored) == found
+    panel.unknown.click()
+    assert panel.keep_found.isVisible()  # offered again while the last answer stands
+
+
+def test_a_file_opened_again_offers_the_orientation_its_match_read(window, qtbot, tmp_path):
+    panel = window.matching_panel
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        panel.match_button.click()
+    offered = panel.keep_found.text()
+    window.documents.save_as(tmp_path / "pair.json")
+    window.documents.open_correspondences(tmp_path / "pair.json")
+    assert window.session.last_match is None  # no result in memory: the file's record speaks
+    assert "automatic cliques from the file" in panel.summary.text() and "read the sketch" in panel.summary.text()
+    assert panel.keep_found.isVisible() and panel.keep_found.text() == offered
+    panel.keep_found.click()
+    assert window.views["sketch"].orientation == (panel.orientation.angle, panel.orientation.mirrored)

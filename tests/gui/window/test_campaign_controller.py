@@ -1,0 +1,99 @@
+"""Campaigns in the window: open a dataset folder, walk its pairs, save each on leaving, reopen where one stopped."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import new_window
+from PySide6.QtCore import Qt
+
+from ursim_core.correspondences import load_correspondences
+from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
+from ursim_gui.model.campaign import open_campaign, pair_summary
+
+
+def kth_folder():
+    root = dataset_root()
+    folder = None if root is None else root / "ursim_kth_sketches"
+    if folder is None or not folder.is_dir():
+        pytest.skip(MISSING_REASON)
+    return folder
+
+
+def test_a_kth_campaign_of_18_pairs_through_the_widgets_and_back(qtbot, tmp_path):
+    folder = kth_folder()
+    out, data = tmp_path / "annotations", tmp_path / "userdata"
+    window = new_window(qtbot, data)
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        assert window.campaigns.open(folder, output_dir=out)
+    campaign = window.campaigns.campaign
+    assert len(campaign.pairs) == 18 and window.campaign_panel.table.rowCount() == 18
+    left: dict = {}  # pair name -> its file's bytes when the user left it
+    for index, pair in enumerate(campaign.pairs):
+        assert campaign.current == index and window.session.map("sketch").path == pair.sketch
+        assert window.campaign_panel.status_text(index) == "automatic"  # matched and saved, not reviewed
+        assert pair.output.is_file() and window.session.correspondences.cliques
+        window.actions["accept_all"].trigger()
+        assert window.campaign_panel.status_text(index) == "done"
+        if index + 1 < len(campaign.pairs):
+            with qtbot.waitSignal(window.campaigns.pair_ready, timeout=120_000):
+                qtbot.keyClick(window.views["sketch"], Qt.Key.Key_D)
+        else:
+            assert window.campaigns.save_current()
+        left[pair.name] = pair.output.read_bytes()
+        # No other pair's file was touched since the user left it.
+        assert {name: (out / f"{name}.json").read_bytes() for name in left} == left
+    assert window.campaign_panel.progress.value() == 18
+    window.close()
+
+    reopened = new_window(qtbot, data)
+    assert reopened.campaigns.open(folder, output_dir=out)
+    again = reopened.campaigns.campaign
+    assert sorted(p.stem for p in out.glob("*.json") if p.name != "campaign.json") == sorted(left)
+    assert again.current == 17 and reopened.session.path == again.pairs[17].output  # where the user stopped
+    assert [reopened.campaign_panel.status_text(row) for row in range(18)] == ["done"] * 18
+    reopened.close()
+    assert {name: (out / f"{name}.json").read_bytes() for name in left} == left  # nothing rewritten
+
+
+def test_leaving_a_pair_saves_it_and_reopening_restores_status_and_position(plain_campaign, qtbot, tmp_path):
+    out, data = tmp_path / "out", tmp_path / "userdata"
+    window = new_window(qtbot, data)
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=out)
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        qtbot.keyClick(window.views["sketch"], Qt.Key.Key_D)
+    session = window.session
+    session.set_status(session.correspondences.cliques[0].id, "rejected")  # in review
+    qtbot.keyClick(window.views["sketch"], Qt.Key.Key_A)  # back: s2 is saved on the way
+    assert pair_summary(out / "s2.json")[0] == "in review"
+    assert load_correspondences(out / "s2.json").cliques[0].status == "rejected"
+    assert not (out / "s3.json").exists()
+    s1 = (out / "s1.json").read_bytes()
+    window.close()
+
+    reopened = new_window(qtbot, data)
+    reopened.campaigns.open(plain_campaign, output_dir=out)
+    panel = reopened.campaign_panel
+    assert [panel.status_text(row) for row in range(3)] == ["automatic", "in review", "not started"]
+    assert reopened.campaigns.campaign.current == 0 and (out / "s1.json").read_bytes() == s1
+    assert reopened.preferences.annotator() == "tester"  # asked once, remembered
+    assert load_correspondences(out / "s1.json").annotator == "tester"
+
+
+def test_a_campaign_of_robot_maps_is_matched_as_robot_maps(qtbot, tmp_path):
+    """The app matched the Halmstad robot maps as sketches (planar), where `ursim evaluate` overlays them."""
+    root = dataset_root()
+    folder = None if root is None else root / "ursim_halmstad_robot_maps" / "E5"
+    if folder is None or not folder.is_dir():
+        pytest.skip(MISSING_REASON)
+    campaign = open_campaign(folder, output_dir=tmp_path / "out")
+    assert {pair.input_kind for pair in campaign.pairs} == {"metric"}
+    kth = dataset_root() / "ursim_kth_sketches"
+    if kth.is_dir():
+        assert {pair.input_kind for pair in open_campaign(kth, output_dir=tmp_path / "kth").pairs} == {"sketch"}
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        assert window.campaigns.open(folder, output_dir=tmp_path / "out")
+    assert window.matching_panel.config().input_kind == "metric"
+    assert window.session.last_match.config.resolved().matcher == "overlay"
+    window.close()
