@@ -79,7 +79,9 @@ def prepare(
     ``config.position_refits`` (the planar matcher), the answer in each orientation is matched
     again with the sketch's positions laid on the metric map by its own pairs
     (:mod:`ursim_core.matching.refit`), and with ``config.signature_refit`` also laid by the answer
-    matched without the position term; the answer found is kept in ``Prepared.chosen``.
+    matched without the position term; the orientations are ranked by the refitted answers, and
+    the answer found (the refitted one, or with ``config.keep_refit=False`` the one before the
+    refit) is kept in ``Prepared.chosen``.
     ``config.matcher='auto'`` is resolved first (:meth:`MatchConfig.resolved`).
 
     Parameters
@@ -129,8 +131,8 @@ def prepare(
     if constraints is not None:
         base = dataclasses.replace(base, constraints=constraints)
     if len(candidates) == 1:
-        if not _refits(config):
-            return base
+        if not _refits(config) or not config.keep_refit:
+            return base  # without keep_refit the refit only ranks orientations, and there is one
         base, result = _refitted(base, match_prepared(base, progress=progress))
         return dataclasses.replace(base, chosen=result)
 
@@ -192,8 +194,10 @@ def prepare(
             result = choose_m(prepared, progress=share, known=known.get(index))
         else:
             result = match_prepared(prepared, progress=share)
-        prepared, result = _refitted(prepared, result, starts)
-        trials.append((ranked(result.normalised_cost, index), index, prepared, result))
+        refitted, answer = _refitted(prepared, result, starts)
+        # Ranked by the refitted answer's score either way; keep_refit=False keeps the first answer.
+        kept = (refitted, answer) if config.keep_refit else (prepared, result)
+        trials.append((ranked(answer.normalised_cost, index), index, *kept))
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(

@@ -8,7 +8,7 @@ import pytest
 
 from ursim_core.bench.invariance import run_case
 from ursim_core.errors import ParameterError
-from ursim_core.matching import MatchConfig, match_prepared, prepare
+from ursim_core.matching import MatchConfig, match, match_prepared, prepare
 from ursim_core.matching.positions import region_positions
 from ursim_core.matching.refit import fit_axis_transform, refitted_graph
 
@@ -132,3 +132,47 @@ def test_signature_refit_is_a_bool_on_by_default_and_off_in_the_published_config
         MatchConfig(signature_refit=1)
     assert MatchConfig().signature_refit
     assert not MatchConfig.paper().signature_refit and not MatchConfig.released().signature_refit
+
+
+def test_keep_refit_is_a_boolean():
+    with pytest.raises(ParameterError) as error:
+        MatchConfig(keep_refit="no")
+    assert error.value.field == "keep_refit"
+
+
+def _transformed_pair(seed: int, kind: str):
+    """The sketch of generated pair ``seed`` transformed as ``ursim bench invariance``'s ``kind``
+    is, and the plan, both segmented as there."""
+    from ursim_core.bench.invariance import _parameters, transformed_sketch
+    from ursim_core.segmentation import segment_canonical
+    from ursim_core.synth import make_pair
+
+    plan, sketch = make_pair(seed=seed)
+    degrees, mirrored, scale, kept = _parameters(seed, kind)
+    image, _ = transformed_sketch(
+        sketch.free, [], degrees=degrees, mirrored=mirrored, scale=scale, kept=kept, seed=seed
+    )
+    return segment_canonical(image, preset="default"), segment_canonical(plan.free, preset="default")
+
+
+def test_without_keep_refit_the_refit_still_ranks_the_orientations():
+    # Generated pair 4 is nearly symmetric under a half turn: with no refit it is read half-turned
+    # (F1 0.11); ranked by the refitted answers, the orientations put it upright (round 30).
+    assert run_case(4, "upright", config=MatchConfig(position_refits=0)).f1 < 0.2
+    assert run_case(4, "upright", config=MatchConfig(keep_refit=False)).f1 == 1.0
+
+
+def test_without_keep_refit_the_answer_is_the_one_from_before_the_refit():
+    # Rescaled pair 9: the refit changes the pairs (F1 0.67 -> 1.00 in round 30), so the two
+    # settings must give different answers, and keep_refit=False the answer matched without any
+    # refit in the orientation it chose.
+    sketch, plan = _transformed_pair(9, "rescaled")
+    kept = match(sketch, plan, config=MatchConfig())
+    first = match(sketch, plan, config=MatchConfig(keep_refit=False))
+    degrees, mirrored = first.orientation
+    told = MatchConfig(position_refits=0, orientation=degrees, mirrored=mirrored)
+    assert sorted(first.pairs) == sorted(match(sketch, plan, config=told).pairs)
+    assert sorted(first.pairs) != sorted(kept.pairs)
+    # Told the orientation, there is nothing to rank: no refit at all.
+    one = MatchConfig(keep_refit=False, orientation=degrees, mirrored=mirrored)
+    assert sorted(match(sketch, plan, config=one).pairs) == sorted(first.pairs)
