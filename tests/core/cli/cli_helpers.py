@@ -16,6 +16,8 @@ from ursim_core.cli import goal as goal_cli
 from ursim_core.cli import route as route_cli
 from ursim_core.correspondences import Clique, Correspondences, MapRef, save_correspondences
 from ursim_core.errors import UrsimError
+from ursim_core.io.maps import load_map
+from ursim_core.io.occupancy_grid import save_map_yaml
 
 
 def two_rooms(path: Path, *, door: bool = True) -> Path:
@@ -56,6 +58,26 @@ def rooms_image(n_rooms=3, width=60, height=50, door=10):
     return grey
 
 
+def building_pair(folder: Path) -> tuple[Path, Path]:
+    """``sketch.png`` (:func:`building` at 1.3 times the size) and ``metric.png`` in ``folder``."""
+    sketch, metric = folder / "sketch.png", folder / "metric.png"
+    cv2.imwrite(str(metric), building())
+    cv2.imwrite(str(sketch), building(1.3))
+    return sketch, metric
+
+
+def navigation_maps(folder: Path) -> tuple[Path, Path, Path]:
+    """A three-room sketch, a larger metric map of the same rooms, and that map as a ROS YAML map
+    (0.05 m per pixel, origin (-1, 2)) in ``folder``."""
+    sketch = folder / "sketch.png"
+    cv2.imwrite(str(sketch), rooms_image())
+    metric_png = folder / "metric.png"
+    cv2.imwrite(str(metric_png), rooms_image(width=90, height=70))
+    metric_yaml = folder / "metric.yaml"
+    save_map_yaml(load_map(metric_png), metric_yaml, resolution=0.05, origin=(-1.0, 2.0, 0.0))
+    return sketch, metric_png, metric_yaml
+
+
 def correspondences_file(tmp_path, sketch, metric):
     # Rooms matched in order, by clicked points; the middle room carries a label.
     corr = Correspondences(
@@ -82,7 +104,8 @@ def run_python(code: str, **environment: str) -> dict:
 
 
 def ursim(argv) -> int:
-    """What `ursim` does once the lead registers the two commands: parse, run, one-line errors."""
+    """``ursim goal`` and ``ursim route`` as the ``ursim`` command runs them (parse, run, one-line
+    errors), on a parser of their own: what their ``add_parser`` registers."""
     parser = argparse.ArgumentParser(prog="ursim")
     commands = parser.add_subparsers(dest="command", required=True)
     goal_cli.add_parser(commands)

@@ -2,11 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import stat
-from pathlib import Path
-
-import pytest
 from cli_helpers import run_python, two_rooms
 
 from ursim_core.cli import main
@@ -37,24 +32,8 @@ def test_progress_bar_off_a_terminal_is_silent_and_does_not_import_tqdm(capsys):
     assert run_python(code) is False
 
 
-# The same helper as in tests/core/io/test_atomic.py.
-def _count_directory_syncs(monkeypatch) -> list[str]:
-    synced: list[str] = []
-    real_fsync = os.fsync
-
-    def fsync(descriptor):
-        if stat.S_ISDIR(os.fstat(descriptor).st_mode):
-            synced.append(os.readlink(f"/proc/self/fd/{descriptor}"))
-        return real_fsync(descriptor)
-
-    monkeypatch.setattr(os, "fsync", fsync)
-    return synced
-
-
-def test_staged_outputs_sync_their_final_folder_once(tmp_path, monkeypatch):
-    if not Path("/proc/self/fd").is_dir():
-        pytest.skip("reads the synced folders' paths from /proc (Linux)")
-    synced = _count_directory_syncs(monkeypatch)
+def test_staged_outputs_sync_their_final_folder_once(tmp_path, directory_syncs):
+    synced = directory_syncs
     out = tmp_path / "out"
     with staged_folder(out) as staging:
         for name in ("a.png", "b.png", "c.json"):

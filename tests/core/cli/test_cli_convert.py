@@ -4,21 +4,16 @@ from __future__ import annotations
 
 import json
 
-import cv2
 import pytest
-from cli_helpers import building
+from cli_helpers import building_pair
 
 from ursim_core.cli import main
 from ursim_core.correspondences import load_correspondences, load_dat
 
 
-# The same fixture as in test_cli_match.py.
 @pytest.fixture()
 def pair(tmp_path):
-    sketch, metric = tmp_path / "sketch.png", tmp_path / "metric.png"
-    cv2.imwrite(str(metric), building())
-    cv2.imwrite(str(sketch), building(1.3))
-    return sketch, metric
+    return building_pair(tmp_path)
 
 
 def test_convert_exports_by_name_and_by_format(tmp_path, capsys):

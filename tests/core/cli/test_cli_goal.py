@@ -5,24 +5,14 @@ from __future__ import annotations
 import json
 
 import pytest
-from cli_helpers import correspondences_file, rooms_image, ursim
-from PIL import Image
+from cli_helpers import correspondences_file, navigation_maps, ursim
 
 from ursim_core.io.maps import load_map, world_to_pixel
-from ursim_core.io.occupancy_grid import save_map_yaml
 
 
-# The same fixture in test_cli_goal.py and test_cli_route.py.
 @pytest.fixture
 def maps(tmp_path):
-    sketch = tmp_path / "sketch.png"
-    Image.fromarray(rooms_image()).save(sketch)
-    metric_png = tmp_path / "metric.png"
-    big = rooms_image(width=90, height=70)
-    Image.fromarray(big).save(metric_png)
-    metric_yaml = tmp_path / "metric.yaml"
-    save_map_yaml(load_map(metric_png), metric_yaml, resolution=0.05, origin=(-1.0, 2.0, 0.0))
-    return sketch, metric_png, metric_yaml
+    return navigation_maps(tmp_path)
 
 
 def test_goal_prints_a_pose_stamped_in_the_map_frame(tmp_path, maps, capsys):

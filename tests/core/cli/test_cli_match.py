@@ -8,7 +8,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from cli_helpers import building, two_rooms
+from cli_helpers import building, building_pair, two_rooms
 
 from ursim_core.cli import main
 from ursim_core.correspondences import load_correspondences
@@ -16,10 +16,7 @@ from ursim_core.correspondences import load_correspondences
 
 @pytest.fixture()
 def pair(tmp_path):
-    sketch, metric = tmp_path / "sketch.png", tmp_path / "metric.png"
-    cv2.imwrite(str(metric), building())
-    cv2.imwrite(str(sketch), building(1.3))
-    return sketch, metric
+    return building_pair(tmp_path)
 
 
 def test_match_writes_all_outputs(tmp_path, pair):

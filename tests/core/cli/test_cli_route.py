@@ -7,27 +7,16 @@ import math
 
 import pytest
 import yaml
-from cli_helpers import correspondences_file, rooms_image, ursim
-from PIL import Image
+from cli_helpers import correspondences_file, navigation_maps, ursim
 
 from ursim_core.cli import route as route_cli
 from ursim_core.errors import FormatError
-from ursim_core.io.maps import load_map
-from ursim_core.io.occupancy_grid import save_map_yaml
 from ursim_core.navigation import load_waypoints_yaml
 
 
-# The same fixture in test_cli_goal.py and test_cli_route.py.
 @pytest.fixture
 def maps(tmp_path):
-    sketch = tmp_path / "sketch.png"
-    Image.fromarray(rooms_image()).save(sketch)
-    metric_png = tmp_path / "metric.png"
-    big = rooms_image(width=90, height=70)
-    Image.fromarray(big).save(metric_png)
-    metric_yaml = tmp_path / "metric.yaml"
-    save_map_yaml(load_map(metric_png), metric_yaml, resolution=0.05, origin=(-1.0, 2.0, 0.0))
-    return sketch, metric_png, metric_yaml
+    return navigation_maps(tmp_path)
 
 
 def test_route_writes_waypoints_nav2_can_load(tmp_path, maps, capsys):

@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
+from correspondence_helpers import one_line_error
 
 from ursim_core.correspondences import (
     Clique,
@@ -15,17 +14,9 @@ from ursim_core.correspondences import (
     save_correspondences,
     save_dat,
 )
-from ursim_core.errors import FileChangedError, SaveRefusedError, UrsimError
+from ursim_core.errors import FileChangedError, SaveRefusedError
 
 NOW = "2024-05-01T12:00:00Z"
-
-
-# The same check as in test_json_codec.py and test_dat_codec.py.
-def _one_line_error(path: Path, error: UrsimError) -> str:
-    message = str(error)
-    assert "\n" not in message
-    assert str(path) in message or path.name in message
-    return message
 
 
 # --------------------------------------------------------------------------- issue 12, item 3: two writers, saving onto a map
@@ -44,7 +35,7 @@ def test_save_detects_a_change_on_disk_since_load(tmp_path):
     with pytest.raises(FileChangedError) as caught:
         save_correspondences(second.with_clique(Clique(id=3)), target, expected_sha256=second.loaded_sha256)
     assert isinstance(caught.value, SaveRefusedError)
-    _one_line_error(target, caught.value)
+    one_line_error(target, caught.value)
     assert target.read_bytes() == before  # the first session's clique 2 is still there
     # The question answered "overwrite": no expected digest, the save goes through.
     save_correspondences(second.with_clique(Clique(id=3)), target)

@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 
 import pytest
+from correspondence_helpers import one_line_error
 
 from ursim_core.correspondences import (
     Clique,
@@ -16,7 +17,7 @@ from ursim_core.correspondences import (
     save_correspondences,
     save_dat,
 )
-from ursim_core.errors import FormatError, UrsimError
+from ursim_core.errors import FormatError
 from ursim_core.evaluation import datasets
 
 SAMPLE = """\
@@ -276,14 +277,6 @@ def test_real_files_match_the_dataset_description():
 NOW = "2024-05-01T12:00:00Z"
 
 
-# The same check as in test_json_codec.py.
-def _one_line_error(path: Path, error: UrsimError) -> str:
-    message = str(error)
-    assert "\n" not in message
-    assert str(path) in message or path.name in message
-    return message
-
-
 # --------------------------------------------------------------------------- issue 12, item 4: the .dat header
 
 
@@ -347,7 +340,7 @@ def test_huge_integer_in_a_dat_file_is_a_format_error(tmp_path):
     path.write_text("# a.png b.png\n# 0match set\n# map1\n" + "9" * 5000 + " 1\n# map2\n", encoding="utf-8")
     with pytest.raises(FormatError, match="line 4") as caught:
         load_dat(path)
-    _one_line_error(path, caught.value)
+    one_line_error(path, caught.value)
 
 
 def test_nul_in_a_dat_header_is_a_format_error(tmp_path):

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from correspondence_helpers import one_line_error
 
 from ursim_core.correspondences import (
     Clique,
@@ -23,7 +24,7 @@ from ursim_core.correspondences import (
     save_correspondences,
     save_dat,
 )
-from ursim_core.errors import FormatError, MapChangedWarning, UrsimError
+from ursim_core.errors import FormatError, MapChangedWarning
 from ursim_core.io import map_from_array
 
 NOW = "2024-05-01T12:00:00Z"
@@ -515,13 +516,6 @@ def _write_json_text(folder: Path, text: str, name: str = "pair.json") -> Path:
     return path
 
 
-def _one_line_error(path: Path, error: UrsimError) -> str:
-    message = str(error)
-    assert "\n" not in message
-    assert str(path) in message or path.name in message
-    return message
-
-
 # --------------------------------------------------------------------------- issue 12, item 1: file names
 
 
@@ -551,7 +545,7 @@ def test_nul_in_a_map_path_is_a_format_error(tmp_path):
     path = _write_json_text(tmp_path, json.dumps(document))
     with pytest.raises(FormatError, match="maps.sketch.path") as caught:
         load_correspondences(path)
-    _one_line_error(path, caught.value)
+    one_line_error(path, caught.value)
 
 
 # --------------------------------------------------------------------------- issue 12, item 2: whatever loads saves
@@ -573,7 +567,7 @@ def test_whatever_loads_saves(tmp_path, text):
     try:
         corr = load_correspondences(path)
     except FormatError as error:
-        _one_line_error(path, error)
+        one_line_error(path, error)
         return
     target = tmp_path / "again.json"
     save_correspondences(corr, target, now=NOW)
@@ -602,7 +596,7 @@ def test_deep_nesting_is_a_format_error(tmp_path, depth):
     path = _write_json_text(tmp_path, text)
     with pytest.raises(FormatError, match="nest") as caught:
         load_correspondences(path)
-    _one_line_error(path, caught.value)
+    one_line_error(path, caught.value)
 
 
 @pytest.mark.parametrize(
@@ -627,7 +621,7 @@ def test_numbers_that_crashed_are_format_errors(tmp_path, change, field):
     with pytest.raises(FormatError) as caught:
         load_correspondences(path)
     assert caught.value.field == field
-    _one_line_error(path, caught.value)
+    one_line_error(path, caught.value)
 
 
 def test_float_sizes_are_format_errors(tmp_path):

@@ -4,32 +4,14 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 from PIL import Image
+from synthetic_kth import SKETCH_SCALES, plan_image
 
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation import report, tables
 from ursim_core.evaluation.results import DEFAULT_M_GRID, EvaluationResult
 from ursim_core.evaluation.runner import run_evaluation
-
-
-# The plan and sketch scales of the synthetic_dataset fixture (tests/core/conftest.py), read by two tests.
-def _plan(scale: float) -> np.ndarray:
-    def s(value):
-        return int(round(value * scale))
-
-    free = np.zeros((s(70), s(190)), bool)
-    free[s(5) : s(65), s(5) : s(55)] = True
-    free[s(15) : s(55), s(65) : s(105)] = True
-    free[s(5) : s(45), s(115) : s(185)] = True
-    free[s(30) : s(38), s(55) : s(65)] = True
-    free[s(20) : s(28), s(105) : s(115)] = True
-    return np.where(free, 255, 0).astype(np.uint8)
-
-
-MODEL_SCALE = 1.5
-SKETCH_SCALES = {"copy": MODEL_SCALE, "small": 1.0}
 
 GRID = (0.0, 0.1, 0.2)
 
@@ -291,7 +273,7 @@ def test_disk_cache_misses_when_a_map_changes(synthetic_dataset, tmp_path):
         human=False,
     )
     run_evaluation(dataset, **options)
-    Image.fromarray(_plan(1.2)).save(dataset / "sketches" / "small.png")
+    Image.fromarray(plan_image(1.2)).save(dataset / "sketches" / "small.png")
     again = run_evaluation(dataset, **options)
     assert again.timings["maps"] == 4 and again.timings["maps_from_cache"] == 3
 

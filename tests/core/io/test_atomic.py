@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 import stat
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -150,24 +149,8 @@ def test_stale_temporary_files_of_our_pattern_are_removed_on_the_next_save(tmp_p
 # --------------------------------------------------------------------------- scratch folders (the staged outputs of ursim_core.cli.common)
 
 
-# The same helper as in tests/core/cli/test_cli_common.py.
-def _count_directory_syncs(monkeypatch) -> list[str]:
-    synced: list[str] = []
-    real_fsync = os.fsync
-
-    def fsync(descriptor):
-        if stat.S_ISDIR(os.fstat(descriptor).st_mode):
-            synced.append(os.readlink(f"/proc/self/fd/{descriptor}"))
-        return real_fsync(descriptor)
-
-    monkeypatch.setattr(os, "fsync", fsync)
-    return synced
-
-
-def test_saves_into_a_scratch_folder_sync_their_content_but_not_the_folder(tmp_path, monkeypatch):
-    if not Path("/proc/self/fd").is_dir():
-        pytest.skip("reads the synced folders' paths from /proc (Linux)")
-    synced = _count_directory_syncs(monkeypatch)
+def test_saves_into_a_scratch_folder_sync_their_content_but_not_the_folder(tmp_path, directory_syncs):
+    synced = directory_syncs
     with atomic.scratch_directory(tmp_path):
         atomic.atomic_write_bytes(tmp_path / "a.bin", b"a")
     assert synced == []
