@@ -12,7 +12,8 @@ ground-truth points moved alike:
 - ``all``: cropped, rescaled, mirrored and turned at once.
 
 Both maps are segmented with the MAORIS ``default`` preset (the sketch in its canonical pose,
-:func:`ursim_core.segmentation.segment_canonical`), matched with the default
+:func:`ursim_core.segmentation.segment_canonical`, and in its other resamplings when it is turned
+onto its wall axes, for the planar matcher's vote), matched with the default
 :class:`~ursim_core.matching.MatchConfig` (nothing told about the transformation) and scored by
 pair F1 and place accuracy (:mod:`ursim_core.evaluation.scoring`). The transformations are drawn
 from a generator seeded by the pair's seed and the kind, so every run shows the same cases.
@@ -135,9 +136,13 @@ def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None, plan_
         kept=kept,
         seed=seed,
     )
-    sketch_seg = segment_canonical(image, preset="default")
+    config = config or MatchConfig()
+    # As ursim match: a sketch turned onto its wall axes is also segmented in its other
+    # resamplings when the planar matcher will vote over them.
+    resampled = config.resampling_vote and config.resolved().matcher == "planar"
+    sketch_seg = segment_canonical(image, preset="default", resampled=resampled)
     metric_seg = plan_segmentation if plan_segmentation is not None else segment_canonical(plan.free, preset="default")
-    result = match(sketch_seg, metric_seg, config=config or MatchConfig())
+    result = match(sketch_seg, metric_seg, config=config)
     points = iter(moved)
     regions, point_cliques = [], []
     for clique in truth.cliques:

@@ -222,7 +222,7 @@ def options_of(args: argparse.Namespace) -> dict[str, Any]:
     return {name: getattr(args, name) for name in OPTION_NAMES}
 
 
-def load_and_segment(sketch, metric, args, *, params: dict[str, Any], canonical: bool):
+def load_and_segment(sketch, metric, args, *, params: dict[str, Any], canonical: bool, resampled: bool = False):
     """Both maps loaded, then both segmented, each pair of steps on two threads.
 
     The decoders, OpenCV and the MAORIS kernels release the GIL, so two building-sized maps take
@@ -242,7 +242,12 @@ def load_and_segment(sketch, metric, args, *, params: dict[str, Any], canonical:
         sketch_load, metric_load = pool.submit(load, sketch, args), pool.submit(load, metric, args)
         sketch_map, metric_map = sketch_load.result(), metric_load.result()
         sketch_job = pool.submit(
-            segment_checked, sketch_map, preset=args.sketch_preset, params=params, canonical=canonical
+            segment_checked,
+            sketch_map,
+            preset=args.sketch_preset,
+            params=params,
+            canonical=canonical,
+            resampled=resampled,
         )
         metric_job = pool.submit(segment_checked, metric_map, preset=args.metric_preset, params=params)
         sketch_seg, metric_seg = sketch_job.result(), metric_job.result()
@@ -294,10 +299,12 @@ def match_pair(
     reference = None if reference_path is None else load_reference(reference_path)
     review = None if review_path is None else load_reference(review_path)
     params = segmentation_params(args)
-    # The sketch is segmented in its canonical pose unless the matcher is told it is upright.
+    # The sketch is segmented in its canonical pose unless the matcher is told it is upright, and
+    # in its other resamplings when it is turned onto its wall axes, for the planar matcher's vote.
     canonical = config.orientation != "upright"
+    resampled = canonical and config.resampling_vote and config.resolved().matcher == "planar" and review is None
     sketch_map, metric_map, sketch_seg, metric_seg = load_and_segment(
-        sketch, metric, args, params=params, canonical=canonical
+        sketch, metric, args, params=params, canonical=canonical, resampled=resampled
     )
     for loaded, loaded_path in ((reference, reference_path), (review, review_path)):
         if loaded is not None:
@@ -376,6 +383,7 @@ def match_pair(
         "match_ms": elapsed * 1000,
         "reason": result.reason or "",
         "orientation": result.orientation,
+        "resampling_votes": result.resampling_votes,
         "out": out,
     }
     if reference is not None:
@@ -415,8 +423,10 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"{record['n_matches']} matches ({record['n_sketch_regions']} sketch regions, "
         f"{record['n_metric_regions']} metric regions), m = {m_text}, sketch turned "
-        f"{record['orientation'][0]:.1f} deg{' mirrored' if record['orientation'][1] else ''}, "
-        f"{record['match_ms']:.1f} ms" + (f"; {record['reason']}" if record["reason"] else "")
+        f"{record['orientation'][0]:.1f} deg{' mirrored' if record['orientation'][1] else ''}"
+        + (f", voted over {record['resampling_votes']} resamplings" if record["resampling_votes"] else "")
+        + f", {record['match_ms']:.1f} ms"
+        + (f"; {record['reason']}" if record["reason"] else "")
     )
     print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
     if args.reference is not None:

@@ -113,17 +113,28 @@ def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, p
     atomic_write_text(out / f"{name}.regions.json", json.dumps(document, indent=2) + "\n")
 
 
-def segment_checked(the_map, *, preset: str, params: dict[str, Any], canonical: bool = False, method: str = "maoris"):
+def segment_checked(
+    the_map,
+    *,
+    preset: str,
+    params: dict[str, Any],
+    canonical: bool = False,
+    method: str = "maoris",
+    resampled: bool = False,
+):
     """Segment a map; a segmentation with no region is an error that names the map.
 
     ``canonical``: in the map's canonical pose (:mod:`ursim_core.segmentation.canonical`), for a
-    sketch whose orientation the matcher does not assume.
+    sketch whose orientation the matcher does not assume; ``resampled`` (with ``canonical``): also
+    in the other resamplings of a map turned onto its wall axes, for the planar matcher's vote.
     """
     from ursim_core.segmentation import segment, segment_canonical, why_no_region
 
     announce_kernel_compilation()
-    segmenter = segment_canonical if canonical else segment
-    segmentation = segmenter(the_map, method=method, preset=preset, params=params)
+    if canonical:
+        segmentation = segment_canonical(the_map, method=method, preset=preset, params=params, resampled=resampled)
+    else:
+        segmentation = segment(the_map, method=method, preset=preset, params=params)
     if segmentation.n_regions == 0:
         raise SegmentationError(f"0 regions: {why_no_region(the_map.free, method=method)}", path=the_map.path)
     return segmentation

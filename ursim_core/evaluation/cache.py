@@ -32,7 +32,8 @@ class SegmentationJob:
     ``orientation`` (an :class:`~ursim_core.evaluation.augment.Orientation`, None for the map as
     it is) turns and mirrors the loaded map before it is segmented. ``canonical`` segments it with
     :func:`ursim_core.segmentation.canonical.segment_canonical` (sketches, whose orientation is
-    unknown to the matcher), else with ``segment``."""
+    unknown to the matcher), else with ``segment``; ``resampled`` (with ``canonical``) also in
+    the other resamplings of a map resampled onto its wall axes, for the planar matcher's vote."""
 
     path: Path = field(compare=False)
     digest: str
@@ -41,6 +42,7 @@ class SegmentationJob:
     augment: str = ""
     orientation: Any = field(default=None, compare=False)
     canonical: bool = False
+    resampled: bool = False
 
     @classmethod
     def of(
@@ -52,6 +54,7 @@ class SegmentationJob:
         orientation: Any = None,
         *,
         canonical: bool = False,
+        resampled: bool = False,
     ) -> SegmentationJob:
         path = Path(path)
         if path not in digests:
@@ -70,6 +73,7 @@ class SegmentationJob:
             augment="" if orientation is None else orientation.name,
             orientation=orientation,
             canonical=canonical,
+            resampled=canonical and resampled,
         )
 
     @property
@@ -78,6 +82,7 @@ class SegmentationJob:
             f"{self.digest}|{self.preset}|{self.load_key}"
             + (f"|{self.augment}" if self.augment else "")
             + ("|canonical" if self.canonical else "")
+            + ("|resampled" if self.resampled else "")
         )
 
     @property
@@ -98,7 +103,7 @@ def segment_job(job: SegmentationJob):
     if job.canonical:
         from ursim_core.segmentation import segment_canonical
 
-        return segment_canonical(the_map, preset=job.preset)
+        return segment_canonical(the_map, preset=job.preset, resampled=job.resampled)
     return segment(the_map, preset=job.preset)
 
 
@@ -129,6 +134,7 @@ def _disk_cache_path(cache_dir: Path, job: SegmentationJob) -> Path:
             # Only augmented jobs carry the key, so the cache files of upright maps keep their names.
             **({"augment": job.augment} if job.augment else {}),
             **({"canonical": True} if job.canonical else {}),
+            **({"resampled": True} if job.resampled else {}),
         },
         sort_keys=True,
     )
@@ -139,14 +145,27 @@ def _read_disk_cache(path: Path, job: SegmentationJob):
     from ursim_core.segmentation import Segmentation, resolve_params
     from ursim_core.segmentation.regions import region_table
 
+    params = resolve_params("maoris", job.preset, {"canonical": job.canonical})
     try:
         with np.load(path) as stored:
             labels = stored["labels"].astype(np.int32)
+            # The other resamplings (segment_canonical(..., resampled=True)) and their turns.
+            offsets = stored["resampled_offsets"].tolist() if "resampled_offsets" in stored else []
+            others = [stored[f"resampled_{index}"].astype(np.int32) for index in range(len(offsets))]
     except (OSError, KeyError, ValueError):
         # A missing, damaged or foreign cache file is only a cache miss.
         return None
+    resampled = tuple(
+        Segmentation(
+            labels=other,
+            regions=region_table(other),
+            method="maoris",
+            params={**params, "canonical_turn_offset": None if np.isnan(offset) else offset},
+        )
+        for other, offset in zip(others, offsets, strict=True)
+    )
     return Segmentation(
-        labels=labels, regions=region_table(labels), method="maoris", params=resolve_params("maoris", job.preset)
+        labels=labels, regions=region_table(labels), method="maoris", params=params, resampled=resampled
     )
 
 
@@ -154,7 +173,11 @@ def _write_disk_cache(path: Path, segmentation) -> None:
     from ursim_core.io.atomic import atomic_write_bytes
 
     buffer = io.BytesIO()
-    np.savez_compressed(buffer, labels=segmentation.labels)
+    others = {f"resampled_{index}": other.labels for index, other in enumerate(segmentation.resampled)}
+    if others:
+        offsets = [other.params.get("canonical_turn_offset") for other in segmentation.resampled]
+        others["resampled_offsets"] = np.array([np.nan if o is None else o for o in offsets], float)
+    np.savez_compressed(buffer, labels=segmentation.labels, **others)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(path, buffer.getvalue())

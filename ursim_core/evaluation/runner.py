@@ -247,7 +247,16 @@ def run_evaluation(
     # A sketch whose orientation the matcher does not assume is segmented in its canonical pose.
     canonical = base_config.orientation != "upright"
     for experiment in experiments:
-        upright = SegmentationJob.of(experiment.sketch, input_preset, load_options, digests, canonical=canonical)
+        # The planar matcher votes over the other resamplings of a sketch resampled onto its axes.
+        resampled = canonical and any(
+            _config_for(base_config, matcher, variant, released, experiment.input_kind).resolved().matcher == "planar"
+            and base_config.resampling_vote
+            for matcher in matchers
+            for variant in variants
+        )
+        upright = SegmentationJob.of(
+            experiment.sketch, input_preset, load_options, digests, canonical=canonical, resampled=resampled
+        )
         metric_job = SegmentationJob.of(experiment.metric, model_preset, load_options, digests)
         place_job = SegmentationJob.of(experiment.metric, PLACE_REFERENCE_PRESET, PLACE_REFERENCE_LOAD, digests)
         for orientation in orientations or (None,):
@@ -255,7 +264,13 @@ def run_evaluation(
                 Instance(
                     experiment=experiment,
                     sketch_job=SegmentationJob.of(
-                        experiment.sketch, input_preset, load_options, digests, orientation, canonical=canonical
+                        experiment.sketch,
+                        input_preset,
+                        load_options,
+                        digests,
+                        orientation,
+                        canonical=canonical,
+                        resampled=resampled,
                     ),
                     metric_job=metric_job,
                     place_job=place_job,

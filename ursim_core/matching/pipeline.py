@@ -28,6 +28,7 @@ disconnected graphs, constant attributes) never raise: the result is valid, poss
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import networkx as nx
 
@@ -39,6 +40,7 @@ from ursim_core.matching.descriptors import blend_positions, pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines
 from ursim_core.matching.planar import planar_graph
 from ursim_core.matching.refit import refit_from, refit_positions, signature_start
+from ursim_core.matching.resampling import voted_answer, with_resampled
 from ursim_core.matching.results import MatchResult, Prepared
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
 from ursim_core.segmentation.canonical import wall_angle
@@ -70,6 +72,10 @@ def prepare(
     sketch_seg, metric_seg, config: MatchConfig = MatchConfig(), *, progress=None, constraints=None
 ) -> Prepared:
     """Compute everything that does not depend on m, the sketch's orientation included.
+
+    A sketch segmented in several resamplings (``Segmentation.resampled``) has each of them
+    prepared as well (``config.resampling_vote``, the planar matcher, no constraints), and
+    :func:`match_prepared` votes over their answers (:mod:`ursim_core.matching.resampling`).
 
     With ``config.orientation='any'`` (the default) every candidate orientation of
     :func:`ursim_core.matching.orientation.orientation_candidates` is matched with the
@@ -112,6 +118,12 @@ def prepare(
     >>> prepare(g, g.copy()).c_matrix.shape
     (3, 3)
     """
+    prepared = _prepare_one(sketch_seg, metric_seg, config, progress=progress, constraints=constraints)
+    return with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
+
+
+def _prepare_one(sketch_seg, metric_seg, config: MatchConfig, *, progress=None, constraints=None) -> Prepared:
+    """:func:`prepare` of one segmentation of the sketch."""
     config = config.resolved()
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
     constraints = constraints or None
@@ -469,6 +481,13 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
     >>> sorted(match_prepared(prepare(g, g.copy()), 0.01).pairs)
     [(0, 0), (1, 1), (2, 2), (3, 3)]
     """
+    if prepared.resampled is not None:
+        return voted_answer(prepared, m, functools.partial(_match_one, progress=progress))
+    return _match_one(prepared, m, progress=progress)
+
+
+def _match_one(prepared: Prepared, m: float | None = None, *, progress=None) -> MatchResult:
+    """:func:`match_prepared` of one segmentation of the sketch."""
     config = prepared.config
     if config.matcher == "overlay" and prepared.chosen is not None:
         # Its answer does not depend on m: the same at every m of a sweep.

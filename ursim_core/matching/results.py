@@ -36,6 +36,9 @@ class Prepared:
     chosen: Any = None
     #: What a person has said about the pair (:class:`~ursim_core.matching.constraints.MatchConstraints`).
     constraints: MatchConstraints | None = None
+    #: The sketch's other segmentations, prepared (:class:`~ursim_core.matching.resampling.Resampled`):
+    #: :func:`match_prepared` votes over their answers.
+    resampled: Any = None
 
     @functools.cached_property
     def index_constraints(self) -> IndexConstraints | None:
@@ -85,6 +88,10 @@ class MatchResult:
         metric map, chosen or given (``MatchConfig.orientation``).
     orientation_scan : dict
         With ``orientation='any'``: the normalised score of each candidate tried.
+    resampling_votes : int
+        How many segmentations of a resampled sketch voted on ``pairs``
+        (:mod:`ursim_core.matching.resampling`; the other fields are the first segmentation's
+        answer's); 0 when there was no vote.
     """
 
     pairs: list
@@ -103,6 +110,7 @@ class MatchResult:
     m_scan: dict = field(default_factory=dict)
     orientation: tuple = (0.0, False)
     orientation_scan: dict = field(default_factory=dict)
+    resampling_votes: int = 0
 
 
 def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:

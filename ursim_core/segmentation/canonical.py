@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["wall_angle", "canonical_pose", "canonical_labels", "dihedral"]
+__all__ = ["wall_angle", "canonical_pose", "canonical_labels", "dihedral", "turned_back", "RESAMPLING_OFFSETS"]
 
 # Contours are simplified to polygons with this tolerance (pixels) before their edge directions are
 # taken: pixel staircases of a straight wall would otherwise vote for 0 and 90 degrees.
@@ -36,6 +36,10 @@ _ANGLE_MAX_PIXELS = 1_500_000
 # Below this many degrees off the axes a map is not resampled: walls a few degrees off are
 # how people draw, and resampling would blur thin walls for nothing.
 _MIN_ANGLE = 3.0
+#: The other turns back (degrees added to the wall angle) of a map that is resampled onto its wall
+#: axes: MAORIS's regions change with the resampling, so the matcher votes over the answers of
+#: these segmentations and of the map segmented as it is (:mod:`ursim_core.matching.resampling`).
+RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0)
 
 
 def wall_angle(free: np.ndarray) -> float:
@@ -207,15 +211,32 @@ def _turned(free: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
     return image >= 128, matrix
 
 
-def canonical_labels(free: np.ndarray, labels_of, *, min_angle: float = _MIN_ANGLE) -> np.ndarray:
+def turned_back(free: np.ndarray, *, min_angle: float = _MIN_ANGLE) -> bool:
+    """Whether :func:`canonical_labels` resamples ``free`` onto its wall axes (its walls are at
+    least ``min_angle`` degrees off the image axes).
+
+    Examples
+    --------
+    >>> free = np.zeros((60, 80), bool); free[10:50, 10:70] = True
+    >>> turned_back(free)
+    False
+    """
+    return abs(wall_angle(np.asarray(free) != 0)) >= min_angle
+
+
+def canonical_labels(
+    free: np.ndarray, labels_of, *, min_angle: float = _MIN_ANGLE, turn_offset: float | None = 0.0
+) -> np.ndarray:
     """Label ``free`` in its canonical pose with ``labels_of`` and bring the labels back.
 
     ``labels_of(free) -> labels`` is any segmenter on a free-space mask. The result is in
     ``free``'s own pixel frame, ids 1..N in the raster order of the canonical image, so every
     quarter turn or mirror image of a map gets the same regions with the same ids.
     ``min_angle``: the smallest wall-direction offset, in degrees, for which the map is turned
-    before it is labelled. :func:`ursim_core.segmentation.segment_canonical` is this with a
-    registered segmenter.
+    before it is labelled. ``turn_offset``: degrees added to that turn (one of the other
+    resamplings of :data:`RESAMPLING_OFFSETS`); None labels the map as it is, without the turn.
+    A map that is not turned is labelled the same whatever the offset.
+    :func:`ursim_core.segmentation.segment_canonical` is this with a registered segmenter.
 
     Examples
     --------
@@ -230,7 +251,10 @@ def canonical_labels(free: np.ndarray, labels_of, *, min_angle: float = _MIN_ANG
 
     free = np.asarray(free) != 0
     angle = wall_angle(free)
-    work, matrix = (free, None) if abs(angle) < min_angle else _turned(free, -angle)
+    if abs(angle) < min_angle or turn_offset is None:
+        work, matrix = free, None
+    else:
+        work, matrix = _turned(free, -(angle + turn_offset))
     quarter_turns, mirrored = canonical_pose(work)
     inner = np.asarray(labels_of(dihedral(work, quarter_turns, mirrored)), dtype=np.int32)
     labels = _undo_dihedral(inner, quarter_turns, mirrored)

@@ -58,6 +58,12 @@ class Segmentation:
         Parameters used (JSON-serialisable).
     source : Path or None
         Label image path when loaded from a file.
+    resampled : tuple of Segmentation
+        Other segmentations of the same map, for a sketch that :func:`segment_canonical`
+        resamples onto its wall axes (``resampled=True``): turned back by other angles, and not
+        turned back. MAORIS's regions change with the resampling, so the matcher votes over the
+        answers of all of them (:mod:`ursim_core.matching.resampling`). Empty otherwise, and in
+        every segmentation made from edited labels.
 
     Examples
     --------
@@ -68,7 +74,7 @@ class Segmentation:
     (2, 2, 1)
     """
 
-    __slots__ = ("_graph", "_regions", "labels", "method", "params", "source")
+    __slots__ = ("_graph", "_regions", "labels", "method", "params", "resampled", "source")
 
     def __init__(
         self,
@@ -79,12 +85,13 @@ class Segmentation:
         source: Path | None = None,
         *,
         regions: RegionTable | None = None,
+        resampled: tuple[Segmentation, ...] = (),
     ) -> None:
         if graph is None and regions is None:
             raise TypeError("Segmentation needs the region graph or the region table of its labels")
         for name, value in (
             ("labels", labels), ("method", method), ("params", {} if params is None else params), ("source", source),
-            ("_graph", graph), ("_regions", regions),
+            ("_graph", graph), ("_regions", regions), ("resampled", tuple(resampled)),
         ):  # fmt: skip
             object.__setattr__(self, name, value)
 
@@ -95,7 +102,10 @@ class Segmentation:
         raise AttributeError(f"Segmentation is immutable: cannot delete {name!r}")
 
     def __reduce__(self):
-        return (_rebuilt, (self.labels, self._graph, self.method, self.params, self.source, self._regions))
+        return (
+            _rebuilt,
+            (self.labels, self._graph, self.method, self.params, self.source, self._regions, self.resampled),
+        )
 
     def __repr__(self) -> str:
         return f"Segmentation(method={self.method!r}, n_regions={self.n_regions}, shape={tuple(self.labels.shape)})"
@@ -130,8 +140,8 @@ class Segmentation:
         return 0
 
 
-def _rebuilt(labels, graph, method, params, source, regions) -> Segmentation:
-    return Segmentation(labels, graph, method, params, source, regions=regions)
+def _rebuilt(labels, graph, method, params, source, regions, resampled=()) -> Segmentation:
+    return Segmentation(labels, graph, method, params, source, regions=regions, resampled=resampled)
 
 
 def _maoris(free: np.ndarray, **params: Any) -> np.ndarray:
@@ -208,16 +218,31 @@ def resolve_params(
 
     ``canonical`` (True: segment in the map's canonical pose, see
     :mod:`ursim_core.segmentation.canonical`) is a parameter of every method; it is kept in the
-    result only when True, so earlier parameter dicts stay as they were.
+    result only when True, so earlier parameter dicts stay as they were. So is
+    ``canonical_turn_offset`` (with ``canonical``: degrees added to the turn onto the wall axes,
+    or None for no turn; one of the resampled segmentations of :func:`segment_canonical`), kept
+    only when given.
     """
+    import math
+
     from ursim_core.errors import ParameterError
 
     params = dict(params or {})
     canonical = params.pop("canonical", False)
     if canonical not in (True, False):
         raise ParameterError(f"must be true or false, not {canonical!r}", field="canonical")
+    turn = {}
+    if "canonical_turn_offset" in params:
+        offset = params.pop("canonical_turn_offset")
+        if offset is not None and (
+            isinstance(offset, bool) or not isinstance(offset, (int, float)) or not math.isfinite(offset)
+        ):
+            raise ParameterError(f"must be a number of degrees or null, not {offset!r}", field="canonical_turn_offset")
+        if not canonical:
+            raise ParameterError("needs canonical: true", field="canonical_turn_offset")
+        turn = {"canonical_turn_offset": None if offset is None else float(offset)}
     resolved = _resolve_method_params(method, preset, params, ParameterError)
-    return {**resolved, "canonical": True} if canonical else resolved
+    return {**resolved, "canonical": True, **turn} if canonical else resolved
 
 
 def _resolve_method_params(method, preset, params, ParameterError) -> dict[str, Any]:
@@ -281,11 +306,15 @@ def segment(
 
     free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
     resolved = resolve_params(method, preset, params)
-    settings = {name: value for name, value in resolved.items() if name != "canonical"}
+    settings = {name: value for name, value in resolved.items() if name not in ("canonical", "canonical_turn_offset")}
     if resolved.get("canonical"):
         from ursim_core.segmentation.canonical import canonical_labels
 
-        labels = canonical_labels(free, lambda pose: SEGMENTERS[method](pose, **settings))
+        labels = canonical_labels(
+            free,
+            lambda pose: SEGMENTERS[method](pose, **settings),
+            turn_offset=resolved.get("canonical_turn_offset", 0.0),
+        )
     else:
         labels = np.asarray(SEGMENTERS[method](free, **settings), dtype=np.int32)
     return Segmentation(labels=labels, regions=region_table(labels), method=method, params=resolved)
@@ -297,6 +326,7 @@ def segment_canonical(
     method: str = "maoris",
     preset: str | None = "sketch",
     params: dict[str, Any] | None = None,
+    resampled: bool = False,
 ) -> Segmentation:
     """:func:`segment` in the map's canonical pose: the same regions however the map is turned.
 
@@ -304,6 +334,14 @@ def segment_canonical(
     :mod:`ursim_core.segmentation.canonical`. Labels are in the map's own pixel frame;
     ``params`` of the result hold ``"canonical": True`` so that ``segment`` with them gives the
     same segmentation again.
+
+    ``resampled=True``: when the map is resampled onto its wall axes (walls 3 degrees or more off
+    the image axes), also segment it turned back by the other angles of
+    :data:`~ursim_core.segmentation.canonical.RESAMPLING_OFFSETS` and not turned back, into
+    ``Segmentation.resampled`` (five more segmentations), for the matcher to vote over. The
+    regions of a resampled sketch depend on the resampling: on the 18 KTH sketches turned by
+    15, 30, ..., 345 degrees, the better of two such segmentations per sketch scores 0.76 mean F1
+    against 0.69 for the default one (round 30).
 
     Examples
     --------
@@ -314,7 +352,20 @@ def segment_canonical(
     >>> np.array_equal(np.rot90(a.labels), b.labels), a.params["canonical"]
     (True, True)
     """
-    return segment(map_or_free, method=method, preset=preset, params={**(params or {}), "canonical": True})
+    params = {**(params or {}), "canonical": True}
+    base = segment(map_or_free, method=method, preset=preset, params=params)
+    if not resampled:
+        return base
+    from ursim_core.segmentation.canonical import RESAMPLING_OFFSETS, turned_back
+
+    free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
+    if not turned_back(free):
+        return base
+    others = tuple(
+        segment(free, method=method, preset=preset, params={**params, "canonical_turn_offset": offset})
+        for offset in (None, *RESAMPLING_OFFSETS)
+    )
+    return Segmentation(base.labels, method=base.method, params=base.params, regions=base.regions, resampled=others)
 
 
 def read_label_array(path: str | Path) -> np.ndarray:

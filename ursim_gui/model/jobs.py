@@ -133,7 +133,7 @@ class SegmentJob:
         ursim_core.errors.UrsimError
             For an unknown method, preset or parameter (checked before the long step).
         """
-        from ursim_core.segmentation import resolve_params, segment
+        from ursim_core.segmentation import resolve_params, segment, segment_canonical
 
         progress(0.0, "checking parameters")
         _check(cancelled, "segmentation")
@@ -142,11 +142,16 @@ class SegmentJob:
         _check(cancelled, "segmentation")
         progress(0.05, "segmenting")
         params = dict(self.params or {})
-        if self.side == "sketch" and self.canonical:
+        if self.side == "sketch" and self.canonical and params.pop("canonical", True):
             # As the CLI: a sketch whose orientation the matcher does not assume is segmented in
-            # its canonical pose (ursim_core.segmentation.canonical), recorded in its parameters.
-            params.setdefault("canonical", True)
-        segmentation = segment(self.map, method=self.method, preset=self.preset, params=params)
+            # its canonical pose (ursim_core.segmentation.canonical), recorded in its parameters,
+            # and in its other resamplings when it is turned onto its wall axes (the planar
+            # matcher votes over them: ursim_core.matching.resampling).
+            segmentation = segment_canonical(
+                self.map, method=self.method, preset=self.preset, params=params, resampled=True
+            )
+        else:
+            segmentation = segment(self.map, method=self.method, preset=self.preset, params=params)
         _check(cancelled, "segmentation")
         progress(1.0, f"{segmentation.n_regions} regions")
         return segmentation

@@ -82,6 +82,9 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
         text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
         if math.isfinite(result.cost):
             text += f", cost {result.cost:.3g}"
+        if getattr(result, "resampling_votes", 0):
+            # The pairs are a vote; m and the cost are the first segmentation's answer's.
+            text += f"\nvoted over {result.resampling_votes} resamplings of the turned sketch"
     found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
         text += f"\nread the sketch {found.describe()}"

@@ -232,3 +232,21 @@ def test_threads_give_the_outputs_of_one_step_after_the_other(tmp_path):
     alone = segment_checked(load(sketch, args), preset="sketch", params={}, canonical=True)
     assert np.array_equal(sketch_seg.labels, alone.labels)
     assert np.array_equal(metric_seg.labels, segment_checked(load(metric, args), preset="default", params={}).labels)
+
+
+def test_a_turned_sketch_is_matched_in_its_resamplings_and_voted(tmp_path, capsys):
+    from ursim_core.segmentation.canonical import _turned
+    from ursim_core.synth import make_pair
+
+    plan, sketch = make_pair(seed=5)
+    turned, _ = _turned(sketch.free, 25.0)
+    cv2.imwrite(str(tmp_path / "sketch.png"), turned.astype(np.uint8) * 255)
+    cv2.imwrite(str(tmp_path / "plan.png"), plan.free.astype(np.uint8) * 255)
+    out = tmp_path / "out"
+    assert main(["match", str(tmp_path / "sketch.png"), str(tmp_path / "plan.png"), "-o", str(out)]) == 0
+    assert "voted over 6 resamplings" in capsys.readouterr().out
+    corr = load_correspondences(out / "correspondences.json")
+    assert corr.extra["matcher"]["config"]["resampling_vote"] is True
+    # The voted pairs are in the regions of the label image written beside them.
+    labels = cv2.imread(str(out / "sketch.labels.png"), cv2.IMREAD_UNCHANGED)
+    assert {r for c in corr.cliques for r in c.sketch_regions} <= set(np.unique(labels).tolist()) - {0}

@@ -144,6 +144,31 @@ def test_cross_validated_keep_refit_in_every_orientation(root):
 _SEGMENTATIONS: dict = {}
 
 
+def test_the_resampled_segmentations_vote_at_free_angles(root):
+    # Round 30: the sketches turned by 30 and 60 degrees are resampled onto their wall axes, and
+    # their regions change with the resampling; the vote over six resamplings gave 0.71 mean F1
+    # against 0.64 for one (a study script; in sample, the design was chosen on these sketches).
+    results = {
+        value: run_evaluation(
+            root / "ursim_kth_sketches",
+            matchers=["planar"],
+            variants=["T4"],
+            augment="angles=30,60",
+            human=False,
+            config_overrides={"resampling_vote": value},
+            segmentation_cache=_SEGMENTATIONS,
+        )
+        for value in (True, False)
+    }
+    cv = cross_validate(results, option="resampling_vote")
+    turned = {name: f1 for name, (f1, _) in cv.by_orientation.items() if name != "rot0"}
+    assert len(turned) == 2, cv.table()
+    voted, single = cv.in_sample[True][0], cv.in_sample[False][0]
+    assert voted >= single + 0.03, cv.table()
+    # Held out (each sketch with the value the other 17 prefer) the vote keeps most of its gain.
+    assert cv.f1 >= single + 0.02, cv.table()
+
+
 def test_paper_method_with_oracle_m(root):
     cases = kth_pairs(root, pipeline="recommended")
     summary = summarise(f1_table(cases, MatchConfig.paper(), M_GRID))

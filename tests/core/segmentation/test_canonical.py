@@ -2,11 +2,21 @@
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 
-from ursim_core.segmentation import segment_canonical
-from ursim_core.segmentation.canonical import _turned, canonical_pose, dihedral, wall_angle
+from ursim_core.errors import ParameterError
+from ursim_core.segmentation import resolve_params, segment, segment_canonical
+from ursim_core.segmentation.canonical import (
+    RESAMPLING_OFFSETS,
+    _turned,
+    canonical_pose,
+    dihedral,
+    turned_back,
+    wall_angle,
+)
 from ursim_core.synth import make_pair
 
 
@@ -41,3 +51,52 @@ def test_canonical_segmentation_turns_with_the_map():
     for quarter_turns, mirrored in ((1, False), (2, True), (3, True)):
         moved = segment_canonical(dihedral(plan.free, quarter_turns, mirrored), preset="default")
         assert np.array_equal(moved.labels, dihedral(upright.labels, quarter_turns, mirrored))
+
+
+def _plan_turned(degrees: float) -> np.ndarray:
+    plan, _ = make_pair(seed=2)
+    turned, _ = _turned(plan.free, degrees)
+    return turned
+
+
+def test_a_map_on_its_axes_has_no_other_resampling():
+    plan, _ = make_pair(seed=2)
+    assert not turned_back(plan.free)
+    assert segment_canonical(plan.free, preset="default", resampled=True).resampled == ()
+
+
+def test_a_turned_map_is_also_segmented_in_its_other_resamplings():
+    free = _plan_turned(25.0)
+    assert turned_back(free)
+    seg = segment_canonical(free, preset="default", resampled=True)
+    assert np.array_equal(seg.labels, segment_canonical(free, preset="default").labels)
+    offsets = [other.params["canonical_turn_offset"] for other in seg.resampled]
+    assert offsets == [None, *RESAMPLING_OFFSETS]
+    for other in seg.resampled:
+        assert other.labels.shape == free.shape and other.n_regions > 0
+        assert other.resampled == ()
+        # Each records what made it: segment() with its parameters gives it again.
+        again = segment(free, method=other.method, params=other.params)
+        assert np.array_equal(again.labels, other.labels)
+    # Turned by other angles, the resampled map's regions differ somewhere.
+    assert any(not np.array_equal(other.labels, seg.labels) for other in seg.resampled)
+
+
+def test_the_resampled_segmentations_survive_pickling():
+    seg = segment_canonical(_plan_turned(25.0), preset="default", resampled=True)
+    copy = pickle.loads(pickle.dumps(seg))
+    assert [o.params for o in copy.resampled] == [o.params for o in seg.resampled]
+    assert all(np.array_equal(a.labels, b.labels) for a, b in zip(copy.resampled, seg.resampled, strict=True))
+
+
+@pytest.mark.parametrize(
+    "params, field",
+    [
+        ({"canonical_turn_offset": 1.0}, "canonical_turn_offset"),
+        ({"canonical": True, "canonical_turn_offset": "x"}, "canonical_turn_offset"),
+    ],
+)
+def test_a_turn_offset_needs_a_number_and_the_canonical_pose(params, field):
+    with pytest.raises(ParameterError) as error:
+        resolve_params("maoris", "default", params)
+    assert error.value.field == field

@@ -122,3 +122,18 @@ def test_a_file_opened_again_offers_the_orientation_its_match_read(window, qtbot
     assert panel.keep_found.isVisible() and panel.keep_found.text() == offered
     panel.keep_found.click()
     assert window.views["sketch"].orientation == (panel.orientation.angle, panel.orientation.mirrored)
+
+
+def test_the_summary_says_when_the_pairs_are_a_vote_over_resamplings():
+    import networkx as nx
+
+    from ursim_core.matching import match
+    from ursim_gui.panels.matching_panel import describe_result
+
+    graph = nx.path_graph(3)
+    nx.set_node_attributes(graph, {0: 50, 1: 10, 2: 12}, "size")
+    nx.set_node_attributes(graph, 0.3, "pca_shape")
+    nx.set_node_attributes(graph, {0: (0, 0), 1: (0, 10), 2: (0, 20)}, "centroid")
+    result = match(graph, graph.copy())
+    assert "voted" not in describe_result(result)
+    assert "voted over 6 resamplings" in describe_result(dataclasses.replace(result, resampling_votes=6))

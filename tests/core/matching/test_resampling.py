@@ -1,0 +1,91 @@
+"""The vote over the answers of a resampled sketch's segmentations (ursim_core.matching.resampling)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from ursim_core.matching import MatchConfig, MatchConstraints, match, prepare
+from ursim_core.matching.resampling import region_correspondence, vote_pairs, voted_result
+from ursim_core.segmentation import segment_canonical
+from ursim_core.segmentation.canonical import _turned
+from ursim_core.synth import make_pair
+
+BASE = np.array([[1, 1, 2, 2, 3, 3]])
+
+
+def test_each_region_goes_to_the_region_it_overlaps_most():
+    other = np.array([[4, 4, 4, 5, 0, 6]])
+    assert region_correspondence(BASE, other) == {4: 1, 5: 2, 6: 3}
+    assert region_correspondence(BASE, np.zeros_like(BASE)) == {}
+
+
+def test_a_pair_needs_the_quorum():
+    answers = [(BASE, [(1, 10), (2, 20), (3, 30)]), (BASE, [(1, 10), (2, 21)]), (BASE, [(1, 10), (3, 30)])]
+    assert vote_pairs(BASE, answers, quorum=2) == [(1, 10), (3, 30)]
+    assert vote_pairs(BASE, answers, quorum=3) == [(1, 10)]
+
+
+def test_the_vote_is_one_to_one_and_ties_go_to_the_earlier_answer():
+    answers = [(BASE, [(1, 10), (2, 20)]), (BASE, [(1, 20), (2, 10)])]
+    assert vote_pairs(BASE, answers, quorum=1) == [(1, 10), (2, 20)]
+
+
+def test_answers_in_other_segmentations_are_carried_over():
+    split = np.array([[7, 8, 9, 9, 0, 0]])  # region 1 split in two, region 3 missing
+    answers = [(BASE, [(1, 10), (3, 30)]), (split, [(7, 10), (8, 10), (9, 20)]), (split, [(9, 20)])]
+    # 7 and 8 both carry to region 1: one vote for (1, 10) per answer, not two.
+    assert vote_pairs(BASE, answers, quorum=2) == [(1, 10), (2, 20)]
+
+
+def test_the_voted_result_takes_the_orientation_most_answers_read():
+    first = match(_graph(), _graph())
+    turned = dataclasses.replace(first, orientation=(90.0, False))
+    voted = voted_result(first, BASE, [(BASE, turned), (BASE, turned)])
+    assert voted.orientation == (90.0, False) and voted.resampling_votes == 3
+    assert voted_result(first, BASE, [(BASE, turned)]).orientation == first.orientation
+
+
+def _graph():
+    import networkx as nx
+
+    g = nx.path_graph(3)
+    nx.set_node_attributes(g, {0: 50, 1: 10, 2: 12}, "size")
+    nx.set_node_attributes(g, 0.3, "pca_shape")
+    nx.set_node_attributes(g, {0: (0, 0), 1: (0, 10), 2: (0, 20)}, "centroid")
+    return g
+
+
+@pytest.fixture(scope="module")
+def turned_pair():
+    plan, sketch = make_pair(seed=5)
+    turned, _ = _turned(sketch.free, 25.0)
+    return segment_canonical(turned, preset="default", resampled=True), segment_canonical(plan.free, preset="default")
+
+
+def test_a_resampled_sketch_is_matched_in_every_segmentation_and_voted(turned_pair):
+    sketch, plan = turned_pair
+    assert len(sketch.resampled) == 5
+    prepared = prepare(sketch, plan)
+    assert prepared.resampled is not None and len(prepared.resampled.variants) == 5
+    voted = match(sketch, plan)
+    assert voted.resampling_votes == 6
+    # The voted pairs are in the first segmentation's regions, one to one.
+    assert {a for a, _ in voted.pairs} <= set(sketch.graph.nodes)
+    assert len({a for a, _ in voted.pairs}) == len(voted.pairs) == len({b for _, b in voted.pairs})
+    # Each answer alone, carried over: the vote keeps what a majority of them hold.
+    answers = [(sketch.labels, match(sketch, plan, config=MatchConfig(resampling_vote=False)).pairs)]
+    answers += [(other.labels, match(other, plan).pairs) for other in sketch.resampled]
+    assert sorted(voted.pairs) == sorted(vote_pairs(sketch.labels, answers, quorum=3))
+
+
+def test_no_vote_when_switched_off_given_constraints_or_another_matcher(turned_pair):
+    sketch, plan = turned_pair
+    assert match(sketch, plan, config=MatchConfig(resampling_vote=False)).resampling_votes == 0
+    assert match(sketch, plan, config=MatchConfig(matcher="hungarian")).resampling_votes == 0
+    first = match(sketch, plan, config=MatchConfig(resampling_vote=False)).pairs[0]
+    constrained = match(sketch, plan, constraints=MatchConstraints(fixed=(first,)))
+    assert constrained.resampling_votes == 0 and first in constrained.pairs
+    assert not MatchConfig.paper().resampling_vote and not MatchConfig.released().resampling_vote
