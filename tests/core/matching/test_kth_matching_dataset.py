@@ -94,14 +94,15 @@ def test_default_matches_every_orientation_alike(root):
     assert max(means.values()) - min(means.values()) < 1e-9, means
 
 
-def _cross_validated(root, option: str, values):
-    """Leave-one-sketch-out cross-validation of ``option`` over ``values`` (planar T4, dihedral)."""
+def _cross_validated(root, option: str, values, *, augment: str = "dihedral"):
+    """Leave-one-sketch-out cross-validation of ``option`` over ``values`` (planar T4, the sketches
+    turned as ``augment`` says)."""
     results = {
         value: run_evaluation(
             root / "ursim_kth_sketches",
             matchers=["planar"],
             variants=["T4"],
-            augment="dihedral",
+            augment=augment,
             human=False,
             config_overrides={option: value},
             segmentation_cache=_SEGMENTATIONS,
@@ -148,19 +149,7 @@ def test_the_resampled_segmentations_vote_at_free_angles(root):
     # Round 30: the sketches turned by 30 and 60 degrees are resampled onto their wall axes, and
     # their regions change with the resampling; the vote over six resamplings gave 0.71 mean F1
     # against 0.64 for one (a study script; in sample, the design was chosen on these sketches).
-    results = {
-        value: run_evaluation(
-            root / "ursim_kth_sketches",
-            matchers=["planar"],
-            variants=["T4"],
-            augment="angles=30,60",
-            human=False,
-            config_overrides={"resampling_vote": value},
-            segmentation_cache=_SEGMENTATIONS,
-        )
-        for value in (True, False)
-    }
-    cv = cross_validate(results, option="resampling_vote")
+    cv = _cross_validated(root, "resampling_vote", (True, False), augment="angles=30,60")
     turned = {name: f1 for name, (f1, _) in cv.by_orientation.items() if name != "rot0"}
     assert len(turned) == 2, cv.table()
     voted, single = cv.in_sample[True][0], cv.in_sample[False][0]
