@@ -248,11 +248,15 @@ def run_evaluation(
     canonical = base_config.orientation != "upright"
     for experiment in experiments:
         # The planar matcher votes over the other resamplings of a sketch resampled onto its axes.
-        resampled = canonical and any(
-            _config_for(base_config, matcher, variant, released, experiment.input_kind).resolved().matcher == "planar"
+        resampled = (
+            canonical
             and base_config.resampling_vote
-            for matcher in matchers
-            for variant in variants
+            and any(
+                _config_for(base_config, matcher, variant, released, experiment.input_kind).resolved().matcher
+                == "planar"
+                for matcher in matchers
+                for variant in variants
+            )
         )
         upright = SegmentationJob.of(
             experiment.sketch, input_preset, load_options, digests, canonical=canonical, resampled=resampled
