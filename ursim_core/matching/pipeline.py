@@ -36,14 +36,17 @@ from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
-from ursim_core.matching.descriptors import blend_positions, pair_descriptors
-from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines
-from ursim_core.matching.planar import planar_graph
+from ursim_core.matching.oriented import (
+    candidate_overlaps,
+    orientations_to_try,
+    prepare_oriented,
+    reoriented,
+    sketch_outlines,
+)
 from ursim_core.matching.refit import refit_from, refit_positions, signature_start
 from ursim_core.matching.resampling import voted_answer, with_resampled
 from ursim_core.matching.results import MatchResult, Prepared
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
-from ursim_core.segmentation.canonical import wall_angle
 
 __all__ = [
     "MATCH_PRESETS",
@@ -137,9 +140,9 @@ def _prepare_one(sketch_seg, metric_seg, config: MatchConfig, *, progress=None, 
             )
     if config.matcher == "overlay":
         return _prepare_overlay(sketch_seg, metric_seg, config, constraints)
-    candidates = _orientations(config, sketch_seg, metric_seg)
-    outlines = _outlines(sketch_seg, sketch_graph, candidates)
-    base = _prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
+    candidates = orientations_to_try(config, sketch_seg, metric_seg)
+    outlines = sketch_outlines(sketch_seg, sketch_graph, candidates)
+    base = prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
     if constraints is not None:
         base = dataclasses.replace(base, constraints=constraints)
     if len(candidates) == 1:
@@ -149,7 +152,7 @@ def _prepare_one(sketch_seg, metric_seg, config: MatchConfig, *, progress=None, 
         return dataclasses.replace(base, chosen=result)
 
     def candidate(index: int) -> Prepared:
-        return base if index == 0 else _reoriented(base, sketch_graph, candidates[index], outlines)
+        return base if index == 0 else reoriented(base, sketch_graph, candidates[index], outlines)
 
     if max(base.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
         # Large graphs: one planar sweep costs seconds, so the orientation is chosen by how well
@@ -173,7 +176,7 @@ def _prepare_one(sketch_seg, metric_seg, config: MatchConfig, *, progress=None, 
         prepared_candidates = {index: candidate(index) for index in range(len(candidates))}
         finalists = range(len(candidates))
     overlaps = (
-        _candidate_overlaps(config, sketch_seg, metric_seg, candidates, list(finalists)) if len(finalists) > 1 else {}
+        candidate_overlaps(config, sketch_seg, metric_seg, candidates, list(finalists)) if len(finalists) > 1 else {}
     )
 
     def ranked(cost: float, index: int) -> float:
@@ -304,7 +307,7 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
     metric_labels = getattr(metric_seg, "labels", None)
     if sketch_labels is None or metric_labels is None:
         raise ParameterError("the overlay matcher needs segmentations (label images), not bare graphs", field="matcher")
-    candidates = _orientations(config, sketch_seg, metric_seg)
+    candidates = orientations_to_try(config, sketch_seg, metric_seg)
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
     fit = None
     if constraints is not None and len(constraints.fixed) >= 2:
@@ -315,8 +318,8 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
     if fit is None:
         fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
     orientation = (fit.degrees, fit.mirrored)
-    outlines = _outlines(sketch_seg, sketch_graph, [orientation])
-    base = _prepare_oriented(sketch_graph, metric_graph, config, orientation, outlines)
+    outlines = sketch_outlines(sketch_seg, sketch_graph, [orientation])
+    base = prepare_oriented(sketch_graph, metric_graph, config, orientation, outlines)
     pairs = overlay_pairs(sketch_labels, metric_labels, fit.matrix, min_iou=config.overlay_min_iou)
     pairs = constrained_pairs(pairs, constraints)
     descriptors = base.descriptors
@@ -343,23 +346,6 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
     return dataclasses.replace(base, chosen=result, constraints=constraints)
 
 
-def _candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates, indices) -> dict[int, float]:
-    """Free-space overlap of the sketch fitted onto the metric map, per candidate orientation
-    (empty when not asked for or when either side is a bare graph with no label image)."""
-    sketch_labels = getattr(sketch_seg, "labels", None)
-    metric_labels = getattr(metric_seg, "labels", None)
-    if config.orientation_overlap == 0 or sketch_labels is None or metric_labels is None:
-        return {}
-    from ursim_core.matching.alignment import fit_alignments
-
-    fitted = fit_alignments(sketch_labels, metric_labels, [candidates[index] for index in indices])
-    return {index: max(alignment.overlap, _SMALLEST_OVERLAP) for index, alignment in zip(indices, fitted)}
-
-
-#: Floor of an overlap used as a divisor (a sketch with no free space, say).
-_SMALLEST_OVERLAP = 1e-3
-
-
 def _share_of(progress, index: int, count: int):
     """``progress`` for step ``index`` of ``count``: fractions scaled into its share, messages prefixed."""
     if progress is None:
@@ -369,101 +355,6 @@ def _share_of(progress, index: int, count: int):
         progress((index + fraction) / count, f"orientation {index + 1} of {count}: {message}")
 
     return report
-
-
-def _orientations(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[float, bool]]:
-    """The orientations worth trying: only those that can change the answer."""
-    if config.orientation != "any":
-        return orientation_candidates(orientation=config.orientation, mirrored=config.mirrored)
-    if config.position_weight == 0 and config.matcher != "overlay":
-        # Without the position term only a mirror image changes anything (the planar
-        # matcher's neighbour orders reverse); the other graph matchers do not see orientation.
-        if config.matcher != "planar" or config.mirrored is not None:
-            return [(0.0, bool(config.mirrored))]
-        return [(0.0, False), (0.0, True)]
-    sketch_labels = getattr(sketch_seg, "labels", None)
-    metric_labels = getattr(metric_seg, "labels", None)
-    return orientation_candidates(
-        orientation="any",
-        mirrored=config.mirrored,
-        sketch_angle=wall_angle(sketch_labels) if sketch_labels is not None else 0.0,
-        metric_angle=wall_angle(metric_labels) if metric_labels is not None else 0.0,
-    )
-
-
-def _outlines(sketch_seg, sketch_graph: nx.Graph, candidates) -> dict | None:
-    """The sketch's region outlines (:func:`~ursim_core.matching.orientation.region_outlines`)
-    when a candidate is not a quarter turn and the label image is at hand; else None."""
-    labels = getattr(sketch_seg, "labels", None)
-    if labels is None or all(degrees % 90.0 == 0.0 for degrees, _ in candidates):
-        return None
-    return region_outlines(sketch_graph, labels)
-
-
-def _reoriented(
-    base: Prepared, sketch_graph: nx.Graph, orientation: tuple[float, bool], outlines: dict | None = None
-) -> Prepared:
-    """``base`` for another orientation of the sketch: new positions, same signatures."""
-    turned = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
-    descriptors = base.descriptors
-    if descriptors is not None and descriptors.signature_c is not None:
-        c_matrix = blend_positions(
-            descriptors.signature_c,
-            turned,
-            descriptors.sketch_nodes,
-            base.metric_graph,
-            descriptors.metric_nodes,
-            base.config.position_weight,
-        )
-        descriptors = dataclasses.replace(descriptors, c_matrix=c_matrix)
-    return dataclasses.replace(
-        base, sketch_graph=turned, descriptors=descriptors, sketch_planar=planar_graph(turned), orientation=orientation
-    )
-
-
-def _prepare_oriented(
-    sketch_graph, metric_graph, config: MatchConfig, orientation: tuple[float, bool], outlines: dict | None = None
-) -> Prepared:
-    sketch_graph = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
-    notes = []
-    for name, graph in (("sketch", sketch_graph), ("metric map", metric_graph)):
-        count = graph.number_of_nodes()
-        if count == 0:
-            notes.append(f"the {name} has no regions")
-        elif count == 1:
-            notes.append(f"the {name} has a single region")
-        else:
-            components = nx.number_connected_components(graph)
-            if components > 1:
-                notes.append(f"the {name} graph has {components} connected components (no heat flows between them)")
-    descriptors = None
-    if sketch_graph.number_of_nodes() and metric_graph.number_of_nodes():
-        descriptors = pair_descriptors(
-            sketch_graph,
-            metric_graph,
-            variant=config.variant,
-            weights=config.weights,
-            standardise_with=config.standardise,
-            uniqueness_k=config.uniqueness_k,
-            disparity=config.disparity,
-            times=config.times,
-            size_weight_floor=config.size_weight_floor,
-            method=config.signature_method,
-            position_weight=config.position_weight,
-        )
-        notes.extend(descriptors.notes)
-        if config.variant != "baseline" and not descriptors.unique_sketch and not descriptors.unique_metric:
-            notes.append("no unique region in either map")
-    return Prepared(
-        config=config,
-        sketch_graph=sketch_graph,
-        metric_graph=metric_graph,
-        descriptors=descriptors,
-        sketch_planar=planar_graph(sketch_graph),
-        metric_planar=planar_graph(metric_graph),
-        notes=tuple(dict.fromkeys(notes)),
-        orientation=orientation,
-    )
 
 
 def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None) -> MatchResult:

@@ -1,0 +1,164 @@
+"""One sketch orientation prepared for matching: the candidates, and each one's ``Prepared``.
+
+:func:`ursim_core.matching.prepare` tries the orientations a sketch can have
+(:func:`orientations_to_try`); each is prepared by :func:`prepare_oriented` for the first and
+:func:`reoriented` for the others, which reuse the first's signatures (only the position term and
+the neighbour orders depend on the orientation), and ranked with the free-space overlap of the
+sketch fitted onto the metric map in it (:func:`candidate_overlaps`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import networkx as nx
+
+from ursim_core.matching.config import MatchConfig
+from ursim_core.matching.descriptors import blend_positions, pair_descriptors
+from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines
+from ursim_core.matching.planar import planar_graph
+from ursim_core.matching.results import Prepared
+from ursim_core.segmentation.canonical import wall_angle
+
+__all__ = ["orientations_to_try", "sketch_outlines", "prepare_oriented", "reoriented", "candidate_overlaps"]
+
+
+def orientations_to_try(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[float, bool]]:
+    """The ``(degrees, mirrored)`` orientations worth trying: only those that can change the answer.
+
+    ``config.orientation`` other than ``'any'`` names one (or its two mirror readings); without the
+    position term only a mirror image changes the planar matcher's answer; otherwise the
+    candidates of :func:`~ursim_core.matching.orientation.orientation_candidates` from both maps'
+    wall angles (read from their label images; 0 for bare graphs).
+
+    Examples
+    --------
+    >>> orientations_to_try(MatchConfig(orientation="upright", mirrored=False), None, None)
+    [(0.0, False)]
+    >>> len(orientations_to_try(MatchConfig(), nx.Graph(), nx.Graph()))  # 4 turns, mirrored or not
+    8
+    """
+    if config.orientation != "any":
+        return orientation_candidates(orientation=config.orientation, mirrored=config.mirrored)
+    if config.position_weight == 0 and config.matcher != "overlay":
+        # Without the position term only a mirror image changes anything (the planar
+        # matcher's neighbour orders reverse); the other graph matchers do not see orientation.
+        if config.matcher != "planar" or config.mirrored is not None:
+            return [(0.0, bool(config.mirrored))]
+        return [(0.0, False), (0.0, True)]
+    sketch_labels = getattr(sketch_seg, "labels", None)
+    metric_labels = getattr(metric_seg, "labels", None)
+    return orientation_candidates(
+        orientation="any",
+        mirrored=config.mirrored,
+        sketch_angle=wall_angle(sketch_labels) if sketch_labels is not None else 0.0,
+        metric_angle=wall_angle(metric_labels) if metric_labels is not None else 0.0,
+    )
+
+
+def sketch_outlines(sketch_seg, sketch_graph: nx.Graph, candidates) -> dict | None:
+    """The sketch's region outlines (:func:`~ursim_core.matching.orientation.region_outlines`)
+    when a candidate is not a quarter turn and the label image is at hand; else None."""
+    labels = getattr(sketch_seg, "labels", None)
+    if labels is None or all(degrees % 90.0 == 0.0 for degrees, _ in candidates):
+        return None
+    return region_outlines(sketch_graph, labels)
+
+
+def reoriented(
+    base: Prepared, sketch_graph: nx.Graph, orientation: tuple[float, bool], outlines: dict | None = None
+) -> Prepared:
+    """``base`` for another orientation of the sketch: new positions, same signatures."""
+    turned = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
+    descriptors = base.descriptors
+    if descriptors is not None and descriptors.signature_c is not None:
+        c_matrix = blend_positions(
+            descriptors.signature_c,
+            turned,
+            descriptors.sketch_nodes,
+            base.metric_graph,
+            descriptors.metric_nodes,
+            base.config.position_weight,
+        )
+        descriptors = dataclasses.replace(descriptors, c_matrix=c_matrix)
+    return dataclasses.replace(
+        base, sketch_graph=turned, descriptors=descriptors, sketch_planar=planar_graph(turned), orientation=orientation
+    )
+
+
+def prepare_oriented(
+    sketch_graph, metric_graph, config: MatchConfig, orientation: tuple[float, bool], outlines: dict | None = None
+) -> Prepared:
+    """Everything the matchers need of the pair with the sketch in ``orientation``, but no answer.
+
+    The descriptors (:func:`~ursim_core.matching.descriptors.pair_descriptors`: attributes,
+    anchors, signatures, ``c``) and both planar graphs; ``notes`` say what is degenerate (no
+    region, one region, several components, no unique region), for the answer's ``reason``.
+
+    Examples
+    --------
+    >>> g = nx.path_graph(3)
+    >>> nx.set_node_attributes(g, {0: 50, 1: 10, 2: 12}, "size")
+    >>> nx.set_node_attributes(g, 0.3, "pca_shape")
+    >>> nx.set_node_attributes(g, {0: (0, 0), 1: (0, 10), 2: (0, 20)}, "centroid")
+    >>> prepared = prepare_oriented(g, g.copy(), MatchConfig(), (180.0, False))
+    >>> prepared.c_matrix.shape, prepared.orientation
+    ((3, 3), (180.0, False))
+    """
+    sketch_graph = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
+    notes = []
+    for name, graph in (("sketch", sketch_graph), ("metric map", metric_graph)):
+        count = graph.number_of_nodes()
+        if count == 0:
+            notes.append(f"the {name} has no regions")
+        elif count == 1:
+            notes.append(f"the {name} has a single region")
+        else:
+            components = nx.number_connected_components(graph)
+            if components > 1:
+                notes.append(f"the {name} graph has {components} connected components (no heat flows between them)")
+    descriptors = None
+    if sketch_graph.number_of_nodes() and metric_graph.number_of_nodes():
+        descriptors = pair_descriptors(
+            sketch_graph,
+            metric_graph,
+            variant=config.variant,
+            weights=config.weights,
+            standardise_with=config.standardise,
+            uniqueness_k=config.uniqueness_k,
+            disparity=config.disparity,
+            times=config.times,
+            size_weight_floor=config.size_weight_floor,
+            method=config.signature_method,
+            position_weight=config.position_weight,
+        )
+        notes.extend(descriptors.notes)
+        if config.variant != "baseline" and not descriptors.unique_sketch and not descriptors.unique_metric:
+            notes.append("no unique region in either map")
+    return Prepared(
+        config=config,
+        sketch_graph=sketch_graph,
+        metric_graph=metric_graph,
+        descriptors=descriptors,
+        sketch_planar=planar_graph(sketch_graph),
+        metric_planar=planar_graph(metric_graph),
+        notes=tuple(dict.fromkeys(notes)),
+        orientation=orientation,
+    )
+
+
+def candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates, indices) -> dict[int, float]:
+    """Free-space overlap of the sketch fitted onto the metric map, per candidate orientation
+    (empty when not asked for or when either side is a bare graph with no label image)."""
+    sketch_labels = getattr(sketch_seg, "labels", None)
+    metric_labels = getattr(metric_seg, "labels", None)
+    if config.orientation_overlap == 0 or sketch_labels is None or metric_labels is None:
+        return {}
+    from ursim_core.matching.alignment import fit_alignments
+
+    fitted = fit_alignments(sketch_labels, metric_labels, [candidates[index] for index in indices])
+    return {index: max(alignment.overlap, _SMALLEST_OVERLAP) for index, alignment in zip(indices, fitted)}
+
+
+#: Floor of an overlap used as a divisor (a sketch with no free space, say).
+_SMALLEST_OVERLAP = 1e-3
