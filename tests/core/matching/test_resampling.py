@@ -22,6 +22,15 @@ def test_each_region_goes_to_the_region_it_overlaps_most():
     assert region_correspondence(BASE, np.zeros_like(BASE)) == {}
 
 
+def test_ties_go_to_the_lower_region_and_walls_are_not_regions():
+    # Region 4 covers one pixel of 2 and one of 3: 2 wins. Region 5 lies on walls (-1) and
+    # background (0) only, so it has no entry; the -1 in ``other`` counts for nothing either.
+    labels = np.array([[2, 3, -1, 0, 1, 1]])
+    other = np.array([[4, 4, 5, 5, -1, 6]])
+    assert region_correspondence(labels, other) == {4: 2, 6: 1}
+    assert region_correspondence(np.zeros((0, 0), int), np.zeros((0, 0), int)) == {}
+
+
 def test_a_pair_needs_the_quorum():
     answers = [(BASE, [(1, 10), (2, 20), (3, 30)]), (BASE, [(1, 10), (2, 21)]), (BASE, [(1, 10), (3, 30)])]
     assert vote_pairs(BASE, answers, quorum=2) == [(1, 10), (3, 30)]
