@@ -40,6 +40,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "Segmentation",
             "SEGMENTERS",
             "segment_canonical",
+            "with_resamplings",
             "DEFAULT_SEGMENTERS",
             "segment",
             "resolve_params",

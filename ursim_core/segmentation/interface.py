@@ -356,16 +356,53 @@ def segment_canonical(
     base = segment(map_or_free, method=method, preset=preset, params=params)
     if not resampled:
         return base
+    return with_resamplings(base, map_or_free, method=method, params=base.params)
+
+
+def with_resamplings(
+    segmentation: Segmentation, map_or_free: Any, *, method: str, params: dict[str, Any]
+) -> Segmentation:
+    """``segmentation`` with its other resamplings (``Segmentation.resampled``), as
+    ``segment_canonical(..., resampled=True)`` makes them.
+
+    For a canonical segmentation met again without them: its label image reloaded from a file
+    (:func:`load_label_image`, whose method is ``'label-image'``), say, when the method and the
+    (resolved) parameters that made it are known. Without them the planar matcher would match
+    one segmentation of a sketch that was matched over six before, and answer otherwise.
+    ``segmentation`` itself is returned when it has resamplings already, when ``params`` are not
+    canonical (or are one of the resamplings), or when the map is on its wall axes (no
+    resampling to vary).
+
+    Examples
+    --------
+    >>> free = np.zeros((100, 170), bool)
+    >>> free[10:90, 10:70] = free[30:70, 100:150] = free[45:55, 70:100] = True
+    >>> plain = segment(free, preset="default", params={"canonical": True})
+    >>> with_resamplings(plain, free, method="maoris", params=plain.params) is plain  # on its axes
+    True
+    """
+    params = dict(params or {})
+    if segmentation.resampled or params.get("canonical") is not True or "canonical_turn_offset" in params:
+        return segmentation
     from ursim_core.segmentation.canonical import RESAMPLING_OFFSETS, turned_back
 
     free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
     if not turned_back(free):
-        return base
+        return segmentation
+    # The parameters are resolved already: no preset on top of them.
     others = tuple(
-        segment(free, method=method, preset=preset, params={**params, "canonical_turn_offset": offset})
+        segment(free, method=method, preset=None, params={**params, "canonical_turn_offset": offset})
         for offset in (None, *RESAMPLING_OFFSETS)
     )
-    return Segmentation(base.labels, method=base.method, params=base.params, regions=base.regions, resampled=others)
+    return Segmentation(
+        segmentation.labels,
+        segmentation._graph,
+        segmentation.method,
+        segmentation.params,
+        segmentation.source,
+        regions=segmentation._regions,
+        resampled=others,
+    )
 
 
 def read_label_array(path: str | Path) -> np.ndarray:

@@ -236,7 +236,7 @@ class DocumentOperations:
     def _load_side(side: str, ref: MapRef, document: Path | None, warnings: list[str]):
         """(map, segmentation) of one side of a document; raises UrsimError naming both files."""
         from ursim_core.io.maps import load_map
-        from ursim_core.segmentation import SEGMENTERS, load_label_image, segment
+        from ursim_core.segmentation import SEGMENTERS, load_label_image, segment, with_resamplings
 
         if ref.path is None:
             return None, None
@@ -260,6 +260,19 @@ class DocumentOperations:
                     )
         except UrsimError as error:
             raise type(error)(f"{error.problem}{where}", path=error.path, field=error.field) from error
+        if side == "sketch" and segmentation is not None and ref.segmentation_method in SEGMENTERS:
+            # A turned sketch was segmented in several resamplings, which the planar matcher votes
+            # over; a saved document keeps the first only: make the others again, or matching the
+            # reopened document would answer otherwise than before it was saved.
+            try:
+                segmentation = with_resamplings(
+                    segmentation, map_, method=ref.segmentation_method, params=ref.segmentation_params
+                )
+            except UrsimError as error:
+                warnings.append(
+                    f"{ref.path}: the sketch's other resamplings could not be made ({error.problem}); "
+                    f"matching uses its one segmentation"
+                )
         if ref.sha256 is not None and map_.sha256 is not None and ref.sha256.lower() != map_.sha256.lower():
             warnings.append(
                 f"{ref.path}: the {side} map changed since the correspondences were saved; "

@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 
 from ursim_core.errors import ParameterError
-from ursim_core.segmentation import resolve_params, segment, segment_canonical
+from ursim_core.segmentation import (
+    load_label_image,
+    resolve_params,
+    save_label_image,
+    segment,
+    segment_canonical,
+    with_resamplings,
+)
 from ursim_core.segmentation.canonical import (
     RESAMPLING_OFFSETS,
     _turned,
@@ -80,6 +87,29 @@ def test_a_turned_map_is_also_segmented_in_its_other_resamplings():
         assert np.array_equal(again.labels, other.labels)
     # Turned by other angles, the resampled map's regions differ somewhere.
     assert any(not np.array_equal(other.labels, seg.labels) for other in seg.resampled)
+
+
+def test_a_reloaded_label_image_gets_its_resamplings_again(tmp_path):
+    free = _plan_turned(25.0)
+    seg = segment_canonical(free, preset="default", resampled=True)
+    save_label_image(seg, tmp_path / "labels.png")
+    reloaded = load_label_image(tmp_path / "labels.png", shape=free.shape)
+    assert reloaded.resampled == ()
+    again = with_resamplings(reloaded, free, method=seg.method, params=seg.params)
+    # The reloaded labels stay the answer's frame; the others are the ones segment_canonical made.
+    assert np.array_equal(again.labels, reloaded.labels) and again.source == reloaded.source
+    assert [o.params for o in again.resampled] == [o.params for o in seg.resampled]
+    assert all(np.array_equal(a.labels, b.labels) for a, b in zip(again.resampled, seg.resampled, strict=True))
+
+
+def test_resamplings_are_made_only_for_a_canonical_segmentation_of_a_turned_map():
+    free = _plan_turned(25.0)
+    plain = segment(free, preset="default")
+    assert with_resamplings(plain, free, method="maoris", params=plain.params) is plain  # not canonical
+    canonical = segment_canonical(free, preset="default", resampled=True)
+    assert with_resamplings(canonical, free, method="maoris", params=canonical.params) is canonical  # has them
+    one = canonical.resampled[0]  # itself one of the resamplings
+    assert with_resamplings(one, free, method="maoris", params=one.params) is one
 
 
 def test_the_resampled_segmentations_survive_pickling():

@@ -164,6 +164,34 @@ def test_open_segments_when_the_label_image_is_missing(tmp_path):
     assert session.correspondences == author.correspondences and not session.dirty
 
 
+def test_a_reopened_turned_sketch_is_segmented_in_its_resamplings_again(tmp_path):
+    from ursim_core.evaluation.augment import Orientation, transform_image
+    from ursim_core.synth import make_pair
+
+    plan, _ = make_pair(seed=2)
+    turned = transform_image(plan.free, Orientation(25.0))
+    cv2.imwrite(str(tmp_path / "sketch.png"), np.where(turned, 255, 0).astype(np.uint8))
+    cv2.imwrite(str(tmp_path / "plan.png"), np.where(plan.free, 255, 0).astype(np.uint8))
+    author = AnnotationSession()
+    author.load_map("sketch", tmp_path / "sketch.png")
+    author.load_map("metric", tmp_path / "plan.png")
+    for side in ("sketch", "metric"):
+        job = SegmentJob(author.map(side), "default", None, side=side)
+        author.set_segmentation(side, job.run(lambda *a: None, lambda: False))
+    made = author.segmentation("sketch")
+    assert len(made.resampled) == 5  # the planar matcher votes over six
+    author.link([1], [1])
+    author.save(tmp_path / "pair.json")
+
+    session = AnnotationSession()
+    session.open(tmp_path / "pair.json")
+    reopened = session.segmentation("sketch")
+    assert np.array_equal(reopened.labels, made.labels)
+    assert [o.params for o in reopened.resampled] == [o.params for o in made.resampled]
+    assert all(np.array_equal(a.labels, b.labels) for a, b in zip(reopened.resampled, made.resampled, strict=True))
+    assert session.segmentation("metric").resampled == () and not session.dirty
+
+
 def test_open_errors_leave_the_session_unchanged(session, tmp_path):
     session.link([1], [1])
     before = (session.correspondences, session.map("sketch"), session.segmentation("metric"), len(session.history))
