@@ -20,7 +20,14 @@ from ursim_core.matching.planar import planar_graph
 from ursim_core.matching.results import Prepared
 from ursim_core.segmentation.canonical import wall_angle
 
-__all__ = ["orientations_to_try", "sketch_outlines", "prepare_oriented", "reoriented", "candidate_overlaps"]
+__all__ = [
+    "orientations_to_try",
+    "nearest_orientations",
+    "sketch_outlines",
+    "prepare_oriented",
+    "reoriented",
+    "candidate_overlaps",
+]
 
 
 def orientations_to_try(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[float, bool]]:
@@ -54,6 +61,31 @@ def orientations_to_try(config: MatchConfig, sketch_seg, metric_seg) -> list[tup
         sketch_angle=wall_angle(sketch_labels) if sketch_labels is not None else 0.0,
         metric_angle=wall_angle(metric_labels) if metric_labels is not None else 0.0,
     )
+
+
+def nearest_orientations(candidates, wanted) -> list[tuple[float, bool]]:
+    """For each ``(degrees, mirrored)`` of ``wanted``, the candidate of the same mirror flag whose
+    turn is closest to it; each once, in the order of ``wanted``; all ``candidates`` if none fits.
+
+    Another segmentation of the same sketch in the same frame has wall angles a fraction of a
+    degree apart, so its candidates are the first segmentation's turned by that fraction: this
+    finds the ones that read the sketch the same way.
+
+    Examples
+    --------
+    >>> candidates = [(1.0, False), (91.0, False), (181.0, False), (271.0, False), (359.0, True)]
+    >>> nearest_orientations(candidates, [(180.0, False), (0.0, True), (178.0, False)])
+    [(181.0, False), (359.0, True)]
+    """
+    chosen = []
+    for degrees, mirrored in wanted:
+        same_flag = [candidate for candidate in candidates if candidate[1] == mirrored]
+        if not same_flag:
+            continue
+        nearest = min(same_flag, key=lambda candidate: abs((candidate[0] - degrees + 180.0) % 360.0 - 180.0))
+        if nearest not in chosen:
+            chosen.append(nearest)
+    return chosen or list(candidates)
 
 
 def sketch_outlines(sketch_seg, sketch_graph: nx.Graph, candidates) -> dict | None:

@@ -38,6 +38,7 @@ from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchCon
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
 from ursim_core.matching.oriented import (
     candidate_overlaps,
+    nearest_orientations,
     orientations_to_try,
     prepare_oriented,
     reoriented,
@@ -125,8 +126,11 @@ def prepare(
     return with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
 
 
-def _prepare_one(sketch_seg, metric_seg, config: MatchConfig, *, progress=None, constraints=None) -> Prepared:
-    """:func:`prepare` of one segmentation of the sketch."""
+def _prepare_one(
+    sketch_seg, metric_seg, config: MatchConfig, *, progress=None, constraints=None, orientations=None
+) -> Prepared:
+    """:func:`prepare` of one segmentation of the sketch; with ``orientations``, only the
+    candidates nearest to them are tried (:func:`~ursim_core.matching.oriented.nearest_orientations`)."""
     config = config.resolved()
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
     constraints = constraints or None
@@ -141,6 +145,8 @@ def _prepare_one(sketch_seg, metric_seg, config: MatchConfig, *, progress=None, 
     if config.matcher == "overlay":
         return _prepare_overlay(sketch_seg, metric_seg, config, constraints)
     candidates = orientations_to_try(config, sketch_seg, metric_seg)
+    if orientations:
+        candidates = nearest_orientations(candidates, orientations)
     outlines = sketch_outlines(sketch_seg, sketch_graph, candidates)
     base = prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
     if constraints is not None:

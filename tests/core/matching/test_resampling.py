@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from ursim_core.matching import MatchConfig, MatchConstraints, match, prepare
+from ursim_core.matching import MatchConfig, MatchConstraints, match, match_prepared, prepare
 from ursim_core.matching.resampling import region_correspondence, vote_pairs, voted_result
 from ursim_core.segmentation import segment_canonical
 from ursim_core.segmentation.canonical import _turned
@@ -84,10 +84,30 @@ def test_a_resampled_sketch_is_matched_in_every_segmentation_and_voted(turned_pa
     # The voted pairs are in the first segmentation's regions, one to one.
     assert {a for a, _ in voted.pairs} <= set(sketch.graph.nodes)
     assert len({a for a, _ in voted.pairs}) == len(voted.pairs) == len({b for _, b in voted.pairs})
-    # Each answer alone, carried over: the vote keeps what a majority of them hold.
+    # Each answer alone, carried over: the vote keeps what at least half of them hold.
     answers = [(sketch.labels, match(sketch, plan, config=MatchConfig(resampling_vote=False)).pairs)]
-    answers += [(other.labels, match(other, plan).pairs) for other in sketch.resampled]
+    answers += [(labels, match_prepared(variant).pairs) for labels, variant in prepared.resampled.variants]
     assert sorted(voted.pairs) == sorted(vote_pairs(sketch.labels, answers, quorum=3))
+
+
+def test_the_other_segmentations_try_the_first_ones_finalist_orientations(turned_pair, monkeypatch):
+    from ursim_core.matching import pipeline
+
+    sketch, plan = turned_pair
+    made = []  # every orientation prepared after a segmentation's first
+    reoriented = pipeline.reoriented
+    monkeypatch.setattr(pipeline, "reoriented", lambda *args, **kw: made.append(args[2]) or reoriented(*args, **kw))
+    prepared = prepare(sketch, plan)
+    finalists = list(prepared.orientation_scan)
+    assert 1 < len(finalists) < 8  # the first segmentation screened eight and kept a few
+    # Eight for the first segmentation; the finalists only for each of the five others.
+    assert len(made) == 7 + 5 * (len(finalists) - 1)
+    for _, variant in prepared.resampled.variants:
+        tried = list(variant.orientation_scan)
+        assert 1 <= len(tried) <= len(finalists)
+        for degrees, mirrored in tried:
+            # The same reading, turned by the fraction of a degree the wall angles differ by.
+            assert any(flag == mirrored and abs((degrees - wanted + 180) % 360 - 180) < 3 for wanted, flag in finalists)
 
 
 def test_no_vote_when_switched_off_given_constraints_or_another_matcher(turned_pair):
