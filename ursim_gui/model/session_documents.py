@@ -269,8 +269,9 @@ class DocumentOperations:
                     segmentation, map_, method=ref.segmentation_method, params=ref.segmentation_params
                 )
             except UrsimError as error:
+                why = f"{error.field}: {error.problem}" if error.field else error.problem
                 warnings.append(
-                    f"{ref.path}: the sketch's other resamplings could not be made ({error.problem}); "
+                    f"{ref.path}: the sketch's other resamplings could not be made ({why}); "
                     f"matching uses its one segmentation"
                 )
         if ref.sha256 is not None and map_.sha256 is not None and ref.sha256.lower() != map_.sha256.lower():

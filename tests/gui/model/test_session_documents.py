@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 
 import cv2
@@ -17,6 +18,7 @@ from ursim_core.correspondences import (
     save_correspondences,
 )
 from ursim_core.errors import FormatError, MapError, UrsimError
+from ursim_core.segmentation import save_label_image
 from ursim_gui.model.jobs import SegmentJob
 from ursim_gui.model.session import AnnotationSession
 
@@ -190,6 +192,22 @@ def test_a_reopened_turned_sketch_is_segmented_in_its_resamplings_again(tmp_path
     assert [o.params for o in reopened.resampled] == [o.params for o in made.resampled]
     assert all(np.array_equal(a.labels, b.labels) for a, b in zip(reopened.resampled, made.resampled, strict=True))
     assert session.segmentation("metric").resampled == () and not session.dirty
+
+    # Parameters edited by hand into ones that cannot segment: the document still opens, on its
+    # label image, and says why matching it will use the one segmentation.
+    document = json.loads((tmp_path / "pair.json").read_text(encoding="utf-8"))
+    save_label_image(made, tmp_path / "sketch-labels.png")
+    document["maps"]["sketch"]["segmentation"]["labels"] = "sketch-labels.png"
+    document["maps"]["sketch"]["segmentation"]["params"]["doors"] = "x"
+    (tmp_path / "edited.json").write_text(json.dumps(document), encoding="utf-8")
+    recorder = Recorder(session)
+    session.open(tmp_path / "edited.json")
+    assert np.array_equal(session.segmentation("sketch").labels, made.labels)
+    assert session.segmentation("sketch").resampled == ()
+    ((message,),) = recorder.calls["error"]
+    assert "sketch.png" in message and "doors" in message and "one segmentation" in message
+    session.save(tmp_path / "again.json")  # what loads saves again
+    assert load_correspondences(tmp_path / "again.json").cliques == session.correspondences.cliques
 
 
 def test_open_errors_leave_the_session_unchanged(session, tmp_path):
