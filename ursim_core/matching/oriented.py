@@ -33,8 +33,9 @@ __all__ = [
 def orientations_to_try(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[float, bool]]:
     """The ``(degrees, mirrored)`` orientations worth trying: only those that can change the answer.
 
-    ``config.orientation`` other than ``'any'`` names one (or its two mirror readings); without the
-    position term only a mirror image changes the planar matcher's answer; otherwise the
+    ``config.orientation`` other than ``'any'`` names the one; without the position term only a
+    mirror image changes the planar matcher's answer (both readings, unless ``config.mirrored``
+    says which) and nothing changes the other graph matchers'; otherwise the
     candidates of :func:`~ursim_core.matching.orientation.orientation_candidates` from both maps'
     wall angles (read from their label images; 0 for bare graphs).
 
