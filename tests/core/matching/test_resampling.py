@@ -31,6 +31,25 @@ def test_ties_go_to_the_lower_region_and_walls_are_not_regions():
     assert region_correspondence(np.zeros((0, 0), int), np.zeros((0, 0), int)) == {}
 
 
+def test_the_correspondence_is_the_largest_overlap_pixel_by_pixel():
+    # A reference that counts every pixel in Python, on random label images with walls (-1),
+    # background (0), ties and regions that overlap nothing.
+    rng = np.random.default_rng(32)
+    for _ in range(300):
+        shape = tuple(rng.integers(0, 9, 2))
+        labels = rng.integers(-1, rng.integers(1, 7), shape)
+        other = rng.integers(-1, rng.integers(1, 7), shape)
+        if rng.random() < 0.5:  # mostly the same segmentation, as two resamplings are
+            other = np.where(rng.random(shape) < 0.8, labels, other)
+        counts: dict = {}
+        for a, b in zip(labels.ravel().tolist(), other.ravel().tolist(), strict=True):
+            if a > 0 and b > 0:
+                counts.setdefault(b, {}).setdefault(a, 0)
+                counts[b][a] += 1
+        expected = {b: min(row, key=lambda a: (-row[a], a)) for b, row in counts.items()}
+        assert region_correspondence(labels, other) == expected
+
+
 def test_a_pair_needs_the_quorum():
     answers = [(BASE, [(1, 10), (2, 20), (3, 30)]), (BASE, [(1, 10), (2, 21)]), (BASE, [(1, 10), (3, 30)])]
     assert vote_pairs(BASE, answers, quorum=2) == [(1, 10), (3, 30)]
@@ -88,6 +107,27 @@ def test_a_resampled_sketch_is_matched_in_every_segmentation_and_voted(turned_pa
     answers = [(sketch.labels, match(sketch, plan, config=MatchConfig(resampling_vote=False)).pairs)]
     answers += [(labels, match_prepared(variant).pairs) for labels, variant in prepared.resampled.variants]
     assert sorted(voted.pairs) == sorted(vote_pairs(sketch.labels, answers, quorum=3))
+
+
+def test_the_regions_are_carried_over_once_per_preparation_not_once_per_vote(turned_pair, monkeypatch):
+    from ursim_core.matching import resampling
+
+    sketch, plan = turned_pair
+    prepared = prepare(sketch, plan)
+    resampled = prepared.resampled
+    expected = [
+        region_correspondence(sketch.labels, labels) for labels in (sketch.labels, *(v[0] for v in resampled.variants))
+    ]
+    assert list(resampled.correspondences) == expected
+    assert expected[0] == {region: region for region in sketch.graph.nodes}
+    calls = []
+    monkeypatch.setattr(resampling, "region_correspondence", lambda *args: calls.append(args) or {})
+    for m in (0.1, 0.2, None):  # a sweep over m votes at every m
+        voted = match_prepared(prepared, m)
+        answers = [(sketch.labels, match_prepared(dataclasses.replace(prepared, resampled=None), m).pairs)]
+        answers += [(labels, match_prepared(variant, m).pairs) for labels, variant in resampled.variants]
+        assert sorted(voted.pairs) == sorted(vote_pairs(sketch.labels, answers, quorum=3, correspondences=expected))
+    assert not calls
 
 
 def test_the_other_segmentations_try_the_first_ones_finalist_orientations(turned_pair, monkeypatch):
