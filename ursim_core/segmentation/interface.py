@@ -27,9 +27,6 @@ __all__ = [
     "segment_canonical",
     "why_no_region",
     "resolve_params",
-    "read_label_array",
-    "load_label_image",
-    "save_label_image",
 ]
 
 
@@ -366,7 +363,7 @@ def with_resamplings(
     ``segment_canonical(..., resampled=True)`` makes them.
 
     For a canonical segmentation met again without them: its label image reloaded from a file
-    (:func:`load_label_image`, whose method is ``'label-image'``), say, when the method and the
+    (:func:`~ursim_core.segmentation.label_files.load_label_image`, whose method is ``'label-image'``), say, when the method and the
     (resolved) parameters that made it are known. Without them the planar matcher would match
     one segmentation of a sketch that was matched over six before, and answer otherwise.
     ``segmentation`` itself is returned when it has resamplings already, when ``params`` are not
@@ -403,77 +400,6 @@ def with_resamplings(
         regions=segmentation._regions,
         resampled=others,
     )
-
-
-def read_label_array(path: str | Path) -> np.ndarray:
-    """Read a label image file as an int32 array of the stored ids (0 = no region).
-
-    Accepts 8- or 16-bit single-channel images, and colour images whose channels are equal.
-    Raises :class:`~ursim_core.errors.SegmentationError` naming the file otherwise.
-    """
-    import cv2
-
-    from ursim_core.errors import SegmentationError
-
-    path = Path(path)
-    if not path.is_file():
-        raise SegmentationError("label image not found", path=path)
-    labels = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if labels is None:
-        raise SegmentationError("not a readable image", path=path)
-    if labels.ndim == 3:
-        channels = labels[..., :3]
-        if not (
-            np.array_equal(channels[..., 0], channels[..., 1]) and np.array_equal(channels[..., 0], channels[..., 2])
-        ):
-            raise SegmentationError("a label image must have one channel (grey, 8 or 16 bit), got colour", path=path)
-        labels = channels[..., 0]
-    if labels.dtype not in (np.uint8, np.uint16):
-        raise SegmentationError(f"a label image must be 8 or 16 bit, got {labels.dtype}", path=path)
-    return labels.astype(np.int32)
-
-
-def load_label_image(path: str | Path, *, shape: tuple[int, int] | None = None) -> Segmentation:
-    """Load a label image (8- or 16-bit single-channel PNG, 0 = no region) as a segmentation.
-
-    Region ids are kept as stored, so ids in a correspondence file that references this
-    image stay valid.
-
-    Parameters
-    ----------
-    path : str or Path
-        The label image.
-    shape : (rows, cols), optional
-        Required size (the map's); a mismatch raises :class:`~ursim_core.errors.SegmentationError`.
-    """
-
-    from ursim_core.errors import SegmentationError
-    from ursim_core.segmentation.regions import region_table
-
-    path = Path(path)
-    labels = read_label_array(path)
-    if shape is not None and tuple(labels.shape) != tuple(shape):
-        raise SegmentationError(
-            f"label image is {labels.shape[0]}x{labels.shape[1]} (rows x cols) but the map is {shape[0]}x{shape[1]}",
-            path=path,
-        )
-    return Segmentation(labels=labels, regions=region_table(labels), method="label-image", params={}, source=path)
-
-
-def save_label_image(segmentation: Segmentation, path: str | Path) -> None:
-    """Write the label image as a 16-bit PNG (0 = no region), atomically."""
-    import cv2
-
-    from ursim_core.errors import SegmentationError
-    from ursim_core.io.atomic import atomic_write_bytes
-
-    labels = segmentation.labels
-    if labels.size and int(labels.max()) > 65535:
-        raise SegmentationError(f"{int(labels.max())} regions do not fit a 16-bit label image", path=path)
-    ok, encoded = cv2.imencode(".png", labels.astype(np.uint16))
-    if not ok:
-        raise SegmentationError("could not encode the label image", path=path)
-    atomic_write_bytes(Path(path), encoded.tobytes())
 
 
 def why_no_region(free: np.ndarray, *, method: str = "maoris") -> str:

@@ -274,6 +274,6 @@ def load_label_array(path: str | Path) -> np.ndarray:
     ...     load_label_array(path).tolist()
     [[0, 1, 2]]
     """
-    from ursim_core.segmentation.interface import read_label_array
+    from ursim_core.segmentation.label_files import read_label_array
 
     return relabel_in_raster_order(read_label_array(path))
