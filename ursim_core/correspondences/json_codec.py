@@ -11,7 +11,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import math
 import os
 import warnings
 from collections.abc import Callable, Sequence
@@ -28,12 +27,10 @@ from ursim_core.correspondences.json_text import (
 from ursim_core.correspondences.schema import (
     CURRENT_VERSION,
     FORMAT_NAME,
-    OutOfRange,
-    field_path,
-    json_type,
     short,
     validate,
 )
+from ursim_core.correspondences.strict_json import MAX_DEPTH, check_values, parse_json_object
 from ursim_core.correspondences.values import (
     CLIQUE_KEYS,
     MAP_KEYS,
@@ -101,9 +98,9 @@ def load_correspondences(path: str | os.PathLike, *, sketch_map=None, metric_map
     path = Path(path)
     raw = read_file_bytes(path, what="correspondence file")
     with paused_garbage_collection():
-        document = _parse_json_object(raw, path)
+        document = parse_json_object(raw, path)
         document = _upgrade(document, path)
-        _check_values(document, path)
+        check_values(document, path, known_clique_keys=_CLIQUE_KEY_SET)
         validate(document, path)
         _check_unique_ids(document, path)
         folder = Path(os.path.abspath(path)).parent
@@ -246,7 +243,9 @@ def correspondences_to_json(
     # The cliques were checked when they were made (Clique.__post_init__ applies the schema's
     # rules); the rest and every unknown value are checked here, so whatever is saved loads.
     document = _to_document(corr, folder, cliques=[])
-    _check_values({**document, "cliques": [clique.extra for clique in corr.cliques]}, path)
+    check_values(
+        {**document, "cliques": [clique.extra for clique in corr.cliques]}, path, known_clique_keys=_CLIQUE_KEY_SET
+    )
     validate(document, path)
     try:
         # Everything but the cliques goes through json.dumps; the cliques, nearly all of a big
@@ -264,105 +263,6 @@ def correspondences_to_json(
     except UnicodeEncodeError:
         text = escape_lone_surrogates(text)
     return text + "\n"
-
-
-# Deeper than any file URSIM writes (6 levels) by far, shallow enough for every recursive
-# step after parsing (schema, encoder) to stay far from Python's recursion limit.
-MAX_DEPTH = 64
-# 4300 is Python's own limit for int(str); anything this long is garbage for URSIM anyway.
-_MAX_INT_DIGITS = 4000
-
-
-def _parse_json_object(raw: bytes, path: Path) -> dict:
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        raise FormatError(f"not UTF-8 text (byte {error.start}): not a JSON file", path=path) from None
-    hooks = {"object_pairs_hook": _reject_duplicate_keys, "parse_constant": _reject_constant}
-    try:
-        try:
-            document = json.loads(text, parse_float=_parse_float, **hooks)
-        except ValueError as error:
-            if isinstance(error, json.JSONDecodeError) or "digits" not in str(error):
-                raise
-            # An integer too long for int(): parse again, keeping it as a value with a place.
-            document = json.loads(text, parse_float=_parse_float, parse_int=_parse_int, **hooks)
-    except json.JSONDecodeError as error:
-        raise FormatError(
-            f"not valid JSON: {error.msg} at line {error.lineno}, column {error.colno}", path=path
-        ) from None
-    except _InvalidJsonValue as error:
-        raise FormatError(f"not valid JSON for URSIM: {error}", path=path) from None
-    except RecursionError:
-        raise FormatError(
-            f"nested deeper than {MAX_DEPTH} levels (arrays or objects inside each other)", path=path
-        ) from None
-    if not isinstance(document, dict):
-        raise FormatError(f"expected a JSON object at the top level, got {json_type(document)}", path=path)
-    return document
-
-
-def _parse_float(text: str):
-    value = float(text)
-    return value if math.isfinite(value) else OutOfRange(text)
-
-
-def _parse_int(text: str):
-    return OutOfRange(text) if len(text) > _MAX_INT_DIGITS else int(text)
-
-
-def _check_values(document: dict, path: Path) -> None:
-    """Refuse what the schema does not look at: too deep, or numbers out of range.
-
-    Walks everything but the known fields of the cliques (the schema checks those), with an
-    explicit stack, so depth costs no recursion.
-    """
-    stack: list[tuple[Any, tuple, int]] = []
-    for key, value in document.items():
-        if key != "cliques" or type(value) is not list:
-            stack.append((value, (key,), 1))
-            continue
-        for index, clique in enumerate(value):
-            if type(clique) is not dict:
-                stack.append((clique, ("cliques", index), 2))
-                continue
-            for name in clique.keys() - _CLIQUE_KEY_SET:
-                stack.append((clique[name], ("cliques", index, name), 3))
-    while stack:
-        value, where, depth = stack.pop()
-        if type(value) is OutOfRange:
-            raise FormatError(value.problem(), path=path, field=field_path(where))
-        if isinstance(value, (dict, list)):
-            if depth >= MAX_DEPTH:
-                raise FormatError(
-                    f"nested deeper than {MAX_DEPTH} levels (arrays or objects inside each other)",
-                    path=path,
-                    field=field_path(where),
-                )
-            items = value.items() if isinstance(value, dict) else enumerate(value)
-            stack.extend((item, (*where, key), depth + 1) for key, item in items)
-
-
-class _InvalidJsonValue(ValueError):
-    pass
-
-
-def _reject_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict:
-    # json.loads silently keeps the last of two equal keys; a hand-edited file
-    # would lose data without notice.
-    result = dict(pairs)
-    if len(result) != len(pairs):
-        seen: set[str] = set()
-        for key, _ in pairs:
-            if key in seen:
-                shown = repr(key) if len(key) <= 60 else repr(key[:57]) + "..."
-                raise _InvalidJsonValue(f"key {shown} appears twice in one object")
-            seen.add(key)
-    return result
-
-
-def _reject_constant(name: str) -> Any:
-    raise _InvalidJsonValue(f"{name} is not a JSON number")
 
 
 def _upgrade(document: dict, path: Path) -> dict:
