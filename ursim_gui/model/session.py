@@ -34,6 +34,7 @@ from ursim_gui.model.session_documents import DocumentOperations
 from ursim_gui.model.session_edits import EditOperations
 from ursim_gui.model.session_evaluation import EvaluationOperations
 from ursim_gui.model.session_label_edits import LabelEditOperations
+from ursim_gui.model.session_selection import SelectionOperations
 from ursim_gui.model.session_values import (
     APP_TITLE,
     AUTOSAVE_ORIGIN_KEY,
@@ -63,7 +64,9 @@ def _untouched_automatic(clique: Clique) -> bool:
     return clique.source == "auto" and clique.status is None and not clique.note and clique_label(clique) is None
 
 
-class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations, LabelEditOperations):
+class AnnotationSession(
+    SelectionOperations, DocumentOperations, EditOperations, EvaluationOperations, LabelEditOperations
+):
     """State and operations of one annotation window (Qt-free).
 
     Parameters
@@ -231,19 +234,6 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         return self._evaluation
 
     @property
-    def selection(self) -> dict[str, frozenset[int]]:
-        return dict(self._selection)
-
-    @property
-    def selected_clique(self) -> int | None:
-        return self._selected_clique
-
-    @property
-    def focus(self) -> tuple[str, int] | None:
-        """``(side, region)`` the user last picked by itself (what U unlinks), or None."""
-        return self._focus
-
-    @property
     def history(self) -> History[Correspondences]:
         """The undo history (read it; change it only through the session's operations)."""
         return self._history
@@ -388,63 +378,6 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self._announce_value_change(was_dirty)
         self.history_changed.emit()
 
-    # ------------------------------------------------------------------ selection
-    def select(self, side: str, regions: Iterable[int], *, add: bool = False) -> None:
-        """Select regions of ``side``.
-
-        With ``add`` the regions join the current selection and the selected clique
-        stays (so a region can be added to it); without, they replace the side's
-        selection and the selected clique is cleared.
-
-        A plain selection after a selected clique also clears the other side: those
-        regions were the clique's, not picked by the user, and linking must not pull them in.
-        """
-        _check_side(side)
-        chosen = frozenset(int(region) for region in regions)
-        new_selection = dict(self._selection)
-        new_selection[side] = new_selection[side] | chosen if add else chosen
-        if not add and self._selected_clique is not None:
-            new_selection[SIDES[1 - SIDES.index(side)]] = frozenset()
-        new_clique = self._selected_clique if add else None
-        new_focus = (side, next(iter(chosen))) if len(chosen) == 1 else (self._focus if add else None)
-        if new_selection == self._selection and new_clique == self._selected_clique and new_focus == self._focus:
-            return
-        self._selection = new_selection
-        self._selected_clique = new_clique
-        self._focus = new_focus
-        self.selection_changed.emit()
-
-    def select_clique(self, clique_id: int | None, *, focus: tuple[str, int] | None = None) -> None:
-        """Select a clique (its regions become the selection on both sides), or none.
-
-        ``focus`` is the ``(side, region)`` the user clicked to select it (what U then
-        unlinks from this clique); None when it was picked from a list.
-        """
-        if clique_id is None:
-            if self._selected_clique is None:
-                return
-            self._selected_clique = None
-            self._focus = None
-            self.selection_changed.emit()
-            return
-        clique = self._corr.clique(clique_id)
-        self._selected_clique = clique.id
-        self._focus = None if focus is None else (_check_side(focus[0]), int(focus[1]))
-        self._selection = {
-            "sketch": frozenset(clique.sketch_regions),
-            "metric": frozenset(clique.metric_regions),
-        }
-        self.selection_changed.emit()
-
-    def clear_selection(self) -> None:
-        """Select nothing."""
-        if self._selected_clique is None and not any(self._selection.values()):
-            return
-        self._selection = {side: frozenset() for side in SIDES}
-        self._selected_clique = None
-        self._focus = None
-        self.selection_changed.emit()
-
     def undo(self) -> bool:
         """Undo the last edit; False when there is nothing to undo."""
         if not self._history.can_undo:
@@ -493,13 +426,6 @@ class AnnotationSession(DocumentOperations, EditOperations, EvaluationOperations
         self.correspondences_changed.emit()
         if self.dirty != was_dirty:
             self.dirty_changed.emit(self.dirty)
-
-    def _clear_side_selection(self, side: str) -> bool:
-        changed = bool(self._selection[side]) or self._selected_clique is not None
-        self._selection = {**self._selection, side: frozenset()}
-        self._selected_clique = None
-        self._focus = None
-        return changed
 
     def _checked_regions(self, side: str, regions: Iterable[int], *, stale_hint: bool = False) -> tuple[int, ...]:
         chosen = tuple(dict.fromkeys(int(region) for region in regions))

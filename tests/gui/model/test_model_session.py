@@ -1,4 +1,4 @@
-"""AnnotationSession (ursim_gui.model.session): undo/redo, dirty, maps and re-segmentation, queries, selection."""
+"""AnnotationSession (ursim_gui.model.session): undo/redo, dirty, maps and re-segmentation, queries."""
 
 from __future__ import annotations
 
@@ -164,24 +164,6 @@ def test_partners_clique_of_and_colours(session):
     assert all(0 <= channel <= 255 for colour in colours for channel in colour)
     overlay = pytest.importorskip("ursim_gui.model.region_style")
     assert all(color_of_clique(i) == overlay.clique_colour(i) for i in range(1, 100))
-
-
-def test_selection_rules_and_signals(session):
-    clique_id = session.link([1, 2], [5])
-    recorder = Recorder(session)
-    session.select_clique(clique_id)
-    assert session.selection == {"sketch": frozenset({1, 2}), "metric": frozenset({5})}
-    session.select("sketch", [4], add=True)  # extend the clique's selection, keep the clique
-    assert session.selected_clique == clique_id and session.selection["sketch"] == frozenset({1, 2, 4})
-    session.select("metric", [6])  # a plain click starts a new selection
-    assert session.selected_clique is None and session.selection["metric"] == frozenset({6})
-    session.select("metric", [6])  # unchanged: no signal
-    session.clear_selection()
-    session.clear_selection()
-    assert session.selection == {"sketch": frozenset(), "metric": frozenset()}
-    assert recorder.count("selection_changed") == 4
-    with pytest.raises(KeyError):
-        session.select_clique(99)
 
 
 def test_match_config_defaults_to_the_core_defaults(session):
