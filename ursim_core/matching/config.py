@@ -147,6 +147,13 @@ class MatchConfig:
         --augment angles=... --cross-validate resampling_vote=true,false``: true in every fold;
         its quorum was chosen on these sketches); the upright and quarter-turned sketches are not
         resampled, so nothing changes there. Six matches of a turned sketch instead of one.
+    vote_by_reading : bool
+        With ``resampling_vote``: True (default) lets only the answers that read the sketch the way
+        most of them do (the same mirror image, turned within a few degrees) vote on pairs, half
+        of them needed; an answer in another orientation pairs regions of another reading, not
+        votes for or against this one's. False: every answer votes, half of all needed (rounds
+        30-31). On the 18 KTH sketches turned by 15, 30, ..., 345 degrees, in sample: mean F1 /
+        place accuracy 0.7253 / 0.7287 -> 0.7297 / 0.7361 (round 32).
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -205,6 +212,7 @@ class MatchConfig:
     signature_refit: bool = True
     keep_refit: bool = True
     resampling_vote: bool = True
+    vote_by_reading: bool = True
     hypothesis_score: str = "signature"
     score_weight: float = 8.0
     orientation: Any = "any"
@@ -279,7 +287,7 @@ class MatchConfig:
             raise ParameterError(
                 f"must be a non-negative integer, not {self.position_refits!r}", field="position_refits"
             )
-        for name in ("signature_refit", "keep_refit", "resampling_vote"):
+        for name in ("signature_refit", "keep_refit", "resampling_vote", "vote_by_reading"):
             if not isinstance(getattr(self, name), bool):
                 raise ParameterError(f"must be true or false, not {getattr(self, name)!r}", field=name)
         if not self.times:

@@ -76,6 +76,31 @@ def test_the_voted_result_takes_the_orientation_most_answers_read():
     assert voted_result(first, BASE, [(BASE, turned)]).orientation == first.orientation
 
 
+def test_only_the_answers_of_the_most_common_reading_vote_on_pairs():
+    first = match(_graph(), _graph())
+    assert first.config.vote_by_reading
+
+    def answer(degrees, pairs):
+        return dataclasses.replace(first, orientation=(degrees, False), pairs=pairs)
+
+    first = answer(0.0, [(1, 10)])
+    alike = [answer(0.4, [(1, 10), (2, 20)]), answer(359.7, [(1, 10), (2, 20)])]
+    turned = [answer(180.2, [(2, 21), (3, 30)]) for _ in range(3)]
+    # Three read it as the first does, three half a turn round: a tie, which the first's reading
+    # wins; of its three answers two are half.
+    voted = voted_result(first, BASE, [(BASE, a) for a in alike + turned])
+    assert voted.pairs == [(1, 10), (2, 20)] and voted.orientation == (0.0, False)
+    assert voted.resampling_votes == 6
+    # Every answer voting, half of all six needed: the other reading's pairs win.
+    every = voted_result(
+        dataclasses.replace(first, config=MatchConfig(vote_by_reading=False)), BASE, [(BASE, a) for a in alike + turned]
+    )
+    assert every.pairs == [(1, 10), (2, 21), (3, 30)]
+    # Four of six half a turn round: theirs is the reading, the orientation the earliest of them.
+    voted = voted_result(first, BASE, [(BASE, a) for a in alike[:1] + turned + [answer(179.9, [(2, 21)])]])
+    assert voted.pairs == [(2, 21), (3, 30)] and voted.orientation == (180.2, False)
+
+
 def _graph():
     import networkx as nx
 
