@@ -41,7 +41,19 @@ __all__ = [
     "oriented_graph",
     "region_outlines",
     "transform_points",
+    "turn_between",
 ]
+
+
+def turn_between(first_degrees: float, second_degrees: float) -> float:
+    """The smaller turn between two angles, in degrees (0 to 180).
+
+    Examples
+    --------
+    >>> turn_between(359.5, 0.5), turn_between(90.0, 270.0), turn_between(10.0, -10.0)
+    (1.0, 180.0, 20.0)
+    """
+    return abs((float(first_degrees) - float(second_degrees) + 180.0) % 360.0 - 180.0)
 
 
 #: Wall-angle differences below this many degrees are taken as none: the candidates are then the

@@ -15,7 +15,7 @@ import networkx as nx
 
 from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.descriptors import blend_positions, pair_descriptors
-from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines
+from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines, turn_between
 from ursim_core.matching.planar import planar_graph
 from ursim_core.matching.results import Prepared
 from ursim_core.segmentation.canonical import wall_angle
@@ -83,7 +83,7 @@ def nearest_orientations(candidates, wanted) -> list[tuple[float, bool]]:
         same_flag = [candidate for candidate in candidates if candidate[1] == mirrored]
         if not same_flag:
             continue
-        nearest = min(same_flag, key=lambda candidate: abs((candidate[0] - degrees + 180.0) % 360.0 - 180.0))
+        nearest = min(same_flag, key=lambda candidate: turn_between(candidate[0], degrees))
         if nearest not in chosen:
             chosen.append(nearest)
     return chosen or list(candidates)

@@ -206,9 +206,10 @@ def most_common_reading(orientations: Sequence[tuple[float, bool]]) -> list[int]
     [0]
     """
 
+    from ursim_core.matching.orientation import turn_between  # imports networkx; this module does not
+
     def same(first, second) -> bool:
-        turn = abs((float(first[0]) - float(second[0]) + 180.0) % 360.0 - 180.0)
-        return bool(first[1]) == bool(second[1]) and turn < SAME_READING
+        return bool(first[1]) == bool(second[1]) and turn_between(first[0], second[0]) < SAME_READING
 
     groups = [[j for j, other in enumerate(orientations) if same(one, other)] for one in orientations]
     return max(groups, key=len)  # max keeps the first of equal lengths: the earliest reading's
