@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ursim_core.matching.alignment_memo import arc_pairs
 from ursim_core.matching.edit_distance import COMPILED_CELLS, PackedOrders, aligned_index_pairs
 
 __all__ = ["PACKED_CELLS", "arc", "expand_locked"]
@@ -64,11 +65,12 @@ def expand_locked(first_order, second_order, matched, second_positions, same, ca
         first_arc = arc(first_order, first_position, next_first)
         second_arc = arc(second_order, second_position, next_second)
         if first_arc and second_arc:
-            # Expansions from different seeds meet the same arcs again: align each pair of arcs once.
+            # Expansions from different seeds meet the same arcs again: align each pair of arcs
+            # once per match (and once per content across matches, see alignment_memo).
             arc_key = (tuple(first_arc), tuple(second_arc))
             aligned = cache.get(arc_key)
             if aligned is None:
-                aligned = cache[arc_key] = aligned_index_pairs(first_arc, second_arc, same)
+                aligned = cache[arc_key] = arc_pairs(first_arc, second_arc, same)
             candidates.extend(aligned)
     return candidates
 

@@ -52,8 +52,9 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
+from ursim_core.matching.alignment_memo import seed_alignment
 from ursim_core.matching.arcs import expand_locked
-from ursim_core.matching.edit_distance import COMPILED_CELLS, aligned_pairs, cyclic_align
+from ursim_core.matching.edit_distance import COMPILED_CELLS
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -372,14 +373,14 @@ def planar_match(
         consumed.add(seed)
         seeds_expanded += 1
         seed_first, seed_second = seed
-        alignment = cyclic_align(
+        reflected, seed_pairs = seed_alignment(
             first.neighbours[seed_first],
             second.neighbours[seed_second],
             same,
             rotation_search=rotation_search,
             reflections=reflections,
         )
-        first_orders = reversed_first if alignment.reflected else first.neighbours
+        first_orders = reversed_first if reflected else first.neighbours
         seen_first = {seed_first}
         seen_second = {seed_second}
         queue = deque()
@@ -392,7 +393,7 @@ def planar_match(
                 # The fixed pairs are locks from the start, and are in the hypothesis already.
                 matched.update(fixed)
                 pairs = list(fixed) + ([] if seed in fixed else [seed])
-        for pair in aligned_pairs(alignment):
+        for pair in seed_pairs:
             if pair[0] in seen_first or pair[1] in seen_second or pair in forbidden:
                 continue
             queue.append(pair)
@@ -413,7 +414,6 @@ def planar_match(
         # rebuilt each time.
         pop, push, keep = queue.popleft, queue.append, pairs.append
         see_first, see_second, consume = seen_first.add, seen_second.add, consumed.add
-        reflected = alignment.reflected
         while queue:
             pair = pop()
             vertex, partner = pair
