@@ -38,6 +38,7 @@ from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchCon
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
 from ursim_core.matching.oriented import (
     candidate_overlaps,
+    carried_overlaps,
     nearest_orientations,
     orientations_to_try,
     prepare_oriented,
@@ -127,10 +128,13 @@ def prepare(
 
 
 def _prepare_one(
-    sketch_seg, metric_seg, config: MatchConfig, *, progress=None, constraints=None, orientations=None
+    sketch_seg, metric_seg, config: MatchConfig, *, progress=None, constraints=None, orientations=None, overlaps=None
 ) -> Prepared:
     """:func:`prepare` of one segmentation of the sketch; with ``orientations``, only the
-    candidates nearest to them are tried (:func:`~ursim_core.matching.oriented.nearest_orientations`)."""
+    candidates nearest to them are tried (:func:`~ursim_core.matching.oriented.nearest_orientations`);
+    with ``overlaps`` (another segmentation's ``Prepared.orientation_overlaps``), each candidate
+    takes the free-space overlap of the nearest orientation measured there
+    (:func:`~ursim_core.matching.oriented.carried_overlaps`) instead of being fitted again."""
     config = config.resolved()
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
     constraints = constraints or None
@@ -181,9 +185,14 @@ def _prepare_one(
     else:
         prepared_candidates = {index: candidate(index) for index in range(len(candidates))}
         finalists = range(len(candidates))
-    overlaps = (
-        candidate_overlaps(config, sketch_seg, metric_seg, candidates, list(finalists)) if len(finalists) > 1 else {}
-    )
+    if len(finalists) < 2:
+        overlaps = {}
+    else:
+        # Another segmentation of the sketch in the same frame measured them already: its free
+        # space differs from this one's by resampling noise (see resampling.with_resampled).
+        overlaps = carried_overlaps(overlaps, candidates, finalists) if overlaps else None
+        if overlaps is None:
+            overlaps = candidate_overlaps(config, sketch_seg, metric_seg, candidates, list(finalists))
 
     def ranked(cost: float, index: int) -> float:
         # The hypothesis score divided by the free-space overlap in that orientation: both must
@@ -222,7 +231,10 @@ def _prepare_one(
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(
-        prepared, orientation_scan=scan, chosen=dataclasses.replace(result, orientation_scan=scan)
+        prepared,
+        orientation_scan=scan,
+        chosen=dataclasses.replace(result, orientation_scan=scan),
+        orientation_overlaps={candidates[index]: value for index, value in overlaps.items()},
     )
 
 

@@ -48,6 +48,7 @@ import math
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import networkx as nx
 import numpy as np
@@ -80,6 +81,30 @@ class PlanarGraph:
     @property
     def n_vertices(self) -> int:
         return len(self.nodes)
+
+    # What every planar match derives from the graph, computed once per graph: a sweep matches
+    # the same two graphs at 20 values of m, and a turned sketch in several orientations.
+    @cached_property
+    def neighbour_sets(self) -> list[set]:
+        return [set(order) for order in self.neighbours]
+
+    @cached_property
+    def positions(self) -> list[dict]:
+        """The position of every neighbour in each vertex's cyclic order."""
+        return [{vertex: k for k, vertex in enumerate(order)} for order in self.neighbours]
+
+    @cached_property
+    def reversed_neighbours(self) -> list[list[int]]:
+        return [order[::-1] for order in self.neighbours]
+
+    @cached_property
+    def branching(self) -> list[bool]:
+        """Vertices with more than one neighbour (the only ones whose arcs can hold pairs)."""
+        return [len(order) > 1 for order in self.neighbours]
+
+    @cached_property
+    def adjacency_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        return _adjacency_ends(self.neighbour_sets)
 
 
 @dataclass(frozen=True)
@@ -356,14 +381,12 @@ def planar_match(
         best_pairs, best_cost, best_structure, hypotheses = list(fixed), math.inf, math.inf, 0
     consumed = set()
     seeds_expanded = 0
-    first_sets = [set(order) for order in first.neighbours]
-    second_sets = [set(order) for order in second.neighbours]
-    second_positions = [{vertex: k for k, vertex in enumerate(order)} for order in second.neighbours]
-    first_ends, second_ends = _adjacency_ends(first_sets), _adjacency_ends(second_sets)
-    reversed_first = [order[::-1] for order in first.neighbours]
+    first_sets, second_sets = first.neighbour_sets, second.neighbour_sets
+    second_positions = second.positions
+    first_ends, second_ends = first.adjacency_ends, second.adjacency_ends
+    reversed_first = first.reversed_neighbours
     second_neighbours = second.neighbours
-    branching_first = [len(order) > 1 for order in first.neighbours]
-    branching_second = [len(order) > 1 for order in second.neighbours]
+    branching_first, branching_second = first.branching, second.branching
     arc_cache: dict = {}
     packed: dict = {}
     alternatives: list = []

@@ -39,6 +39,9 @@ class Prepared:
     #: The sketch's other segmentations, prepared (:class:`~ursim_core.matching.resampling.Resampled`):
     #: :func:`match_prepared` votes over their answers.
     resampled: Any = None
+    #: The free-space overlap of every candidate orientation that was measured, ``{(degrees, mirrored):
+    #: overlap}``; the sketch's other segmentations take theirs from it (see ``oriented.carried_overlaps``).
+    orientation_overlaps: dict = field(default_factory=dict)
 
     @functools.cached_property
     def index_constraints(self) -> IndexConstraints | None:

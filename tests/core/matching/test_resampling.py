@@ -175,6 +175,30 @@ def test_the_other_segmentations_try_the_first_ones_finalist_orientations(turned
             assert any(flag == mirrored and abs((degrees - wanted + 180) % 360 - 180) < 3 for wanted, flag in finalists)
 
 
+def test_the_sketch_is_fitted_once_and_the_others_take_the_first_ones_overlaps(turned_pair, monkeypatch):
+    from ursim_core.matching import pipeline
+
+    sketch, plan = turned_pair
+    fitted = []
+    measure = pipeline.candidate_overlaps
+    monkeypatch.setattr(pipeline, "candidate_overlaps", lambda *args: fitted.append(args[1]) or measure(*args))
+    prepared = prepare(sketch, plan)
+    assert fitted == [sketch]  # the first segmentation only
+    measured = prepared.orientation_overlaps
+    assert len(measured) == 8 and all(0 < value <= 1 for value in measured.values())
+    for _, variant in prepared.resampled.variants:
+        for (degrees, mirrored), score in variant.orientation_scan.items():
+            # Each orientation's score is its answer's cost over the overlap of the nearest
+            # orientation of the first segmentation (the same reading).
+            nearest = min(
+                (o for o in measured if o[1] == mirrored), key=lambda o: abs((o[0] - degrees + 180) % 360 - 180)
+            )
+            assert abs((nearest[0] - degrees + 180) % 360 - 180) < 3
+            if len(variant.orientation_scan) > 1:
+                assert variant.orientation_overlaps[(degrees, mirrored)] == measured[nearest]
+                assert score > 0
+
+
 def test_no_vote_when_switched_off_given_constraints_or_another_matcher(turned_pair):
     sketch, plan = turned_pair
     assert match(sketch, plan, config=MatchConfig(resampling_vote=False)).resampling_votes == 0
