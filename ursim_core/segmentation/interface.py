@@ -8,6 +8,7 @@ and their adjacency graph (:func:`ursim_core.segmentation.graph.region_graph`) w
 
 from __future__ import annotations
 
+import os
 import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -386,11 +387,24 @@ def with_resamplings(
     free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
     if not turned_back(free):
         return segmentation
+
     # The parameters are resolved already: no preset on top of them.
-    others = tuple(
-        segment(free, method=method, preset=None, params={**params, "canonical_turn_offset": offset})
-        for offset in (None, *RESAMPLING_OFFSETS)
-    )
+    def resampling(offset):
+        return segment(free, method=method, preset=None, params={**params, "canonical_turn_offset": offset})
+
+    # The first here: it loads (or builds) the kernels once, before any thread could.
+    others = [resampling(None)]
+    workers = min(len(RESAMPLING_OFFSETS), _usable_cpus())
+    if workers > 1:
+        # The resamplings are independent, and the kernels, OpenCV and the turns release the GIL:
+        # on two CPUs the five of a KTH sketch take 0.27 s instead of 0.44 s (round 33). The
+        # labels are those made one after the other; map keeps the offsets' order.
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="ursim-resampling") as pool:
+            others.extend(pool.map(resampling, RESAMPLING_OFFSETS))
+    else:
+        others.extend(resampling(offset) for offset in RESAMPLING_OFFSETS)
     return Segmentation(
         segmentation.labels,
         segmentation._graph,
@@ -398,8 +412,13 @@ def with_resamplings(
         segmentation.params,
         segmentation.source,
         regions=segmentation._regions,
-        resampled=others,
+        resampled=tuple(others),
     )
+
+
+def _usable_cpus() -> int:
+    """CPUs this process may run on (a container or taskset may allow fewer than the machine has)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 def why_no_region(free: np.ndarray, *, method: str = "maoris") -> str:

@@ -112,6 +112,31 @@ def test_resamplings_are_made_only_for_a_canonical_segmentation_of_a_turned_map(
     assert with_resamplings(one, free, method="maoris", params=one.params) is one
 
 
+@pytest.mark.parametrize("cpus", [1, 2, 8])
+def test_the_resamplings_made_on_threads_are_those_made_one_after_the_other(monkeypatch, cpus):
+    import threading
+
+    from ursim_core.segmentation import interface
+
+    free = _plan_turned(25.0)
+    base = segment_canonical(free, preset="default")
+    threads = set()
+    original = interface.segment
+
+    def recorded(*args, **kwargs):
+        threads.add(threading.current_thread().name)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(interface, "segment", recorded)
+    monkeypatch.setattr(interface, "_usable_cpus", lambda: cpus)
+    made = with_resamplings(base, free, method="maoris", params=base.params)
+    assert [o.params["canonical_turn_offset"] for o in made.resampled] == [None, *RESAMPLING_OFFSETS]
+    for other in made.resampled:
+        assert np.array_equal(other.labels, original(free, method="maoris", params=other.params).labels)
+    on_pool = {name for name in threads if name.startswith("ursim-resampling")}
+    assert bool(on_pool) == (cpus > 1) and len(on_pool) <= min(cpus, len(RESAMPLING_OFFSETS))
+
+
 def test_the_resampled_segmentations_survive_pickling():
     seg = segment_canonical(_plan_turned(25.0), preset="default", resampled=True)
     copy = pickle.loads(pickle.dumps(seg))
