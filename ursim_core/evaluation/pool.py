@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import concurrent.futures
+import os
 from collections.abc import Callable
 from pathlib import Path
+
+from ursim_core.cpus import THREADS_VARIABLE, usable_cpus
 
 __all__ = ["ProgressCallback", "Progress", "completed", "pixel_count"]
 
@@ -34,7 +37,10 @@ def completed(function, items, *, workers: int, initializer=None, initargs=()):
         for item in items:
             yield item, function(item)
         return
-    pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, initializer=initializer, initargs=initargs)
+    threads = max(1, usable_cpus() // workers)
+    pool = concurrent.futures.ProcessPoolExecutor(
+        max_workers=workers, initializer=_start_worker, initargs=(threads, initializer, initargs)
+    )
     try:
         futures = {pool.submit(function, item): item for item in items}
         for future in concurrent.futures.as_completed(futures):
@@ -43,6 +49,15 @@ def completed(function, items, *, workers: int, initializer=None, initargs=()):
         pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown(wait=True)
+
+
+def _start_worker(threads: int, initializer, initargs) -> None:
+    # The workers already share the CPUs: threads inside each (a turned sketch's resamplings)
+    # would only compete with the other workers (an evaluation of 36 turned sketches on two
+    # workers: 16.5-16.9 s with two threads each, 15.6-15.8 s with one).
+    os.environ[THREADS_VARIABLE] = str(threads)
+    if initializer is not None:
+        initializer(*initargs)
 
 
 def pixel_count(path: Path) -> int:

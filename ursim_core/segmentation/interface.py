@@ -8,12 +8,13 @@ and their adjacency graph (:func:`ursim_core.segmentation.graph.region_graph`) w
 
 from __future__ import annotations
 
-import os
 import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ursim_core.cpus import usable_cpus
 
 if TYPE_CHECKING:  # networkx loads with the region graph, not with this module
     import networkx as nx
@@ -394,7 +395,7 @@ def with_resamplings(
 
     # The first here: it loads (or builds) the kernels once, before any thread could.
     others = [resampling(None)]
-    workers = min(len(RESAMPLING_OFFSETS), _usable_cpus())
+    workers = min(len(RESAMPLING_OFFSETS), usable_cpus())
     if workers > 1:
         # The resamplings are independent, and the kernels, OpenCV and the turns release the GIL:
         # on two CPUs the five of a KTH sketch take 0.27 s instead of 0.44 s (round 33). The
@@ -414,11 +415,6 @@ def with_resamplings(
         regions=segmentation._regions,
         resampled=tuple(others),
     )
-
-
-def _usable_cpus() -> int:
-    """CPUs this process may run on (a container or taskset may allow fewer than the machine has)."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 def why_no_region(free: np.ndarray, *, method: str = "maoris") -> str:

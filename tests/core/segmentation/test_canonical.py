@@ -128,7 +128,7 @@ def test_the_resamplings_made_on_threads_are_those_made_one_after_the_other(monk
         return original(*args, **kwargs)
 
     monkeypatch.setattr(interface, "segment", recorded)
-    monkeypatch.setattr(interface, "_usable_cpus", lambda: cpus)
+    monkeypatch.setattr(interface, "usable_cpus", lambda: cpus)
     made = with_resamplings(base, free, method="maoris", params=base.params)
     assert [o.params["canonical_turn_offset"] for o in made.resampled] == [None, *RESAMPLING_OFFSETS]
     for other in made.resampled:

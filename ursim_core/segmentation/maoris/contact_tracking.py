@@ -7,22 +7,17 @@ rows at the same time, one thread each (the kernels release the GIL), and the ba
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from ursim_core.cpus import usable_cpus
 from ursim_core.segmentation.maoris.compiled import kernels
 
 __all__ = ["start_tracking"]
 
 # Smaller images are counted on one thread: starting threads costs more.
 _BAND_PIXELS = 1 << 20
-
-
-def _usable_cpus() -> int:
-    """CPUs this process may run on (a container or taskset may allow fewer than the machine has)."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 def start_tracking(labels, width, alive, *, bands=None, compacted=None):
@@ -42,7 +37,7 @@ def start_tracking(labels, width, alive, *, bands=None, compacted=None):
     compiled = kernels()
     original, compact_of, n = compiled._compact_labels(labels, alive) if compacted is None else compacted
     if bands is None:
-        bands = min(_usable_cpus(), 4) if labels.size >= _BAND_PIXELS else 1
+        bands = min(usable_cpus(), 4) if labels.size >= _BAND_PIXELS else 1
     rows = labels.size // width
     edges = [row * width for row in np.linspace(0, rows, bands + 1).astype(int)]
     if bands == 1:

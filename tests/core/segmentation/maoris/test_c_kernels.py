@@ -196,7 +196,7 @@ def test_every_c_kernel_gives_numba_results_and_leaves_its_arguments_alike(c_mod
             values = quantize(inscribed_circle_image(free))
             merge_ripples(remove_small_zones(ZoneGraph(flat_zones(values), values), min_size=10))
         monkeypatch.setattr(contact_tracking, "_BAND_PIXELS", 0)
-        monkeypatch.setattr(contact_tracking, "_usable_cpus", lambda: 3)
+        monkeypatch.setattr(contact_tracking, "usable_cpus", lambda: 3)
         labels = maoris_labels(maps[1], PRESETS["robot"])
         padded = np.pad(labels.astype(np.int32), 2)
         alive = np.zeros(int(padded.max()) + 1, bool)

@@ -134,7 +134,7 @@ def test_ahead_of_time_kernels_give_the_jit_labels(monkeypatch):
         labels[way] = [maoris_labels(free, PRESETS[preset]) for free in maps for preset in ("default", "sketch")]
         with monkeypatch.context() as banded:
             banded.setattr(contact_tracking, "_BAND_PIXELS", 0)
-            banded.setattr(contact_tracking, "_usable_cpus", lambda: 3)
+            banded.setattr(contact_tracking, "usable_cpus", lambda: 3)
             labels[way].append(maoris_labels(maps[1], PRESETS["robot"]))
     compiled.forget()
     assert max(int(image.max()) for image in labels["jit"]) > 5

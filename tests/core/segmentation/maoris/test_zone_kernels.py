@@ -255,7 +255,7 @@ def test_segmentation_is_the_same_with_contacts_counted_in_bands(monkeypatch):
     free = make_large_building(600, seed=2).free
     expected = maoris_labels(free, PRESETS["robot"])
     monkeypatch.setattr(_contacts, "_BAND_PIXELS", 0)
-    monkeypatch.setattr(_contacts, "_usable_cpus", lambda: 3)
+    monkeypatch.setattr(_contacts, "usable_cpus", lambda: 3)
     np.testing.assert_array_equal(maoris_labels(free, PRESETS["robot"]), expected)
 
 
