@@ -6,6 +6,8 @@ save of the project goes through.
 
 Modules: ``maps`` (the Map value, load_map, map_from_array, pixel <-> world), ``images``
 (file bytes -> decoded pixels -> grey), ``ros_yaml`` (ROS map_server YAML, as nav2 reads it),
+``occupancy_grid`` (ROS OccupancyGrid messages in and out), ``map_saver`` (a map_server YAML and
+its image, as nav2's map_saver writes them),
 ``reading`` (bounded reads of regular files only: no pipe, device or multi-GB file),
 ``atomic`` (atomic writes; stale temporary files cleaned).
 
@@ -21,7 +23,7 @@ import lazy_loader as _lazy
 
 __getattr__, __dir__, __all__ = _lazy.attach(
     __name__,
-    submodules=["atomic", "images", "maps", "occupancy_grid", "reading", "ros_yaml"],
+    submodules=["atomic", "images", "map_saver", "maps", "occupancy_grid", "reading", "ros_yaml"],
     submod_attrs={
         "atomic": ["atomic_write_bytes", "atomic_write_text"],
         "maps": [
@@ -41,11 +43,9 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "map_from_occupancy_grid",
             "occupancy_grid_from_map",
             "occupancy_from_free",
-            "save_map_yaml",
             "yaw_from_quaternion",
             "quaternion_from_yaw",
-            "SAVE_MODES",
-            "SAVE_DEFAULTS",
         ],
+        "map_saver": ["save_map_yaml", "SAVE_MODES", "SAVE_DEFAULTS"],
     },
 )

@@ -16,8 +16,8 @@ from ursim_core.cli import goal as goal_cli
 from ursim_core.cli import route as route_cli
 from ursim_core.correspondences import Clique, Correspondences, MapRef, save_correspondences
 from ursim_core.errors import UrsimError
+from ursim_core.io.map_saver import save_map_yaml
 from ursim_core.io.maps import load_map
-from ursim_core.io.occupancy_grid import save_map_yaml
 
 
 def two_rooms(path: Path, *, door: bool = True) -> Path:

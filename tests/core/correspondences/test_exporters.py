@@ -129,8 +129,8 @@ def test_export_file_uses_the_referenced_labels_and_yaml_map(tmp_path):
     import cv2
 
     from ursim_core.correspondences.exporters import export_file
+    from ursim_core.io.map_saver import save_map_yaml
     from ursim_core.io.maps import load_map
-    from ursim_core.io.occupancy_grid import save_map_yaml
 
     labels = labels_with_hole()
     cv2.imwrite(str(tmp_path / "metric.labels.png"), labels.astype(np.uint16))
