@@ -10,7 +10,9 @@ answers agree where the segmentations do: :func:`vote_pairs` carries every answe
 segmentation's regions and keeps the pairs that at least half of them hold (:func:`voted_result`):
 0.682 -> 0.720 mean F1 and 0.695 -> 0.720 place accuracy on the 360 resampled turns. Since round
 32 only the answers that read the sketch the way most of them do vote on pairs
-(:func:`most_common_reading`, ``MatchConfig.vote_by_reading``).
+(:func:`most_common_reading`, ``MatchConfig.vote_by_reading``). Since round 33 ten segmentations
+vote instead of six (``MatchConfig.vote_segmentations``): the vote's matches had become cheap
+enough for it.
 
 ``segment_canonical(..., resampled=True)`` makes the other segmentations
 (``Segmentation.resampled``); :func:`ursim_core.matching.prepare` prepares each when
@@ -245,6 +247,7 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
     (round 33)."""
     config = prepared.config
     others = getattr(sketch_seg, "resampled", ())
+    others = tuple(others)[: config.vote_segmentations - 1]
     if not others or not config.resampling_vote or config.matcher != "planar" or prepared.constraints is not None:
         return prepared
     finalists = tuple(prepared.orientation_scan) or None

@@ -39,7 +39,9 @@ _MIN_ANGLE = 3.0
 #: The other turns back (degrees added to the wall angle) of a map that is resampled onto its wall
 #: axes: MAORIS's regions change with the resampling, so the matcher votes over the answers of
 #: these segmentations and of the map segmented as it is (:mod:`ursim_core.matching.resampling`).
-RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0)
+#: Rounds 30-32 had the first four; the half degrees came in round 33 (ten segmentations, see
+#: ``MatchConfig.vote_segmentations``, which votes over the first ones of this order).
+RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0, -1.5, -0.5, 0.5, 1.5)
 
 
 def wall_angle(free: np.ndarray) -> float:

@@ -337,7 +337,7 @@ def segment_canonical(
     ``resampled=True``: when the map is resampled onto its wall axes (walls 3 degrees or more off
     the image axes), also segment it turned back by the other angles of
     :data:`~ursim_core.segmentation.canonical.RESAMPLING_OFFSETS` and not turned back, into
-    ``Segmentation.resampled`` (five more segmentations), for the matcher to vote over. The
+    ``Segmentation.resampled`` (nine more segmentations), for the matcher to vote over. The
     regions of a resampled sketch depend on the resampling: on the 18 KTH sketches turned by
     15, 30, ..., 345 degrees, the better of two such segmentations per sketch scores 0.76 mean F1
     against 0.69 for the default one (round 30).
@@ -367,7 +367,7 @@ def with_resamplings(
     For a canonical segmentation met again without them: its label image reloaded from a file
     (:func:`~ursim_core.segmentation.label_files.load_label_image`, whose method is ``'label-image'``), say, when the method and the
     (resolved) parameters that made it are known. Without them the planar matcher would match
-    one segmentation of a sketch that was matched over six before, and answer otherwise.
+    one segmentation of a sketch that was matched over ten before, and answer otherwise.
     ``segmentation`` itself is returned when it has resamplings already, when ``params`` are not
     canonical (or are one of the resamplings), or when the map is on its wall axes (no
     resampling to vary).
@@ -398,7 +398,7 @@ def with_resamplings(
     workers = min(len(RESAMPLING_OFFSETS), usable_cpus())
     if workers > 1:
         # The resamplings are independent, and the kernels, OpenCV and the turns release the GIL:
-        # on two CPUs the five of a KTH sketch take 0.27 s instead of 0.44 s (round 33). The
+        # on two CPUs the five of rounds 30-32 took 0.27 s instead of 0.44 s for a KTH sketch (round 33). The
         # labels are those made one after the other; map keeps the offsets' order.
         from concurrent.futures import ThreadPoolExecutor
 

@@ -244,7 +244,7 @@ def test_a_turned_sketch_is_matched_in_its_resamplings_and_voted(tmp_path, capsy
     cv2.imwrite(str(tmp_path / "plan.png"), plan.free.astype(np.uint8) * 255)
     out = tmp_path / "out"
     assert main(["match", str(tmp_path / "sketch.png"), str(tmp_path / "plan.png"), "-o", str(out)]) == 0
-    assert "voted over 6 resamplings" in capsys.readouterr().out
+    assert "voted over 10 resamplings" in capsys.readouterr().out
     corr = load_correspondences(out / "correspondences.json")
     assert corr.extra["matcher"]["config"]["resampling_vote"] is True
     # The voted pairs are in the regions of the label image written beside them.

@@ -7,10 +7,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from ursim_core.errors import ParameterError
 from ursim_core.matching import MatchConfig, MatchConstraints, match, match_prepared, prepare
-from ursim_core.matching.resampling import region_correspondence, vote_pairs, voted_result
+from ursim_core.matching.resampling import most_common_reading, region_correspondence, vote_pairs, voted_result
 from ursim_core.segmentation import segment_canonical
-from ursim_core.segmentation.canonical import _turned
+from ursim_core.segmentation.canonical import RESAMPLING_OFFSETS, _turned
 from ursim_core.synth import make_pair
 
 BASE = np.array([[1, 1, 2, 2, 3, 3]])
@@ -118,20 +119,55 @@ def turned_pair():
     return segment_canonical(turned, preset="default", resampled=True), segment_canonical(plan.free, preset="default")
 
 
+def _voted_by_hand(sketch, first_answer, variants, m=None, correspondences=None):
+    """The vote of ``voted_result`` written out: the answers of the most common reading, half of them."""
+    answers = [(sketch.labels, first_answer), *((labels, match_prepared(variant, m)) for labels, variant in variants)]
+    voters = most_common_reading([tuple(result.orientation) for _, result in answers])
+    return vote_pairs(
+        sketch.labels,
+        [(answers[index][0], answers[index][1].pairs) for index in voters],
+        quorum=(len(voters) + 1) // 2,
+        correspondences=[correspondences[index] for index in voters] if correspondences else None,
+    )
+
+
 def test_a_resampled_sketch_is_matched_in_every_segmentation_and_voted(turned_pair):
     sketch, plan = turned_pair
-    assert len(sketch.resampled) == 5
+    assert len(sketch.resampled) == len(RESAMPLING_OFFSETS) + 1 == 9
     prepared = prepare(sketch, plan)
-    assert prepared.resampled is not None and len(prepared.resampled.variants) == 5
+    assert prepared.resampled is not None and len(prepared.resampled.variants) == 9
     voted = match(sketch, plan)
-    assert voted.resampling_votes == 6
+    assert voted.resampling_votes == MatchConfig().vote_segmentations == 10
     # The voted pairs are in the first segmentation's regions, one to one.
     assert {a for a, _ in voted.pairs} <= set(sketch.graph.nodes)
     assert len({a for a, _ in voted.pairs}) == len(voted.pairs) == len({b for _, b in voted.pairs})
     # Each answer alone, carried over: the vote keeps what at least half of them hold.
-    answers = [(sketch.labels, match(sketch, plan, config=MatchConfig(resampling_vote=False)).pairs)]
-    answers += [(labels, match_prepared(variant).pairs) for labels, variant in prepared.resampled.variants]
-    assert sorted(voted.pairs) == sorted(vote_pairs(sketch.labels, answers, quorum=3))
+    first = match(sketch, plan, config=MatchConfig(resampling_vote=False))
+    assert sorted(voted.pairs) == sorted(_voted_by_hand(sketch, first, prepared.resampled.variants))
+
+
+@pytest.mark.parametrize("count", [1, 2, 6, 12])
+def test_the_first_segmentations_vote_as_many_as_configured(turned_pair, count):
+    sketch, plan = turned_pair
+    config = MatchConfig(vote_segmentations=count)
+    prepared = prepare(sketch, plan, config)
+    if count == 1:
+        assert prepared.resampled is None and match(sketch, plan, config=config).resampling_votes == 0
+        return
+    used = min(count, 1 + len(sketch.resampled))
+    variants = prepared.resampled.variants
+    # The first resamplings, in the order of RESAMPLING_OFFSETS.
+    assert [labels for labels, _ in variants] == [other.labels for other in sketch.resampled[: used - 1]]
+    voted = match(sketch, plan, config=config)
+    assert voted.resampling_votes == used
+    first = match(sketch, plan, config=MatchConfig(resampling_vote=False))
+    assert sorted(voted.pairs) == sorted(_voted_by_hand(sketch, first, variants))
+
+
+@pytest.mark.parametrize("count", [0, -1, True, 2.0, "6"])
+def test_the_number_of_voting_segmentations_is_checked(count):
+    with pytest.raises(ParameterError, match="vote_segmentations"):
+        MatchConfig(vote_segmentations=count)
 
 
 def test_the_regions_are_carried_over_once_per_preparation_not_once_per_vote(turned_pair, monkeypatch):
@@ -149,9 +185,9 @@ def test_the_regions_are_carried_over_once_per_preparation_not_once_per_vote(tur
     monkeypatch.setattr(resampling, "region_correspondence", lambda *args: calls.append(args) or {})
     for m in (0.1, 0.2, None):  # a sweep over m votes at every m
         voted = match_prepared(prepared, m)
-        answers = [(sketch.labels, match_prepared(dataclasses.replace(prepared, resampled=None), m).pairs)]
-        answers += [(labels, match_prepared(variant, m).pairs) for labels, variant in resampled.variants]
-        assert sorted(voted.pairs) == sorted(vote_pairs(sketch.labels, answers, quorum=3, correspondences=expected))
+        first = match_prepared(dataclasses.replace(prepared, resampled=None), m)
+        by_hand = _voted_by_hand(sketch, first, resampled.variants, m, correspondences=expected)
+        assert sorted(voted.pairs) == sorted(by_hand)
     assert not calls
 
 
@@ -165,8 +201,8 @@ def test_the_other_segmentations_try_the_first_ones_finalist_orientations(turned
     prepared = prepare(sketch, plan)
     finalists = list(prepared.orientation_scan)
     assert 1 < len(finalists) < 8  # the first segmentation screened eight and kept a few
-    # Eight for the first segmentation; the finalists only for each of the five others.
-    assert len(made) == 7 + 5 * (len(finalists) - 1)
+    # Eight for the first segmentation; the finalists only for each of the nine others.
+    assert len(made) == 7 + 9 * (len(finalists) - 1) and len(prepared.resampled.variants) == 9
     for _, variant in prepared.resampled.variants:
         tried = list(variant.orientation_scan)
         assert 1 <= len(tried) <= len(finalists)
