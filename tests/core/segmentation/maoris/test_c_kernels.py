@@ -304,6 +304,19 @@ def test_flat_zones_labelled_in_bands_are_numbas(c_module):
     assert snake == got[-2, 0] and size[snake] > 2048 * 1024 // 2  # one zone through every band
 
 
+@pytest.mark.parametrize("threads", ["1", "3", " 2 ", "0", "many"])
+def test_the_labels_do_not_depend_on_ursim_threads(c_module, monkeypatch, threads):
+    """``URSIM_THREADS`` caps the C kernels' threads as ``ursim_core.cpus.usable_cpus`` does (1: the
+    image whole; 3: three bands, whatever the machine; not a positive integer: ignored); the
+    labels are numba's whatever it says."""
+    from ursim_core.segmentation.maoris.kernels import flat_zones
+
+    values = _band_crossing_values()
+    want = flat_zones.label_flat_zones(values, np.empty(values.shape, np.int32))
+    monkeypatch.setenv("URSIM_THREADS", threads)
+    assert np.array_equal(c_module.label_flat_zones(values, np.empty(values.shape, np.int32)), want)
+
+
 def test_centre_rectangles_scanned_in_bands_are_numbas(c_module):
     """The disc centres of 2**21 px and more are scanned in bands of rows: the rectangles,
     those that go on across a band's first row joined again, are numba's, in numba's order."""

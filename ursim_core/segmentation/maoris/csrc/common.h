@@ -312,9 +312,22 @@ static inline void prefault_join(Prefault *job)
 #define BAND_MIN_PIXELS ((int64_t)1 << 21)
 #define MAX_BANDS 4
 
-/* CPUs this process may run on (a container or taskset may allow fewer than the machine has). */
+/* CPUs this process may use, as ursim_core.cpus.usable_cpus: URSIM_THREADS when it is a positive
+ * integer (a process pool gives each worker its share), else the CPUs it may run on (a container
+ * or taskset may allow fewer than the machine has). */
 static inline int64_t usable_cpus(void)
 {
+    const char *told = getenv("URSIM_THREADS");
+    if (told != NULL) {
+        while (*told == ' ' || *told == '\t')
+            told++;
+        char *end = NULL;
+        long value = strtol(told, &end, 10);
+        while (end != NULL && (*end == ' ' || *end == '\t' || *end == '\n'))
+            end++;
+        if (end != told && end != NULL && *end == '\0' && value > 0 && *told >= '0' && *told <= '9')
+            return (int64_t)value;
+    }
 #ifdef CPU_COUNT
     cpu_set_t set;
     if (sched_getaffinity(0, sizeof(set), &set) == 0) {
