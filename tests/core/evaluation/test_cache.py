@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 
 from ursim_core.evaluation.cache import SegmentationJob, read_cached, segment_job, store_segmentation
-from ursim_core.segmentation.canonical import _turned
+from ursim_core.segmentation.canonical import RESAMPLING_OFFSETS, _turned
 from ursim_core.synth import make_pair
 
 LOAD = {"threshold": 250, "nonzero_free": False}
@@ -26,7 +26,7 @@ def test_a_resampled_job_keeps_its_other_segmentations_on_disk(tmp_path):
     plain = SegmentationJob.of(path, "default", LOAD, {}, canonical=True)
     assert job.key != plain.key and not SegmentationJob.of(path, "default", LOAD, {}, resampled=True).resampled
     segmentation = segment_job(job)
-    assert len(segmentation.resampled) == 5 and segment_job(plain).resampled == ()
+    assert len(segmentation.resampled) == len(RESAMPLING_OFFSETS) + 1 and segment_job(plain).resampled == ()
     store_segmentation(job, segmentation, None, tmp_path / "cache")
     found = read_cached(job, {}, tmp_path / "cache")
     assert np.array_equal(found.labels, segmentation.labels) and found.params["canonical"] is True
