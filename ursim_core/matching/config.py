@@ -290,25 +290,16 @@ class MatchConfig:
             raise ParameterError(f"must be 'sketch', 'metric' or null, not {self.input_kind!r}", field="input_kind")
         if self.mirrored not in (None, True, False):
             raise ParameterError(f"must be true, false or null, not {self.mirrored!r}", field="mirrored")
-        if (
-            isinstance(self.position_refits, bool)
-            or not isinstance(self.position_refits, int)
-            or self.position_refits < 0
+        for name, smallest, wording in (
+            ("position_refits", 0, "a non-negative integer"),
+            ("vote_segmentations", 1, "a positive integer"),
         ):
-            raise ParameterError(
-                f"must be a non-negative integer, not {self.position_refits!r}", field="position_refits"
-            )
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < smallest:
+                raise ParameterError(f"must be {wording}, not {value!r}", field=name)
         for name in ("signature_refit", "keep_refit", "resampling_vote", "vote_by_reading"):
             if not isinstance(getattr(self, name), bool):
                 raise ParameterError(f"must be true or false, not {getattr(self, name)!r}", field=name)
-        if (
-            isinstance(self.vote_segmentations, bool)
-            or not isinstance(self.vote_segmentations, int)
-            or self.vote_segmentations < 1
-        ):
-            raise ParameterError(
-                f"must be a positive integer, not {self.vote_segmentations!r}", field="vote_segmentations"
-            )
         if not self.times:
             raise ParameterError("needs at least one time", field="times")
         if not self.m_grid:
