@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ursim_core.evaluation.packing import Packed, packed_apart
 from ursim_core.evaluation.pool import Progress, completed, pixel_count
 
 __all__ = ["SegmentationJob", "segment_job", "segment_all", "read_cached", "store_segmentation"]
@@ -187,15 +188,21 @@ def _write_disk_cache(path: Path, segmentation) -> None:
 
 
 def read_cached(job: SegmentationJob, memory_cache, cache_dir):
-    """The job's segmentation from the memory cache, else the disk cache (kept in memory), or None."""
-    found = None
-    if memory_cache is not None:
-        found = memory_cache.get(job.key)
+    """The job's segmentation from the memory cache, else the disk cache (kept in memory), or None.
+
+    The memory cache may hold it with its resamplings packed (:class:`~.packing.Packed`, what
+    :func:`segment_all` keeps when asked to pack): it is returned whole.
+    """
+    found = _from_memory(job, memory_cache)
     if found is None and cache_dir is not None:
         found = _read_disk_cache(_disk_cache_path(Path(cache_dir), job), job)
         if found is not None and memory_cache is not None:
             memory_cache[job.key] = found
-    return found
+    return found.whole() if isinstance(found, Packed) else found
+
+
+def _from_memory(job: SegmentationJob, memory_cache):
+    return memory_cache.get(job.key) if memory_cache is not None else None
 
 
 def store_segmentation(job: SegmentationJob, segmentation, memory_cache, cache_dir) -> None:
@@ -206,36 +213,61 @@ def store_segmentation(job: SegmentationJob, segmentation, memory_cache, cache_d
         _write_disk_cache(_disk_cache_path(Path(cache_dir), job), segmentation)
 
 
-def split_cached(jobs, reporter: Progress, memory_cache, cache_dir):
+def split_cached(jobs, reporter: Progress, memory_cache, cache_dir, packed: dict | None = None):
     """The cached segmentations by job key, and the jobs still to run, biggest map first.
 
     Biggest first so that the workers (local processes or a Dask cluster) finish together.
+    ``packed``: see :func:`segment_all`.
     """
     segmentations: dict[str, Any] = {}
     to_run = []
     for job in jobs:
-        found = read_cached(job, memory_cache, cache_dir)
+        found = _from_memory(job, memory_cache)
+        if packed is None or not isinstance(found, Packed):
+            found = read_cached(job, memory_cache, cache_dir)
         if found is None:
             to_run.append(job)
         else:
-            segmentations[job.key] = found
+            segmentations[job.key] = _kept(job, found, memory_cache, packed)
             reporter.step(f"segment {job.path.name} (cached)")
     to_run.sort(key=lambda job: -pixel_count(job.path))
     return segmentations, to_run
 
 
-def record_segmentation(job, segmentation, segmentations: dict, reporter: Progress, memory_cache, cache_dir):
+def record_segmentation(
+    job, segmentation, segmentations: dict, reporter: Progress, memory_cache, cache_dir, packed: dict | None = None
+):
     """Keep a computed segmentation: in the result, in the caches, and say so."""
-    segmentations[job.key] = segmentation
     store_segmentation(job, segmentation, memory_cache, cache_dir)
+    segmentations[job.key] = _kept(job, segmentation, memory_cache, packed)
     turned = f" {job.augment}" if job.augment else ""
     reporter.step(f"segment {job.path.name}{turned}: {segmentation.n_regions} regions")
 
 
-def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir):
-    """Segmentations by job key, from the caches or computed biggest map first."""
-    segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir)
+def _kept(job: SegmentationJob, found, memory_cache, packed: dict | None):
+    """What the result keeps of a segmentation (or of a :class:`~.packing.Packed` one): all of it,
+    or with ``packed`` its resamplings packed into ``packed[job.key]``, the memory cache holding
+    the packed form too (:mod:`ursim_core.evaluation.packing`)."""
+    if packed is None:
+        return found
+    if not isinstance(found, Packed):
+        found = Packed(*packed_apart(found))
+        if memory_cache is not None:
+            memory_cache[job.key] = found
+    if found.resamplings is not None:
+        packed[job.key] = found.resamplings
+    return found.alone
+
+
+def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir, *, packed: dict | None = None):
+    """Segmentations by job key, from the caches or computed biggest map first.
+
+    ``packed``: a dict that receives, by job key, the resamplings of every segmentation that has
+    some, packed (:func:`ursim_core.evaluation.packing.packed_apart`); the segmentations returned
+    then have none. The caches keep them whole.
+    """
+    segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir, packed)
     cached = len(jobs) - len(to_run)
     for job, segmentation in completed(segment_job, to_run, workers=workers):
-        record_segmentation(job, segmentation, segmentations, reporter, memory_cache, cache_dir)
+        record_segmentation(job, segmentation, segmentations, reporter, memory_cache, cache_dir, packed)
     return segmentations, cached

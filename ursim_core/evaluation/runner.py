@@ -302,8 +302,12 @@ def run_evaluation(
             if client is not scheduler:
                 stack.callback(client.close)
         segment_started = time.perf_counter()
+        # The resamplings of turned sketches are kept packed until a task needs them.
+        packed: dict = {}
         if client is None:
-            segmentations, cached = segment_all(distinct_jobs, workers, reporter, segmentation_cache, cache_dir)
+            segmentations, cached = segment_all(
+                distinct_jobs, workers, reporter, segmentation_cache, cache_dir, packed=packed
+            )
         else:
             segmentations, futures, cached = segment_all_dask(
                 client, distinct_jobs, reporter, segmentation_cache, cache_dir
@@ -334,7 +338,7 @@ def run_evaluation(
             for variant in variants
         ]
         if client is None:
-            rows = run_tasks(tasks, segmentations, workers, reporter)
+            rows = run_tasks(tasks, segmentations, workers, reporter, packed)
         else:
             rows = run_tasks_dask(client, tasks, futures, reporter)
     matching_s = time.perf_counter() - match_started

@@ -154,24 +154,31 @@ class MatchTask:
         return (self.name, self.augment, self.model, self.matcher, self.variant)
 
 
-#: Segmentations of a worker process, handed over once by the pool initializer.
+#: Segmentations of a worker process (and the packed resamplings of some), handed over once by
+#: the pool initializer.
 _WORKER_SEGMENTATIONS: dict[str, Any] = {}
+_WORKER_PACKED: dict[str, Any] = {}
 
 
-def _init_worker(segmentations: dict[str, Any]) -> None:
-    global _WORKER_SEGMENTATIONS
-    _WORKER_SEGMENTATIONS = segmentations
+def _init_worker(segmentations: dict[str, Any], packed: dict[str, Any] | None = None) -> None:
+    global _WORKER_SEGMENTATIONS, _WORKER_PACKED
+    _WORKER_SEGMENTATIONS, _WORKER_PACKED = segmentations, packed or {}
 
 
 def _run_task_in_worker(task: MatchTask) -> list[RunRow]:
-    return run_task(task, _WORKER_SEGMENTATIONS)
+    return run_task(task, _WORKER_SEGMENTATIONS, _WORKER_PACKED)
 
 
-def run_task(task: MatchTask, segmentations: dict[str, Any]) -> list[RunRow]:
-    """Prepare once, match at every m (and auto), score against every annotator."""
+def run_task(task: MatchTask, segmentations: dict[str, Any], packed: dict[str, Any] | None = None) -> list[RunRow]:
+    """Prepare once, match at every m (and auto), score against every annotator.
+
+    ``packed``: resamplings packed apart from their segmentations by job key
+    (:func:`ursim_core.evaluation.cache.segment_all`), unpacked here for the sketch's vote.
+    """
+    from ursim_core.evaluation.packing import with_unpacked
     from ursim_core.matching import match_prepared, prepare
 
-    sketch_seg = segmentations[task.sketch_key]
+    sketch_seg = with_unpacked(segmentations[task.sketch_key], (packed or {}).get(task.sketch_key))
     metric_seg = segmentations[task.metric_key]
     place_labels = segmentations[task.place_key].labels
     # What place accuracy needs of each annotator's ground truth does not depend on m.
@@ -215,17 +222,23 @@ def run_task(task: MatchTask, segmentations: dict[str, Any]) -> list[RunRow]:
     return rows
 
 
-def run_tasks(tasks: list[MatchTask], segmentations: dict[str, Any], workers: int, reporter: Progress) -> list[RunRow]:
+def run_tasks(
+    tasks: list[MatchTask],
+    segmentations: dict[str, Any],
+    workers: int,
+    reporter: Progress,
+    packed: dict[str, Any] | None = None,
+) -> list[RunRow]:
     # Largest problems first so the workers finish together; the segmentations reach each
     # worker once through the pool initializer instead of once per task.
     order = sorted(
         tasks, key=lambda t: -(segmentations[t.sketch_key].n_regions * segmentations[t.metric_key].n_regions)
     )
     if workers <= 1 or len(order) < 2:
-        finished = completed(functools.partial(run_task, segmentations=segmentations), order, workers=1)
+        finished = completed(functools.partial(run_task, segmentations=segmentations, packed=packed), order, workers=1)
     else:
         finished = completed(
-            _run_task_in_worker, order, workers=workers, initializer=_init_worker, initargs=(segmentations,)
+            _run_task_in_worker, order, workers=workers, initializer=_init_worker, initargs=(segmentations, packed)
         )
     rows: list[RunRow] = []
     for task, task_rows in finished:
