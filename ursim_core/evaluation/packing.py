@@ -102,20 +102,10 @@ def packed_apart(segmentation: Any) -> tuple[Any, PackedResamplings | None]:
     resampled = getattr(segmentation, "resampled", ())
     if not resampled:
         return segmentation, None
-    from ursim_core.segmentation import Segmentation
-
     items = tuple(
         (pack_labels(other.labels), other.regions, other.method, other.params, other.source) for other in resampled
     )
-    alone = Segmentation(
-        segmentation.labels,
-        segmentation._graph,
-        segmentation.method,
-        segmentation.params,
-        segmentation.source,
-        regions=segmentation._regions,
-    )
-    return alone, PackedResamplings(items)
+    return segmentation.with_resampled(()), PackedResamplings(items)
 
 
 def with_unpacked(segmentation: Any, packed: PackedResamplings | None) -> Any:
@@ -128,15 +118,7 @@ def with_unpacked(segmentation: Any, packed: PackedResamplings | None) -> Any:
         Segmentation(unpack_labels(labels), None, method, params, source, regions=regions)
         for labels, regions, method, params, source in packed.items
     )
-    return Segmentation(
-        segmentation.labels,
-        segmentation._graph,
-        segmentation.method,
-        segmentation.params,
-        segmentation.source,
-        regions=segmentation._regions,
-        resampled=resampled,
-    )
+    return segmentation.with_resampled(resampled)
 
 
 @dataclass(frozen=True)

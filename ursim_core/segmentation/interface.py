@@ -109,6 +109,23 @@ class Segmentation:
     def __repr__(self) -> str:
         return f"Segmentation(method={self.method!r}, n_regions={self.n_regions}, shape={tuple(self.labels.shape)})"
 
+    def with_resampled(self, resampled: tuple[Segmentation, ...]) -> Segmentation:
+        """The same segmentation (labels, regions, graph shared) with ``resampled`` as its other
+        segmentations.
+
+        Examples
+        --------
+        >>> from ursim_core.segmentation.regions import region_table
+        >>> labels = np.array([[1, 1, 2]], np.int32)
+        >>> seg = Segmentation(labels, regions=region_table(labels))
+        >>> other = seg.with_resampled((seg,))
+        >>> other.labels is seg.labels, len(other.resampled), seg.resampled
+        (True, 1, ())
+        """
+        return Segmentation(
+            self.labels, self._graph, self.method, self.params, self.source, regions=self._regions, resampled=resampled
+        )
+
     @property
     def graph(self) -> nx.Graph:
         if self._graph is None:
@@ -406,15 +423,7 @@ def with_resamplings(
             others.extend(pool.map(resampling, RESAMPLING_OFFSETS))
     else:
         others.extend(resampling(offset) for offset in RESAMPLING_OFFSETS)
-    return Segmentation(
-        segmentation.labels,
-        segmentation._graph,
-        segmentation.method,
-        segmentation.params,
-        segmentation.source,
-        regions=segmentation._regions,
-        resampled=tuple(others),
-    )
+    return segmentation.with_resampled(tuple(others))
 
 
 def why_no_region(free: np.ndarray, *, method: str = "maoris") -> str:
