@@ -264,7 +264,7 @@ def segment_all(jobs, workers: int, reporter: Progress, memory_cache, cache_dir,
 
     ``packed``: a dict that receives, by job key, the resamplings of every segmentation that has
     some, packed (:func:`ursim_core.evaluation.packing.packed_apart`); the segmentations returned
-    then have none. The caches keep them whole.
+    then have none. The disk cache keeps them whole, the memory cache packed.
     """
     segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir, packed)
     cached = len(jobs) - len(to_run)
