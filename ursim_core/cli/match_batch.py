@@ -163,21 +163,16 @@ def _summary_csv(records: list[dict[str, Any]]) -> str:
 
 
 def _run_local(pairs, out, options, workers, progress):
-    import concurrent.futures
     import functools
 
+    from ursim_core.evaluation.pool import completed
+
+    # The evaluation's pool: pairs in order on one worker, else processes that are each told
+    # their share of the CPUs (a turned sketch's resamplings are segmented on threads).
     function = functools.partial(run_pair, out=out, options=options)
-    if workers <= 1 or len(pairs) < 2:
-        for index, pair in enumerate(pairs, start=1):
-            yield function(pair)
-            progress(index, text=pair["name"])
-        return
-    with concurrent.futures.ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(function, pair) for pair in pairs]
-        for index, future in enumerate(concurrent.futures.as_completed(futures), start=1):
-            record = future.result()
-            progress(index, text=record["name"])
-            yield record
+    for index, (_, record) in enumerate(completed(function, pairs, workers=workers), start=1):
+        progress(index, text=record["name"])
+        yield record
 
 
 def _run_dask(pairs, out, options, scheduler, progress):
