@@ -17,6 +17,7 @@ from typing import Any
 
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation.cache import record_segmentation, segment_job, split_cached
+from ursim_core.evaluation.packing import with_unpacked
 from ursim_core.evaluation.pool import Progress
 from ursim_core.evaluation.results import RunRow
 from ursim_core.evaluation.tasks import MatchTask, run_task, sorted_rows
@@ -45,17 +46,24 @@ def _run_task_with(task: MatchTask, sketch, metric, place) -> list[RunRow]:
 
 
 def segment_all_dask(client, jobs, reporter: Progress, memory_cache, cache_dir):
-    """Segmentations by job key and their futures on the cluster (cached ones are scattered)."""
+    """Segmentations by job key and their futures on the cluster (cached ones are scattered).
+
+    The cluster holds them whole; here a turned sketch's resamplings are kept packed, as in the
+    local evaluation (:mod:`ursim_core.evaluation.packing`): the tasks read the futures.
+    """
     from distributed import as_completed
 
-    segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir)
-    futures: dict[str, Any] = {key: client.scatter(found) for key, found in segmentations.items()}
+    packed: dict[str, Any] = {}
+    segmentations, to_run = split_cached(jobs, reporter, memory_cache, cache_dir, packed)
+    futures: dict[str, Any] = {
+        key: client.scatter(with_unpacked(found, packed.get(key))) for key, found in segmentations.items()
+    }
     cached = len(jobs) - len(to_run)
     pending = {client.submit(segment_job, job, key=f"segment-{job.key}", pure=False): job for job in to_run}
     for future in as_completed(pending):
         job = pending[future]
         futures[job.key] = future
-        record_segmentation(job, future.result(), segmentations, reporter, memory_cache, cache_dir)
+        record_segmentation(job, future.result(), segmentations, reporter, memory_cache, cache_dir, packed)
     return segmentations, futures, cached
 
 

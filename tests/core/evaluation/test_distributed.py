@@ -7,6 +7,7 @@ import pytest
 distributed = pytest.importorskip("distributed", reason="the 'distributed' extra (dask[distributed]) is not installed")
 
 from ursim_core.errors import ParameterError  # noqa: E402
+from ursim_core.evaluation.packing import Packed  # noqa: E402
 from ursim_core.evaluation.report import runs_csv  # noqa: E402
 from ursim_core.evaluation.runner import run_evaluation  # noqa: E402
 
@@ -34,10 +35,17 @@ def test_local_cluster_gives_the_local_csv(synthetic_dataset, tmp_path):
         distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
         distributed.Client(cluster) as client,
     ):
-        on_cluster = run_evaluation(synthetic_dataset, scheduler=client, **options)
+        cache: dict = {}
+        on_cluster = run_evaluation(synthetic_dataset, scheduler=client, segmentation_cache=cache, **options)
         # Each distinct map was segmented once, as one task.
         segment_tasks = [key for key in client.run_on_scheduler(_task_keys) if str(key).startswith("segment-")]
+        # Again from the memory cache, which holds the turned sketches with their resamplings
+        # packed: they are scattered to the cluster whole.
+        assert any(isinstance(found, Packed) and found.resamplings for found in cache.values())
+        again = run_evaluation(synthetic_dataset, scheduler=client, segmentation_cache=cache, **options)
     assert _without_times(runs_csv(on_cluster)) == _without_times(runs_csv(local))
+    assert _without_times(runs_csv(again)) == _without_times(runs_csv(local))
+    assert again.timings["maps_from_cache"] == again.timings["maps"]
     assert on_cluster.timings["maps"] == local.timings["maps"] == len(set(segment_tasks))
     assert on_cluster.settings["scheduler"].startswith("tcp://")
 
