@@ -80,14 +80,21 @@ def nearest_orientations(candidates, wanted) -> list[tuple[float, bool]]:
     [(181.0, False), (359.0, True)]
     """
     chosen = []
-    for degrees, mirrored in wanted:
-        same_flag = [candidate for candidate in candidates if candidate[1] == mirrored]
-        if not same_flag:
-            continue
-        nearest = min(same_flag, key=lambda candidate: turn_between(candidate[0], degrees))
-        if nearest not in chosen:
+    for orientation in wanted:
+        nearest = _nearest_of_same_flag(candidates, orientation)
+        if nearest is not None and nearest not in chosen:
             chosen.append(nearest)
     return chosen or list(candidates)
+
+
+def _nearest_of_same_flag(orientations, orientation) -> tuple[float, bool] | None:
+    """The one of ``orientations`` with the mirror flag of ``orientation`` whose turn is closest
+    to it (the first of equals); None when none has that flag."""
+    degrees, mirrored = orientation
+    same_flag = [other for other in orientations if bool(other[1]) == bool(mirrored)]
+    if not same_flag:
+        return None
+    return min(same_flag, key=lambda other: turn_between(other[0], degrees))
 
 
 def sketch_outlines(sketch_seg, sketch_graph: nx.Graph, candidates) -> dict | None:
@@ -208,18 +215,16 @@ def carried_overlaps(measured: dict, candidates, indices) -> dict[int, float] | 
     >>> measured = {(0.4, False): 0.8, (90.4, False): 0.5, (0.4, True): 0.6}
     >>> carried_overlaps(measured, [(90.1, False), (0.1, True)], [0, 1])
     {0: 0.5, 1: 0.6}
-    >>> carried_overlaps(measured, [(180.0, True), (270.0, True)], [1]) is None
-    False
+    >>> carried_overlaps(measured, [(180.0, True), (270.0, True)], [1])
+    {1: 0.6}
     >>> carried_overlaps({(0.0, False): 0.8}, [(0.0, True)], [0]) is None
     True
     """
     carried = {}
     for index in indices:
-        degrees, mirrored = candidates[index]
-        same_flag = [orientation for orientation in measured if bool(orientation[1]) == bool(mirrored)]
-        if not same_flag:
+        nearest = _nearest_of_same_flag(measured, candidates[index])
+        if nearest is None:
             return None
-        nearest = min(same_flag, key=lambda orientation: turn_between(orientation[0], degrees))
         carried[index] = measured[nearest]
     return carried
 
