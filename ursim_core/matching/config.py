@@ -164,6 +164,18 @@ class MatchConfig:
         0.7366 / 0.7411 with 10); generated pairs unchanged. Ten matches of a turned sketch
         instead of six: 116-130 -> 179-185 ms per KTH pair turned by 30 degrees (a study script,
         interleaved x3), and nine resamplings to segment instead of five.
+    vote_signature_refit : bool
+        With ``resampling_vote`` and ``signature_refit``: whether the other segmentations of a
+        turned sketch refit from the signatures too (True, the default) or only the first does
+        (each still refits by its own pairs). False skips a sweep and a refit per mirror flag in
+        nine of the ten segmentations: a KTH pair turned by 30 degrees 215-218 -> 180-192 ms (a
+        study script, interleaved x2). Round 35: on the 18 KTH sketches turned by 15, 30, ...,
+        345 degrees (``ursim evaluate ... --cross-validate vote_signature_refit=true,false``)
+        12 of 864 runs changed, all of sketch 10, and false was chosen in 17 folds: held out 0.74
+        / 0.74 either way (in sample 0.7366 / 0.7411 -> 0.7385 / 0.7434). But on generated pairs
+        not used in any design (``ursim bench invariance --seeds 32 --first-seed 32``) False lost:
+        turned 0.956 -> 0.932, all 0.719 -> 0.691, mean 0.862 -> 0.854 (seeds 0-31 unchanged,
+        0.912). So the default keeps the start in every segmentation.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -224,6 +236,7 @@ class MatchConfig:
     resampling_vote: bool = True
     vote_by_reading: bool = True
     vote_segmentations: int = 10
+    vote_signature_refit: bool = True
     hypothesis_score: str = "signature"
     score_weight: float = 8.0
     orientation: Any = "any"
@@ -297,7 +310,7 @@ class MatchConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < smallest:
                 raise ParameterError(f"must be {wording}, not {value!r}", field=name)
-        for name in ("signature_refit", "keep_refit", "resampling_vote", "vote_by_reading"):
+        for name in ("signature_refit", "keep_refit", "resampling_vote", "vote_by_reading", "vote_signature_refit"):
             if not isinstance(getattr(self, name), bool):
                 raise ParameterError(f"must be true or false, not {getattr(self, name)!r}", field=name)
         if not self.times:

@@ -35,6 +35,7 @@ __all__ = [
     "Resampled",
     "SAME_READING",
     "region_correspondence",
+    "region_correspondences",
     "vote_pairs",
     "voted_result",
     "most_common_reading",
@@ -75,22 +76,43 @@ def region_correspondence(labels: np.ndarray, other: np.ndarray) -> dict[int, in
     >>> region_correspondence(a, b)
     {5: 1, 7: 2}
     """
-    # A joint histogram of (other region, region) over the pixels in a region of both (ids > 0;
-    # regions cover about a fifth of a KTH sketch's image), one integer key per pixel: a bincount,
-    # linear in the pixels. np.unique's sort was most of a vote's cost; the histogram over all
-    # pixels took 3.3 ms per KTH pair of segmentations, this one about 1.5 ms (round 32).
-    labels, other = np.asarray(labels).ravel(), np.asarray(other).ravel()
-    both = (labels > 0) & (other > 0)
-    labels, other = labels[both], other[both]
-    if labels.size == 0:
-        return {}
-    stride = int(labels.max()) + 1
-    keys = other.astype(np.intp) * stride + labels
-    counts = np.bincount(keys, minlength=(int(other.max()) + 1) * stride).reshape(-1, stride)
-    present = np.flatnonzero(counts.any(axis=1))
-    # argmax takes the first of equal counts: ties go to the lower region id.
-    best = counts[present].argmax(axis=1)
-    return dict(zip(present.tolist(), best.tolist(), strict=True))
+    return region_correspondences(labels, [other])[0]
+
+
+def region_correspondences(labels: np.ndarray, others: Sequence[np.ndarray]) -> list[dict[int, int]]:
+    """:func:`region_correspondence` of ``labels`` with each of ``others``: the pixels in a region
+    of ``labels`` are found once for all of them.
+
+    Examples
+    --------
+    >>> a = np.array([[1, 1, 2, 2]])
+    >>> region_correspondences(a, [np.array([[5, 5, 5, 7]]), np.array([[0, 3, 3, 3]])])
+    [{5: 1, 7: 2}, {3: 2}]
+    """
+    # A joint histogram of (other region, region) over the pixels in a region of both (ids > 0),
+    # one integer key per pixel: a bincount, linear in the pixels. np.unique's sort was most of a
+    # vote's cost (round 32). Regions cover about a fifth of a turned KTH sketch's image, so the
+    # histograms read only those pixels, found once for the nine other segmentations (round 35:
+    # 21 -> 6 ms per KTH pair turned by 30 degrees, the same correspondences).
+    labels = np.asarray(labels).ravel()
+    inside = np.flatnonzero(labels > 0)
+    regions = labels[inside]
+    stride = int(regions.max()) + 1 if regions.size else 1
+    found = []
+    for other in others:
+        other = np.asarray(other).ravel()[inside]
+        both = other > 0
+        theirs, ours = other[both], regions[both]
+        if ours.size == 0:
+            found.append({})
+            continue
+        keys = theirs.astype(np.intp) * stride + ours
+        counts = np.bincount(keys, minlength=(int(theirs.max()) + 1) * stride).reshape(-1, stride)
+        present = np.flatnonzero(counts.any(axis=1))
+        # argmax takes the first of equal counts: ties go to the lower region id.
+        best = counts[present].argmax(axis=1)
+        found.append(dict(zip(present.tolist(), best.tolist(), strict=True)))
+    return found
 
 
 def vote_pairs(
@@ -244,7 +266,11 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
     (``Prepared.orientation_overlaps``) instead of fitting the sketch again: the same frame and
     the same sketch up to resampling noise. On those 864 runs 18 changed, mean F1 0.7297 -> 0.7307,
     place accuracy 0.7361 -> 0.7384 (in sample); a KTH pair turned by 30 degrees 147 -> 115 ms
-    (round 33)."""
+    (round 33).
+
+    With ``MatchConfig(vote_signature_refit=False)`` only the first segmentation refits from the
+    signatures alone: a turned KTH pair about 15 % faster, held out the same on KTH, but lower on
+    held-out generated pairs (round 35, see the option)."""
     config = prepared.config
     others = getattr(sketch_seg, "resampled", ())
     others = tuple(others)[: config.vote_segmentations - 1]
@@ -252,15 +278,18 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
         return prepared
     finalists = tuple(prepared.orientation_scan) or None
     overlaps = prepared.orientation_overlaps
+    # The refit's start from the signatures alone (``signature_refit``) costs a sweep and a refit
+    # per mirror flag: ``vote_signature_refit=False`` leaves it to the first segmentation.
+    others_config = config if config.vote_signature_refit else config.replace(signature_refit=False)
     variants = tuple(
-        (other.labels, prepare_one(other, metric_seg, config, orientations=finalists, overlaps=overlaps))
+        (other.labels, prepare_one(other, metric_seg, others_config, orientations=finalists, overlaps=overlaps))
         for other in others
     )
     labels = sketch_seg.labels
     # Each region of ``labels`` overlaps itself most: the first answer's correspondence is the identity.
     present = np.flatnonzero(np.bincount(np.maximum(np.asarray(labels).ravel(), 0)))
     identity = {int(region): int(region) for region in present if region > 0}
-    correspondences = (identity, *(region_correspondence(labels, other) for other, _ in variants))
+    correspondences = (identity, *region_correspondences(labels, [other for other, _ in variants]))
     resampled = Resampled(labels=labels, variants=variants, correspondences=correspondences)
     return dataclasses.replace(prepared, resampled=resampled)
 

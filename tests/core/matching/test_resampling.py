@@ -9,7 +9,13 @@ import pytest
 
 from ursim_core.errors import ParameterError
 from ursim_core.matching import MatchConfig, MatchConstraints, match, match_prepared, prepare
-from ursim_core.matching.resampling import most_common_reading, region_correspondence, vote_pairs, voted_result
+from ursim_core.matching.resampling import (
+    most_common_reading,
+    region_correspondence,
+    region_correspondences,
+    vote_pairs,
+    voted_result,
+)
 from ursim_core.segmentation import segment_canonical
 from ursim_core.segmentation.canonical import RESAMPLING_OFFSETS, _turned
 from ursim_core.synth import make_pair
@@ -32,23 +38,33 @@ def test_ties_go_to_the_lower_region_and_walls_are_not_regions():
     assert region_correspondence(np.zeros((0, 0), int), np.zeros((0, 0), int)) == {}
 
 
+def _largest_overlaps_by_hand(labels, other):
+    counts: dict = {}
+    for a, b in zip(labels.ravel().tolist(), other.ravel().tolist(), strict=True):
+        if a > 0 and b > 0:
+            counts.setdefault(b, {}).setdefault(a, 0)
+            counts[b][a] += 1
+    return {b: min(row, key=lambda a: (-row[a], a)) for b, row in counts.items()}
+
+
 def test_the_correspondence_is_the_largest_overlap_pixel_by_pixel():
     # A reference that counts every pixel in Python, on random label images with walls (-1),
-    # background (0), ties and regions that overlap nothing.
+    # background (0), ties and regions that overlap nothing; several others at once as the vote
+    # carries them, one at a time as region_correspondence does.
     rng = np.random.default_rng(32)
     for _ in range(300):
         shape = tuple(rng.integers(0, 9, 2))
         labels = rng.integers(-1, rng.integers(1, 7), shape)
-        other = rng.integers(-1, rng.integers(1, 7), shape)
-        if rng.random() < 0.5:  # mostly the same segmentation, as two resamplings are
-            other = np.where(rng.random(shape) < 0.8, labels, other)
-        counts: dict = {}
-        for a, b in zip(labels.ravel().tolist(), other.ravel().tolist(), strict=True):
-            if a > 0 and b > 0:
-                counts.setdefault(b, {}).setdefault(a, 0)
-                counts[b][a] += 1
-        expected = {b: min(row, key=lambda a: (-row[a], a)) for b, row in counts.items()}
-        assert region_correspondence(labels, other) == expected
+        others = []
+        for _ in range(rng.integers(1, 4)):
+            other = rng.integers(-1, rng.integers(1, 7), shape)
+            if rng.random() < 0.5:  # mostly the same segmentation, as two resamplings are
+                other = np.where(rng.random(shape) < 0.8, labels, other)
+            others.append(other)
+        expected = [_largest_overlaps_by_hand(labels, other) for other in others]
+        assert region_correspondences(labels, others) == expected
+        assert region_correspondence(labels, others[0]) == expected[0]
+    assert region_correspondences(BASE, []) == []
 
 
 def test_a_pair_needs_the_quorum():
@@ -164,6 +180,49 @@ def test_the_first_segmentations_vote_as_many_as_configured(turned_pair, count):
     assert sorted(voted.pairs) == sorted(_voted_by_hand(sketch, first, variants))
 
 
+@pytest.mark.parametrize("asked", [False, True])
+def test_only_the_first_segmentation_refits_from_the_signatures_unless_asked(turned_pair, monkeypatch, asked):
+    from ursim_core.matching import pipeline
+
+    sketch, plan = turned_pair
+    starts = []
+    original = pipeline.signature_start
+
+    def counting(prepared, match_one):
+        starts.append(prepared.orientation)
+        return original(prepared, match_one)
+
+    monkeypatch.setattr(pipeline, "signature_start", counting)
+    config = MatchConfig(vote_signature_refit=asked)
+    prepare(sketch, plan, config.replace(resampling_vote=False))
+    first_only = len(starts)  # once per mirror flag of the first segmentation's finalists
+    starts.clear()
+    prepared = prepare(sketch, plan, config)
+    variants = [variant for _, variant in prepared.resampled.variants]
+    assert 1 <= first_only <= 2 and prepared.config.signature_refit
+    if asked:
+        assert len(starts) >= first_only + len(variants)
+        assert all(variant.config.signature_refit for variant in variants)
+    else:
+        assert len(starts) == first_only
+        assert not any(variant.config.signature_refit for variant in variants)
+        # Each variant is what preparing it alone without the start gives.
+        one = pipeline._prepare_one(
+            sketch.resampled[0],
+            plan,
+            MatchConfig(signature_refit=False),
+            orientations=tuple(prepared.orientation_scan),
+            overlaps=prepared.orientation_overlaps,
+        )
+        assert one.chosen.pairs == variants[0].chosen.pairs and one.orientation == variants[0].orientation
+
+
+@pytest.mark.parametrize("value", [None, 1, "yes"])
+def test_the_others_signature_start_option_is_checked(value):
+    with pytest.raises(ParameterError, match="vote_signature_refit"):
+        MatchConfig(vote_signature_refit=value)
+
+
 @pytest.mark.parametrize("count", [0, -1, True, 2.0, "6"])
 def test_the_number_of_voting_segmentations_is_checked(count):
     with pytest.raises(ParameterError, match="vote_segmentations"):
@@ -183,6 +242,7 @@ def test_the_regions_are_carried_over_once_per_preparation_not_once_per_vote(tur
     assert expected[0] == {region: region for region in sketch.graph.nodes}
     calls = []
     monkeypatch.setattr(resampling, "region_correspondence", lambda *args: calls.append(args) or {})
+    monkeypatch.setattr(resampling, "region_correspondences", lambda *args: calls.append(args) or [])
     for m in (0.1, 0.2, None):  # a sweep over m votes at every m
         voted = match_prepared(prepared, m)
         first = match_prepared(dataclasses.replace(prepared, resampled=None), m)
