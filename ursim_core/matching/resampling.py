@@ -286,10 +286,8 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
         for other in others
     )
     labels = sketch_seg.labels
-    # Each region of ``labels`` overlaps itself most: the first answer's correspondence is the identity.
-    present = np.flatnonzero(np.bincount(np.maximum(np.asarray(labels).ravel(), 0)))
-    identity = {int(region): int(region) for region in present if region > 0}
-    correspondences = (identity, *region_correspondences(labels, [other for other, _ in variants]))
+    # The first answer's is ``labels`` with itself (the identity on its regions), in the same pass.
+    correspondences = tuple(region_correspondences(labels, [labels, *(other for other, _ in variants)]))
     resampled = Resampled(labels=labels, variants=variants, correspondences=correspondences)
     return dataclasses.replace(prepared, resampled=resampled)
 
