@@ -19,6 +19,7 @@ from ursim_core.matching.orientation import orientation_candidates, oriented_gra
 from ursim_core.matching.planar import planar_graph
 from ursim_core.matching.results import Prepared
 from ursim_core.segmentation.canonical import wall_angle
+from ursim_core.segmentation.interface import Segmentation
 
 __all__ = [
     "orientations_to_try",
@@ -55,14 +56,21 @@ def orientations_to_try(config: MatchConfig, sketch_seg, metric_seg) -> list[tup
         if config.matcher != "planar" or config.mirrored is not None:
             return [(0.0, bool(config.mirrored))]
         return [(0.0, False), (0.0, True)]
-    sketch_labels = getattr(sketch_seg, "labels", None)
-    metric_labels = getattr(metric_seg, "labels", None)
     return orientation_candidates(
         orientation="any",
         mirrored=config.mirrored,
-        sketch_angle=wall_angle(sketch_labels) if sketch_labels is not None else 0.0,
-        metric_angle=wall_angle(metric_labels) if metric_labels is not None else 0.0,
+        sketch_angle=_wall_angle_of(sketch_seg),
+        metric_angle=_wall_angle_of(metric_seg),
     )
+
+
+def _wall_angle_of(segmentation) -> float:
+    """The wall angle of a segmentation's label image (a :class:`Segmentation` keeps it), 0 for a
+    bare graph."""
+    if isinstance(segmentation, Segmentation):
+        return segmentation.wall_angle
+    labels = getattr(segmentation, "labels", None)
+    return wall_angle(labels) if labels is not None else 0.0
 
 
 def nearest_orientations(candidates, wanted) -> list[tuple[float, bool]]:

@@ -73,7 +73,7 @@ class Segmentation:
     (2, 2, 1)
     """
 
-    __slots__ = ("_graph", "_regions", "labels", "method", "params", "resampled", "source")
+    __slots__ = ("_graph", "_regions", "_wall_angle", "labels", "method", "params", "resampled", "source")
 
     def __init__(
         self,
@@ -90,7 +90,7 @@ class Segmentation:
             raise TypeError("Segmentation needs the region graph or the region table of its labels")
         for name, value in (
             ("labels", labels), ("method", method), ("params", {} if params is None else params), ("source", source),
-            ("_graph", graph), ("_regions", regions), ("resampled", tuple(resampled)),
+            ("_graph", graph), ("_regions", regions), ("resampled", tuple(resampled)), ("_wall_angle", None),
         ):  # fmt: skip
             object.__setattr__(self, name, value)
 
@@ -122,9 +122,11 @@ class Segmentation:
         >>> other.labels is seg.labels, len(other.resampled), seg.resampled
         (True, 1, ())
         """
-        return Segmentation(
+        other = Segmentation(
             self.labels, self._graph, self.method, self.params, self.source, regions=self._regions, resampled=resampled
         )
+        object.__setattr__(other, "_wall_angle", self._wall_angle)  # the same labels
+        return other
 
     @property
     def graph(self) -> nx.Graph:
@@ -143,6 +145,27 @@ class Segmentation:
 
             object.__setattr__(self, "_regions", RegionTable.from_graph(self._graph))
         return self._regions
+
+    @property
+    def wall_angle(self) -> float:
+        """:func:`~ursim_core.segmentation.canonical.wall_angle` of the regions, computed once.
+
+        The matcher reads both maps' wall angles in every orientation search: for a turned
+        sketch's vote that is ten searches against the same metric map, and a 4000 x 4000 map
+        takes about 20 ms a time.
+
+        Examples
+        --------
+        >>> from ursim_core.segmentation.regions import region_table
+        >>> labels = np.zeros((60, 80), np.int32); labels[10:50, 10:70] = 1
+        >>> Segmentation(labels, regions=region_table(labels)).wall_angle
+        0.0
+        """
+        if self._wall_angle is None:
+            from ursim_core.segmentation.canonical import wall_angle
+
+            object.__setattr__(self, "_wall_angle", float(wall_angle(self.labels)))
+        return self._wall_angle
 
     @property
     def n_regions(self) -> int:

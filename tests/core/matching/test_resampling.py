@@ -217,6 +217,28 @@ def test_only_the_first_segmentation_refits_from_the_signatures_unless_asked(tur
         assert one.chosen.pairs == variants[0].chosen.pairs and one.orientation == variants[0].orientation
 
 
+def test_the_metric_maps_wall_angle_is_measured_once_for_the_whole_vote(turned_pair, monkeypatch):
+    import copy
+
+    from ursim_core.segmentation import canonical
+
+    sketch, plan = turned_pair
+    plan = copy.copy(plan)  # a Segmentation that has not measured its wall angle yet
+    measured = []
+    original = canonical.wall_angle
+    monkeypatch.setattr(canonical, "wall_angle", lambda labels: measured.append(labels) or original(labels))
+    prepared = prepare(sketch, plan)
+    assert len(prepared.resampled.variants) == 9
+    assert sum(labels is plan.labels for labels in measured) == 1
+    # Each segmentation of the sketch at most once too (earlier tests may have measured them).
+    segmentations = [sketch, *sketch.resampled]
+    assert all(sum(labels is seg.labels for labels in measured) <= 1 for seg in segmentations)
+    assert all(any(labels is seg.labels for seg in segmentations) for labels in measured if labels is not plan.labels)
+    count = len(measured)
+    prepare(sketch, plan)
+    assert len(measured) == count
+
+
 @pytest.mark.parametrize("value", [None, 1, "yes"])
 def test_the_others_signature_start_option_is_checked(value):
     with pytest.raises(ParameterError, match="vote_signature_refit"):

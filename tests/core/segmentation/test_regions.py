@@ -62,6 +62,26 @@ def test_a_segmentation_builds_its_graph_once_on_first_use():
     assert seg.graph is graph and _as_lists(graph) == _as_lists(region_graph(seg.labels))
 
 
+def test_a_segmentation_measures_its_wall_angle_once(monkeypatch):
+    import cv2
+
+    from ursim_core.segmentation import canonical
+
+    labels = np.zeros((120, 160), np.int32)  # a room turned by about 20 degrees
+    corners = cv2.boxPoints(((80, 60), (100, 50), -20.0)).astype(np.int32)
+    cv2.fillPoly(labels, [corners], 1)
+    expected = canonical.wall_angle(labels)
+    assert abs(expected) > 10
+    calls = []
+    monkeypatch.setattr(canonical, "wall_angle", lambda image: calls.append(image) or expected)
+    seg = Segmentation(labels, regions=region_table(labels))
+    assert seg.wall_angle == expected and seg.wall_angle == expected
+    assert len(calls) == 1 and calls[0] is labels
+    assert seg.with_resampled(()).wall_angle == expected and len(calls) == 1  # the same labels
+    again = pickle.loads(pickle.dumps(seg))  # measured again from its own labels
+    assert again.wall_angle == expected and len(calls) == 2
+
+
 def test_a_segmentation_is_immutable_and_survives_pickling_and_copies():
     labels = _rooms()
     seg = Segmentation(labels=labels, regions=region_table(labels), method="label-image", params={"a": 1})
