@@ -203,7 +203,7 @@ def _prepare_one(
     if (
         len(finalists) > 1
         and config.m == "auto"
-        and len(candidates) > _FINALISTS
+        and len(candidates) > config.orientation_finalists
         and len(config.m_grid) > 2 * _COARSE_STEP
     ):
         # Screen every orientation on a coarse m grid first; only the best few get the full sweep.
@@ -213,7 +213,7 @@ def _prepare_one(
             coarse_prepared = dataclasses.replace(prepared, config=coarse)
             results, known[index] = matched_sweep(coarse_prepared)
             screened.append((ranked(chosen_of(coarse_prepared, results).normalised_cost, index), index))
-        finalists = sorted(index for _, index in sorted(screened)[:_FINALISTS])
+        finalists = sorted(index for _, index in sorted(screened)[: config.orientation_finalists])
     trials = []
     starts: dict = {}  # the signature starts of the refit, by mirror flag (see _refitted)
     for step, index in enumerate(finalists):
@@ -298,15 +298,13 @@ def _match_coarsely(prepared: Prepared) -> MatchResult:
 
 
 #: With the automatic m, orientations are screened at every ``_COARSE_STEP``-th m of the grid and
-#: the ``_FINALISTS`` best get the full sweep (and the position refit, see :func:`prepare`).
-#: Round 6 (tuned on the 18 KTH sketches, interleaved A/B in one session): step 2 with 2 finalists
-#: gave the same F1 in every orientation as the full sweep of all 8 (0.651 overall) at 36 ms
-#: median per pair, against 58 ms with 3 finalists. Round 8, with exact quarter-turn candidates
-#: and the refit: 2 and 3 finalists give the same on KTH (0.762 in every orientation) but 2 cut
-#: the right reading of a nearly symmetric generated plan (``ursim bench invariance``: 0.823
-#: against 0.858, the same as all 8), for about 15 % more time per pair (interleaved, loaded).
+#: the ``MatchConfig.orientation_finalists`` best get the full sweep (and the position refit, see
+#: :func:`prepare`). Round 6 (tuned on the 18 KTH sketches, interleaved A/B in one session): step 2
+#: with 2 finalists gave the same F1 in every orientation as the full sweep of all 8 (0.651
+#: overall) at 36 ms median per pair, against 58 ms with 3 finalists. Round 8, with exact
+#: quarter-turn candidates and the refit: 2 and 3 finalists gave the same on KTH but 2 cut the
+#: right reading of a nearly symmetric generated plan; round 36: 4 (see the option).
 _COARSE_STEP = 2
-_FINALISTS = 3
 #: Above this many regions in either map, orientations are screened by assignment cost instead,
 #: and the answer is not refitted.
 _SCREEN_BY_ASSIGNMENT = 60

@@ -94,6 +94,16 @@ def test_default_matches_every_orientation_alike(root):
     assert max(means.values()) - min(means.values()) < 1e-9, means
 
 
+def test_sketch_12_is_read_the_way_it_is_drawn(root):
+    # Round 36: with three finalist orientations the right reading of sketch 12 (drawn upright;
+    # the highest free-space overlap of the eight) was screened out and the sketch read transposed.
+    folder = root / "ursim_kth_sketches"
+    model = segment(load_map(folder / "model" / "model_simple.png"), preset="default")
+    sketch = segment_canonical(load_map(folder / "sketches" / "12.png"), preset="default")
+    assert match(sketch, model).orientation == (0.0, False)
+    assert match(sketch, model, config=MatchConfig(orientation_finalists=3)).orientation == (270.0, True)
+
+
 def _cross_validated(root, option: str, values, *, augment: str = "dihedral"):
     """Leave-one-sketch-out cross-validation of ``option`` over ``values`` (planar T4, the sketches
     turned as ``augment`` says)."""

@@ -122,6 +122,30 @@ def test_known_orientation_is_used_as_given():
     assert result.orientation_scan[result.orientation] == min(result.orientation_scan.values())
 
 
+def test_config_validates_orientation_finalists():
+    for bad in (0, -2, 2.5, True, "4"):
+        with pytest.raises(ParameterError, match="orientation_finalists"):
+            MatchConfig(orientation_finalists=bad)
+
+
+@functools.cache
+def _generated_segmentations(seed: int):
+    plan, sketch = make_pair(seed=seed)
+    return segment_canonical(sketch.free, preset="default"), segment_canonical(plan.free, preset="default")
+
+
+def test_the_best_screened_orientations_get_the_full_sweep():
+    sketch_seg, metric_seg = _generated_segmentations(1)
+    tried = {
+        finalists: prepare(sketch_seg, metric_seg, MatchConfig(orientation_finalists=finalists)).orientation_scan
+        for finalists in (1, 3, 4, 8)
+    }
+    # Eight candidates (four turns, mirrored or not): the k best of one screening are finalists.
+    assert [len(tried[k]) for k in (1, 3, 4, 8)] == [1, 3, 4, 8]
+    assert set(tried[1]) < set(tried[3]) < set(tried[4]) < set(tried[8])
+    assert MatchConfig().orientation_finalists == 4
+
+
 # --- invariance of the whole pipeline on generated pairs (ground truth transformed alike) ---
 
 
