@@ -87,7 +87,7 @@ def prepare(
     configured m (the automatic m by default) and the one whose answer scores lowest is kept;
     ties go to the earlier candidate, the identity first. With the automatic m the candidates
     are screened on every second m of the grid and the ``config.orientation_finalists`` best
-    (4) get the full sweep. The signatures are computed once:
+    get the full sweep. The signatures are computed once:
     only the position term and the neighbour orders depend on the orientation. With
     ``config.position_refits`` (the planar matcher), the answer in each orientation is matched
     again with the sketch's positions laid on the metric map by its own pairs

@@ -112,9 +112,14 @@ def test_config_validates_orientation_and_mirrored():
     assert MatchConfig.paper().orientation == "upright" and MatchConfig.released().mirrored is False
 
 
+@functools.cache
+def _generated_segmentations(seed: int):
+    plan, sketch = make_pair(seed=seed)
+    return segment_canonical(sketch.free, preset="default"), segment_canonical(plan.free, preset="default")
+
+
 def test_known_orientation_is_used_as_given():
-    plan, sketch = make_pair(seed=1)
-    s, m = segment_canonical(sketch.free, preset="default"), segment_canonical(plan.free, preset="default")
+    s, m = _generated_segmentations(1)
     prepared = prepare(s, m, MatchConfig(orientation=90, mirrored=True))
     assert prepared.orientation == (90.0, True) and prepared.orientation_scan == {}
     result = match(s, m)
@@ -126,12 +131,6 @@ def test_config_validates_orientation_finalists():
     for bad in (0, -2, 2.5, True, "4"):
         with pytest.raises(ParameterError, match="orientation_finalists"):
             MatchConfig(orientation_finalists=bad)
-
-
-@functools.cache
-def _generated_segmentations(seed: int):
-    plan, sketch = make_pair(seed=seed)
-    return segment_canonical(sketch.free, preset="default"), segment_canonical(plan.free, preset="default")
 
 
 def test_the_best_screened_orientations_get_the_full_sweep():
