@@ -24,6 +24,7 @@ enough for it.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -39,6 +40,7 @@ __all__ = [
     "vote_pairs",
     "voted_result",
     "most_common_reading",
+    "lowest_scored_reading",
     "with_resampled",
     "voted_answer",
 ]
@@ -199,7 +201,11 @@ def voted_result(
     (``labels`` with itself) first."""
     every = [(labels, first), *answers]
     if first.config.vote_by_reading:
-        voters = most_common_reading([result.orientation for _, result in every])
+        orientations = [result.orientation for _, result in every]
+        if first.config.vote_rule == "score":
+            voters = lowest_scored_reading(orientations, [result.orientation_scan for _, result in every])
+        else:
+            voters = most_common_reading(orientations)
         orientation = every[voters[0]][1].orientation
     else:
         voters = list(range(len(every)))
@@ -238,6 +244,47 @@ def most_common_reading(orientations: Sequence[tuple[float, bool]]) -> list[int]
 
     groups = [[j for j, other in enumerate(orientations) if same(one, other)] for one in orientations]
     return max(groups, key=len)  # max keeps the first of equal lengths: the earliest reading's
+
+
+def lowest_scored_reading(orientations: Sequence[tuple[float, bool]], scans: Sequence[dict]) -> list[int]:
+    """The indices of the ``(degrees, mirrored)`` orientations in the reading whose mean score over
+    all the ``scans`` is lowest (``MatchConfig(vote_rule="score")``).
+
+    ``scans[k]`` is the k-th answer's ``orientation_scan``: the rank value (lower is better) of
+    every orientation its segmentation tried. A reading's value in a scan is the lowest of the scan's
+    orientations in that reading (:data:`SAME_READING`); its score is the mean over the scans that
+    tried it. Only readings some answer chose are candidates. Ties, and readings no scan tried,
+    go by :func:`most_common_reading` (more answers, then the earliest).
+
+    Examples
+    --------
+    Three answers, two of them mirrored; the unmirrored reading is ranked better on the whole:
+
+    >>> scans = [{(0.2, False): 0.30, (90.0, True): 0.31}, {(0.0, False): 0.33, (90.1, True): 0.32},
+    ...          {(0.1, False): 0.30, (89.9, True): 0.32}]
+    >>> lowest_scored_reading([(0.2, False), (90.1, True), (89.9, True)], scans)
+    [0]
+    >>> most_common_reading([(0.2, False), (90.1, True), (89.9, True)])
+    [1, 2]
+    """
+    from ursim_core.matching.orientation import turn_between  # imports networkx; this module does not
+
+    def same(first, second) -> bool:
+        return bool(first[1]) == bool(second[1]) and turn_between(first[0], second[0]) < SAME_READING
+
+    best = None
+    for index, reading in enumerate(orientations):
+        group = [j for j, other in enumerate(orientations) if same(reading, other)]
+        values = [
+            min(value for tried, value in scan.items() if same(tried, reading))
+            for scan in scans
+            if any(same(tried, reading) for tried in scan)
+        ]
+        mean = sum(values) / len(values) if values else math.inf
+        key = (mean, -len(group), index)
+        if best is None or key < best[0]:
+            best = (key, group)
+    return best[1] if best else []
 
 
 #: Orientations of one reading are a fraction of a degree apart, those of two readings a quarter

@@ -10,6 +10,7 @@ import pytest
 from ursim_core.errors import ParameterError
 from ursim_core.matching import MatchConfig, MatchConstraints, match, match_prepared, prepare
 from ursim_core.matching.resampling import (
+    lowest_scored_reading,
     most_common_reading,
     region_correspondence,
     region_correspondences,
@@ -86,7 +87,7 @@ def test_answers_in_other_segmentations_are_carried_over():
 
 
 def test_the_voted_result_takes_the_orientation_most_answers_read():
-    first = match(_graph(), _graph())
+    first = match(_graph(), _graph(), config=MatchConfig(vote_rule="count"))
     turned = dataclasses.replace(first, orientation=(90.0, False))
     voted = voted_result(first, BASE, [(BASE, turned), (BASE, turned)])
     assert voted.orientation == (90.0, False) and voted.resampling_votes == 3
@@ -94,7 +95,7 @@ def test_the_voted_result_takes_the_orientation_most_answers_read():
 
 
 def test_only_the_answers_of_the_most_common_reading_vote_on_pairs():
-    first = match(_graph(), _graph())
+    first = match(_graph(), _graph(), config=MatchConfig(vote_rule="count"))
     assert first.config.vote_by_reading
 
     def answer(degrees, pairs):
@@ -118,6 +119,42 @@ def test_only_the_answers_of_the_most_common_reading_vote_on_pairs():
     assert voted.pairs == [(2, 21), (3, 30)] and voted.orientation == (180.2, False)
 
 
+def test_the_score_rule_takes_the_reading_ranked_best_over_every_segmentation():
+    first = match(_graph(), _graph())
+    assert first.config.vote_rule == "score"
+    # Each segmentation ranked both readings; two chose the half turn by a hair, one the upright
+    # reading by a wide margin: the mean says upright, the count says half turn.
+    scans = [{(0.0, False): 0.30, (180.0, False): 0.50}, {(0.3, False): 0.41, (180.3, False): 0.40}]
+    scans.append({(359.8, False): 0.42, (179.8, False): 0.41})
+
+    def answer(degrees, pairs, scan):
+        return dataclasses.replace(first, orientation=(degrees, False), pairs=pairs, orientation_scan=scan)
+
+    every = [answer(0.0, [(1, 10)], scans[0]), answer(180.3, [(2, 21)], scans[1]), answer(179.8, [(2, 21)], scans[2])]
+    voted = voted_result(every[0], BASE, [(BASE, a) for a in every[1:]])
+    assert voted.orientation == (0.0, False) and voted.pairs == [(1, 10)]
+    assert lowest_scored_reading([a.orientation for a in every], scans) == [0]
+    counted = voted_result(
+        dataclasses.replace(every[0], config=MatchConfig(vote_rule="count")), BASE, [(BASE, a) for a in every[1:]]
+    )
+    assert counted.orientation == (180.3, False) and counted.pairs == [(2, 21)]
+
+
+def test_the_score_rule_falls_back_to_the_count_without_scans():
+    orientations = [(0.0, False), (90.2, True), (90.0, True)]
+    assert lowest_scored_reading(orientations, [{}, {}, {}]) == most_common_reading(orientations) == [1, 2]
+    # Equal means: the reading more answers chose, then the earliest.
+    scans = [{(0.0, False): 0.5, (90.0, True): 0.5}] * 3
+    assert lowest_scored_reading(orientations, scans) == [1, 2]
+    assert lowest_scored_reading([(0.0, False), (90.0, True)], scans[:2]) == [0]
+    assert lowest_scored_reading([], []) == []
+
+
+def test_the_vote_rule_is_checked():
+    with pytest.raises(ParameterError, match="vote_rule|one of"):
+        MatchConfig(vote_rule="majority")
+
+
 def _graph():
     import networkx as nx
 
@@ -138,7 +175,9 @@ def turned_pair():
 def _voted_by_hand(sketch, first_answer, variants, m=None, correspondences=None):
     """The vote of ``voted_result`` written out: the answers of the most common reading, half of them."""
     answers = [(sketch.labels, first_answer), *((labels, match_prepared(variant, m)) for labels, variant in variants)]
-    voters = most_common_reading([tuple(result.orientation) for _, result in answers])
+    voters = lowest_scored_reading(
+        [tuple(result.orientation) for _, result in answers], [result.orientation_scan for _, result in answers]
+    )
     return vote_pairs(
         sketch.labels,
         [(answers[index][0], answers[index][1].pairs) for index in voters],
