@@ -169,8 +169,8 @@ class MatchConfig:
         accuracy against 0.7380 / 0.7428 (01 0.70 -> 0.77, 04 0.61 -> 0.70, 07 0.54 -> 0.48). Five
         other rules were measured on the same runs (docs/studies.md, round 37); chosen among all
         seven leave-one-sketch-out, the figure is 0.7348 / 0.7391. Generated pairs (``ursim bench
-        invariance``): seeds 0-31 0.912 -> 0.917 (two combined-kind pairs better), held-out seeds
-        32-63 0.872 -> 0.867 (one worse). Upright and quarter-turned sketches are not resampled:
+        invariance``): seeds 0-31 0.912 -> 0.917, held-out seeds 32-63 0.872 -> 0.867 and 64-95
+        0.897 -> 0.898: neutral there. Upright and quarter-turned sketches are not resampled:
         nothing changes there.
     vote_segmentations : int
         With ``resampling_vote``: how many of a turned sketch's segmentations vote, the first and

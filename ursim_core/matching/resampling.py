@@ -12,7 +12,9 @@ segmentation's regions and keeps the pairs that at least half of them hold (:fun
 32 only the answers that read the sketch the way most of them do vote on pairs
 (:func:`most_common_reading`, ``MatchConfig.vote_by_reading``). Since round 33 ten segmentations
 vote instead of six (``MatchConfig.vote_segmentations``): the vote's matches had become cheap
-enough for it.
+enough for it. Since round 37 the reading they vote in is the one all the segmentations rank best
+on the whole, not the one most of them chose (:func:`lowest_scored_reading`,
+``MatchConfig.vote_rule``).
 
 ``segment_canonical(..., resampled=True)`` makes the other segmentations
 (``Segmentation.resampled``); :func:`ursim_core.matching.prepare` prepares each when
@@ -180,9 +182,11 @@ def voted_result(
     the answers hold (``first`` included, as the answer of ``labels``); its other fields stay the
     first answer's.
 
-    With ``first.config.vote_by_reading`` (the default) the voters are the answers of the reading
-    most of them share (:func:`most_common_reading`; ties: the first's), and the orientation is
-    that of the earliest of them. An answer that reads the sketch turned by a quarter turn or
+    With ``first.config.vote_by_reading`` (the default) the voters are the answers of one reading,
+    and the orientation is that of the earliest of them. The reading is the one ranked best over
+    all the answers' orientation scans (:func:`lowest_scored_reading`, ``vote_rule='score'``, the
+    default) or the one most of them chose (:func:`most_common_reading`, ``vote_rule='count'``;
+    ties: the first's). An answer that reads the sketch turned by a quarter turn or
     mirrored pairs regions of another reading: counted against this reading's pairs (as one of
     all six, round 30), it made a pair that half of the same reading held fall short. The 18 KTH
     sketches turned by 15, 30, ..., 345 degrees (``ursim evaluate ... --cross-validate
