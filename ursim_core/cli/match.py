@@ -288,7 +288,7 @@ def match_pair(
 
     from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
     from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review, sweep_helper
-    from ursim_core.matching.results import match_record
+    from ursim_core.matching.results import match_record, next_reading_record
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -384,6 +384,7 @@ def match_pair(
         "reason": result.reason or "",
         "orientation": result.orientation,
         "resampling_votes": result.resampling_votes,
+        **next_reading_record(result),
         "out": out,
     }
     if reference is not None:
@@ -428,6 +429,18 @@ def run(args: argparse.Namespace) -> int:
         + f", {record['match_ms']:.1f} ms"
         + (f"; {record['reason']}" if record["reason"] else "")
     )
+    from ursim_core.matching.orientation import CLOSE_READING
+
+    runner_up = record.get("next_reading")
+    if runner_up is not None:
+        # How close the matcher came to reading the sketch otherwise: a small gap asks for a look.
+        gap = runner_up["ranked_worse_by"]
+        print(
+            f"next best reading: turned {runner_up['degrees']:.1f} deg{' mirrored' if runner_up['mirrored'] else ''}, "
+            f"ranked {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}"
+            + (": a close call, check the orientation" if gap < CLOSE_READING else "")
+            + " (--orientation and --mirrored tell the matcher)"
+        )
     print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
     if args.reference is not None:
         place = record["place_accuracy"]

@@ -36,13 +36,13 @@ import numpy as np
 
 __all__ = [
     "Resampled",
-    "SAME_READING",
     "region_correspondence",
     "region_correspondences",
     "vote_pairs",
     "voted_result",
     "most_common_reading",
     "lowest_scored_reading",
+    "mean_rank_values",
     "with_resampled",
     "voted_answer",
 ]
@@ -221,13 +221,20 @@ def voted_result(
         quorum=(len(voters) + 1) // 2,
         correspondences=[correspondences[index] for index in voters] if correspondences else None,
     )
-    return dataclasses.replace(first, pairs=pairs, orientation=tuple(orientation), resampling_votes=len(every))
+    # The scan of a vote is each candidate's mean over the answers (what the score rule ranks).
+    scans = [result.orientation_scan for _, result in every]
+    keys = list(first.orientation_scan)
+    scan = dict(zip(keys, mean_rank_values(keys, scans), strict=True))
+    return dataclasses.replace(
+        first, pairs=pairs, orientation=tuple(orientation), resampling_votes=len(every), orientation_scan=scan
+    )
 
 
 def most_common_reading(orientations: Sequence[tuple[float, bool]]) -> list[int]:
     """The indices of the ``(degrees, mirrored)`` orientations that read a sketch the way most of
-    them do: the same mirror flag, turned less than :data:`SAME_READING` degrees apart. Ties go
-    to the reading of the earliest orientation.
+    them do: the same mirror flag, turned less than
+    :data:`~ursim_core.matching.orientation.SAME_READING` degrees apart. Ties go to the reading of
+    the earliest orientation.
 
     The answers of several segmentations of one sketch are found in orientations a fraction of a
     degree apart when they read it alike (their wall angles differ by that much), and a quarter
@@ -241,12 +248,9 @@ def most_common_reading(orientations: Sequence[tuple[float, bool]]) -> list[int]
     [0]
     """
 
-    from ursim_core.matching.orientation import turn_between  # imports networkx; this module does not
+    from ursim_core.matching.orientation import same_reading  # imports networkx; this module does not
 
-    def same(first, second) -> bool:
-        return bool(first[1]) == bool(second[1]) and turn_between(first[0], second[0]) < SAME_READING
-
-    groups = [[j for j, other in enumerate(orientations) if same(one, other)] for one in orientations]
+    groups = [[j for j, other in enumerate(orientations) if same_reading(one, other)] for one in orientations]
     return max(groups, key=len)  # max keeps the first of equal lengths: the earliest reading's
 
 
@@ -256,9 +260,10 @@ def lowest_scored_reading(orientations: Sequence[tuple[float, bool]], scans: Seq
 
     ``scans[k]`` is the k-th answer's ``orientation_scan``: the rank value (lower is better) of
     every orientation its segmentation tried. A reading's value in a scan is the lowest of the scan's
-    orientations in that reading (:data:`SAME_READING`); its score is the mean over the scans that
-    tried it. Only readings some answer chose are candidates. Ties, and readings no scan tried,
-    go by :func:`most_common_reading` (more answers, then the earliest).
+    orientations in that reading (:data:`~ursim_core.matching.orientation.SAME_READING`); its score
+    is the mean over the scans that tried it (:func:`mean_rank_values`). Only readings some answer
+    chose are candidates. Ties, and readings no scan tried, go by :func:`most_common_reading` (more
+    answers, then the earliest).
 
     Examples
     --------
@@ -271,29 +276,39 @@ def lowest_scored_reading(orientations: Sequence[tuple[float, bool]], scans: Seq
     >>> most_common_reading([(0.2, False), (90.1, True), (89.9, True)])
     [1, 2]
     """
-    from ursim_core.matching.orientation import turn_between  # imports networkx; this module does not
+    from ursim_core.matching.orientation import same_reading  # imports networkx; this module does not
 
-    def same(first, second) -> bool:
-        return bool(first[1]) == bool(second[1]) and turn_between(first[0], second[0]) < SAME_READING
-
+    means = mean_rank_values(orientations, scans)
     best = None
     for index, reading in enumerate(orientations):
-        group = [j for j, other in enumerate(orientations) if same(reading, other)]
-        values = [
-            min(value for tried, value in scan.items() if same(tried, reading))
-            for scan in scans
-            if any(same(tried, reading) for tried in scan)
-        ]
-        mean = sum(values) / len(values) if values else math.inf
-        key = (mean, -len(group), index)
+        group = [j for j, other in enumerate(orientations) if same_reading(reading, other)]
+        key = (means[index], -len(group), index)
         if best is None or key < best[0]:
             best = (key, group)
     return best[1] if best else []
 
 
-#: Orientations of one reading are a fraction of a degree apart, those of two readings a quarter
-#: turn (or a mirror image): anything between separates them.
-SAME_READING = 10.0
+def mean_rank_values(readings: Sequence[tuple[float, bool]], scans: Sequence[dict]) -> list[float]:
+    """For each ``(degrees, mirrored)`` reading, its mean rank value over the ``scans`` that tried it
+    (inf when none did). A reading's value in a scan is the lowest of the scan's orientations in that
+    reading (:data:`~ursim_core.matching.orientation.SAME_READING`).
+
+    Examples
+    --------
+    >>> mean_rank_values([(0.0, False), (90.0, True)], [{(0.2, False): 0.3}, {(359.9, False): 0.5}])
+    [0.4, inf]
+    """
+    from ursim_core.matching.orientation import same_reading  # imports networkx; this module does not
+
+    means = []
+    for reading in readings:
+        values = [
+            min(value for tried, value in scan.items() if same_reading(tried, reading))
+            for scan in scans
+            if any(same_reading(tried, reading) for tried in scan)
+        ]
+        means.append(sum(values) / len(values) if values else math.inf)
+    return means
 
 
 def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one) -> Any:

@@ -14,7 +14,7 @@ from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, 
 from ursim_core.matching.descriptors import PairDescriptors
 from ursim_core.matching.planar import PlanarGraph
 
-__all__ = ["Prepared", "MatchResult", "match_record"]
+__all__ = ["Prepared", "MatchResult", "match_record", "next_reading_record"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,4 +148,28 @@ def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
         "reason": result.reason or "",
         # How the sketch was turned to match (chosen when config.orientation is 'any').
         "orientation": {"degrees": round(float(result.orientation[0]), 6), "mirrored": bool(result.orientation[1])},
+        **next_reading_record(result),
     }
+
+
+def next_reading_record(result: MatchResult) -> dict[str, Any]:
+    """``{"next_reading": {"degrees", "mirrored", "ranked_worse_by"}}``: the reading the matcher ranked
+    next when it chose the orientation (:func:`~ursim_core.matching.orientation.next_reading`),
+    JSON-safe; empty when there is none (the orientation was told, or one reading was tried).
+
+    Examples
+    --------
+    >>> result = MatchResult([], [], [], [], 0.1, 3.0, 0.2, None, np.zeros((1, 1)), 1, 1, "", MatchConfig(),
+    ...                      orientation=(0.0, False), orientation_scan={(0.0, False): 0.4, (180.0, True): 0.5})
+    >>> next_reading_record(result)
+    {'next_reading': {'degrees': 180.0, 'mirrored': True, 'ranked_worse_by': 0.25}}
+    """
+    import math
+
+    from ursim_core.matching.orientation import next_reading
+
+    found = next_reading(result.orientation, result.orientation_scan) if result.orientation_scan else None
+    if found is None or not math.isfinite(found[1]):
+        return {}
+    (degrees, mirrored), gap = found
+    return {"next_reading": {"degrees": round(degrees, 6), "mirrored": mirrored, "ranked_worse_by": round(gap, 6)}}

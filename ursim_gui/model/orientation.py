@@ -114,6 +114,44 @@ class SketchOrientation:
         return cls._read(degrees, mirrored)
 
     @classmethod
+    def runner_up_in(cls, result=None, record=None) -> tuple[SketchOrientation, float] | None:
+        """The reading the matcher ranked next when it chose the orientation, and how much worse it
+        ranked (relative; negative when better, see ``ursim_core.matching.orientation.next_reading``):
+        from ``result`` (a ``MatchResult``), else from a file's ``matcher`` record (its
+        ``next_reading``). None when there is none.
+
+        Examples
+        --------
+        >>> record = {"next_reading": {"degrees": 180.04, "mirrored": True, "ranked_worse_by": 0.02}}
+        >>> SketchOrientation.runner_up_in(record=record)
+        (SketchOrientation(angle=180.0, mirrored=True), 0.02)
+        >>> SketchOrientation.runner_up_in(record={"m": 0.1}) is None
+        True
+        """
+        if result is not None:
+            if cls.found_in(result) is None:
+                return None
+            from ursim_core.matching.orientation import next_reading
+
+            found = next_reading(result.orientation, getattr(result, "orientation_scan", None) or {})
+            if found is None:
+                return None
+            (degrees, mirrored), gap = found
+            return cls._read(degrees, mirrored), gap
+        try:
+            runner_up = record["next_reading"]
+            degrees, mirrored, gap = (
+                float(runner_up["degrees"]),
+                runner_up["mirrored"],
+                float(runner_up["ranked_worse_by"]),
+            )
+        except (KeyError, TypeError, ValueError):
+            return None  # an older file, or one a person or another tool wrote
+        if not isinstance(mirrored, bool) or not math.isfinite(degrees) or not math.isfinite(gap):
+            return None
+        return cls._read(degrees, mirrored), gap
+
+    @classmethod
     def _read(cls, degrees: float, mirrored: bool) -> SketchOrientation:
         # Rounded to the tenth of a degree the panel shows: 359.96 is upright.
         return cls(angle=float(round(float(degrees) % 360.0, 1) % 360.0), mirrored=bool(mirrored))

@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from ursim_core.matching.orientation import CLOSE_READING
 from ursim_gui.model.orientation import SketchOrientation
 from ursim_gui.model.pair_settings import MAX_SCALE
 
@@ -88,6 +89,14 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
     found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
         text += f"\nread the sketch {found.describe()}"
+        runner_up = SketchOrientation.runner_up_in(result, None if result is not None else record)
+        if runner_up is not None:
+            # How close the matcher came to reading it otherwise: a small gap asks for a look.
+            other, gap = runner_up
+            side = "worse" if gap >= 0 else "better"
+            text += f"\nnext best reading: {other.describe()}, ranked {abs(gap):.1%} {side}"
+            if gap < CLOSE_READING:
+                text += ": a close call, check the orientation"
     if result is not None and result.reason:
         text += f"\n{result.reason}"
     return text

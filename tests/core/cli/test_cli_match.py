@@ -244,9 +244,26 @@ def test_a_turned_sketch_is_matched_in_its_resamplings_and_voted(tmp_path, capsy
     cv2.imwrite(str(tmp_path / "plan.png"), plan.free.astype(np.uint8) * 255)
     out = tmp_path / "out"
     assert main(["match", str(tmp_path / "sketch.png"), str(tmp_path / "plan.png"), "-o", str(out)]) == 0
-    assert "voted over 10 resamplings" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "voted over 10 resamplings" in printed
     corr = load_correspondences(out / "correspondences.json")
     assert corr.extra["matcher"]["config"]["resampling_vote"] is True
+    # The reading ranked next, printed and kept in the file: another reading, ranked no better
+    # over the ten segmentations (the score rule chose the best).
+    runner_up = corr.extra["matcher"]["next_reading"]
+    chosen = corr.extra["matcher"]["orientation"]
+    assert runner_up["ranked_worse_by"] >= 0 and (runner_up["degrees"], runner_up["mirrored"]) != (
+        chosen["degrees"],
+        chosen["mirrored"],
+    )
+    assert f"next best reading: turned {runner_up['degrees']:.1f} deg" in printed
     # The voted pairs are in the regions of the label image written beside them.
     labels = cv2.imread(str(out / "sketch.labels.png"), cv2.IMREAD_UNCHANGED)
     assert {r for c in corr.cliques for r in c.sketch_regions} <= set(np.unique(labels).tolist()) - {0}
+
+
+def test_a_told_orientation_has_no_runner_up(tmp_path, pair, capsys):
+    out = tmp_path / "out"
+    assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out), "--orientation", "upright"]) == 0
+    assert "next best reading" not in capsys.readouterr().out
+    assert "next_reading" not in load_correspondences(out / "correspondences.json").extra["matcher"]

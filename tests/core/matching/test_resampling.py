@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.matching import MatchConfig, MatchConstraints, match, match_prepared, prepare
 from ursim_core.matching.resampling import (
     lowest_scored_reading,
+    mean_rank_values,
     most_common_reading,
     region_correspondence,
     region_correspondences,
@@ -134,6 +136,9 @@ def test_the_score_rule_takes_the_reading_ranked_best_over_every_segmentation():
     voted = voted_result(every[0], BASE, [(BASE, a) for a in every[1:]])
     assert voted.orientation == (0.0, False) and voted.pairs == [(1, 10)]
     assert lowest_scored_reading([a.orientation for a in every], scans) == [0]
+    # The vote's scan: each of the first's candidates, its reading's mean over the three.
+    assert voted.orientation_scan == pytest.approx({(0.0, False): 0.3767, (180.0, False): 0.4367}, abs=1e-4)
+    assert mean_rank_values([(0.0, False), (180.0, True)], scans) == [pytest.approx(0.3767, abs=1e-4), math.inf]
     counted = voted_result(
         dataclasses.replace(every[0], config=MatchConfig(vote_rule="count")), BASE, [(BASE, a) for a in every[1:]]
     )

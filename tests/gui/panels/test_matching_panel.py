@@ -137,3 +137,32 @@ def test_the_summary_says_when_the_pairs_are_a_vote_over_resamplings():
     result = match(graph, graph.copy())
     assert "voted" not in describe_result(result)
     assert "voted over 6 resamplings" in describe_result(dataclasses.replace(result, resampling_votes=6))
+
+
+def test_the_summary_names_the_reading_ranked_next():
+    import networkx as nx
+
+    from ursim_core.matching import match
+    from ursim_gui.panels.matching_panel import describe_result
+
+    graph = nx.path_graph(3)
+    nx.set_node_attributes(graph, {0: 50, 1: 10, 2: 12}, "size")
+    nx.set_node_attributes(graph, 0.3, "pca_shape")
+    nx.set_node_attributes(graph, {0: (0, 0), 1: (0, 10), 2: (0, 20)}, "centroid")
+    result = dataclasses.replace(
+        match(graph, graph.copy()), orientation=(0.0, False), orientation_scan={(0.0, False): 0.4, (90.0, True): 0.41}
+    )
+    text = describe_result(result)
+    assert "next best reading: turned 90° counter-clockwise, mirrored, ranked 2.5% worse" in text
+    assert "close call" not in text
+    # Reopened from a file: the record says it.
+    record = {
+        "config": {"orientation": "any"},
+        "orientation": {"degrees": 0.0, "mirrored": False},
+        "next_reading": {"degrees": 180.0, "mirrored": False, "ranked_worse_by": 0.004},
+    }
+    text = describe_result(None, automatic_cliques=3, record=record)
+    assert "next best reading: turned 180° counter-clockwise, ranked 0.4% worse: a close call" in text
+    # Told the orientation: nothing was read, so nothing ranked next.
+    told = dataclasses.replace(result, config=dataclasses.replace(result.config, orientation=0.0))
+    assert "next best reading" not in describe_result(told)
