@@ -43,6 +43,10 @@ SUMMARY_COLUMNS = (
     "n_metric_regions",
     "m",
     "match_ms",
+    "orientation_degrees",
+    "orientation_mirrored",
+    "resampling_votes",
+    "next_reading_gap",
     "precision",
     "recall",
     "f1",
@@ -144,6 +148,15 @@ def run_pair(pair: dict[str, Any], out: Path, options: dict[str, Any]) -> dict[s
 
         return {**record, "status": "failed", "error": os_error_text(error)}
     result.pop("out", None)
+    # How the sketch was read and how close the runner-up came: sorted by the gap, a campaign's
+    # close calls come first (see ursim_core.matching.orientation.next_reading).
+    degrees, mirrored = result.pop("orientation")
+    runner_up = result.pop("next_reading", None)
+    result.update(
+        orientation_degrees=float(degrees),
+        orientation_mirrored=bool(mirrored),
+        next_reading_gap=float(runner_up["ranked_worse_by"]) if runner_up else "",
+    )
     return {**record, **result, "status": "ok", "error": ""}
 
 

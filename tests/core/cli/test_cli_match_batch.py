@@ -35,6 +35,12 @@ def test_batch_writes_each_pair_and_a_summary(maps, workers):
     assert [r["name"] for r in rows] == ["a", "b", "c"]
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
     assert "missing.png" in rows[2]["error"] and int(rows[0]["n_matches"]) > 0
+    # How each sketch was read, and how far behind the reading ranked next came.
+    batch_record = json.loads((out / "a" / "correspondences.json").read_text())["matcher"]
+    assert float(rows[0]["orientation_degrees"]) == pytest.approx(batch_record["orientation"]["degrees"], abs=1e-5)
+    assert rows[0]["orientation_mirrored"] == str(batch_record["orientation"]["mirrored"])
+    assert float(rows[0]["next_reading_gap"]) == pytest.approx(batch_record["next_reading"]["ranked_worse_by"])
+    assert rows[0]["resampling_votes"] == "0" and rows[2]["next_reading_gap"] == ""
     for name in ("a", "b"):
         assert {p.name for p in (out / name).iterdir()} == {
             "correspondences.json",
