@@ -94,7 +94,7 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
             # How close the matcher came to reading it otherwise: a small gap asks for a look.
             other, gap = runner_up
             side = "worse" if gap >= 0 else "better"
-            text += f"\nnext best reading: {other.describe()}, ranked {abs(gap):.1%} {side}"
+            text += f"\nnext best: {other.describe()}, ranked {abs(gap):.1%} {side}"
             if gap < CLOSE_READING:
                 text += ": a close call, check the orientation"
     if result is not None and result.reason:

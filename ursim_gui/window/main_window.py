@@ -161,6 +161,9 @@ class MainWindow(QMainWindow):
             holder = QScrollArea()
             holder.setWidgetResizable(True)
             holder.setWidget(widget)
+            # Scrolled up and down only: the dock is kept as wide as the panel needs.
+            holder.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+            holder.setMinimumWidth(widget.minimumSizeHint().width() + holder.verticalScrollBar().sizeHint().width())
             widget = holder
         dock.setWidget(widget)
         self.addDockWidget(area, dock)
@@ -174,7 +177,7 @@ class MainWindow(QMainWindow):
             "segmentation": self._dock(
                 "Segmentation", self.segmentation_panel, right, "dock_segmentation", scroll=True
             ),
-            "matching": self._dock("Matching", self.matching_panel, right, "dock_matching"),
+            "matching": self._dock("Matching", self.matching_panel, right, "dock_matching", scroll=True),
             "table": self._dock("Correspondences", self.table, bottom, "dock_table"),
             "evaluation": self._dock("Evaluation", self.evaluation, bottom, "dock_evaluation"),
             "anchors": self._dock("Anchors", self.anchors, bottom, "dock_anchors"),

@@ -153,7 +153,7 @@ def test_the_summary_names_the_reading_ranked_next():
         match(graph, graph.copy()), orientation=(0.0, False), orientation_scan={(0.0, False): 0.4, (90.0, True): 0.41}
     )
     text = describe_result(result)
-    assert "next best reading: turned 90° counter-clockwise, mirrored, ranked 2.5% worse" in text
+    assert "next best: turned 90° counter-clockwise, mirrored, ranked 2.5% worse" in text
     assert "close call" not in text
     # Reopened from a file: the record says it.
     record = {
@@ -162,7 +162,7 @@ def test_the_summary_names_the_reading_ranked_next():
         "next_reading": {"degrees": 180.0, "mirrored": False, "ranked_worse_by": 0.004},
     }
     text = describe_result(None, automatic_cliques=3, record=record)
-    assert "next best reading: turned 180° counter-clockwise, ranked 0.4% worse: a close call" in text
+    assert "next best: turned 180° counter-clockwise, ranked 0.4% worse: a close call" in text
     # Told the orientation: nothing was read, so nothing ranked next.
     told = dataclasses.replace(result, config=dataclasses.replace(result.config, orientation=0.0))
-    assert "next best reading" not in describe_result(told)
+    assert "next best" not in describe_result(told)
