@@ -96,7 +96,8 @@ def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[flo
     resamplings, the means over them). The gap is relative, ``(runner-up - best) / best``: a few
     percent means the matcher could nearly as well have read the sketch the other way, and a
     person should check the orientation. It is negative when the runner-up ranked better (a vote
-    by count can choose so). None when ``scan`` holds no other reading, or none of this one.
+    by count can choose so). None when ``scan`` holds no other reading, or none of this one, with
+    a finite rank value (and this one's above 0).
 
     Examples
     --------
@@ -104,15 +105,18 @@ def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[flo
     ((0.0, True), 0.02)
     >>> next_reading((0.0, False), {(0.0, False): 0.5}) is None
     True
+    >>> next_reading((0.0, False), {(0.0, False): 0.5, (180.0, False): float("inf")}) is None
+    True
     """
+    # A value that is not finite (a reading no segmentation could rank) says nothing of the gap.
+    scan = {tried: float(value) for tried, value in scan.items() if math.isfinite(value)}
     own = [value for tried, value in scan.items() if same_reading(tried, orientation)]
     others = [(value, tried) for tried, value in scan.items() if not same_reading(tried, orientation)]
-    if not own or not others:
+    if not own or not others or min(own) <= 0:
         return None
     best = min(own)
     value, tried = min(others)
-    gap = (value - best) / best if best > 0 else math.inf if value > best else 0.0
-    return (float(tried[0]), bool(tried[1])), round(float(gap), 12)
+    return (float(tried[0]), bool(tried[1])), round((value - best) / best, 12)
 
 
 #: Wall-angle differences below this many degrees are taken as none: the candidates are then the
