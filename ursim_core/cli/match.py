@@ -406,6 +406,7 @@ def match_pair(
 
 
 def run(args: argparse.Namespace) -> int:
+    from ursim_core.matching.orientation import describe_gap
     from ursim_core.matching.sweep_helper import keep_freed_memory
 
     keep_freed_memory()
@@ -429,17 +430,12 @@ def run(args: argparse.Namespace) -> int:
         + f", {record['match_ms']:.1f} ms"
         + (f"; {record['reason']}" if record["reason"] else "")
     )
-    from ursim_core.matching.orientation import CLOSE_READING
-
     runner_up = record.get("next_reading")
     if runner_up is not None:
         # How close the matcher came to reading the sketch otherwise: a small gap asks for a look.
-        gap = runner_up["ranked_worse_by"]
         print(
             f"next best reading: turned {runner_up['degrees']:.1f} deg{' mirrored' if runner_up['mirrored'] else ''}, "
-            f"ranked {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}"
-            + (": a close call, check the orientation" if gap < CLOSE_READING else "")
-            + " (--orientation and --mirrored tell the matcher)"
+            f"{describe_gap(runner_up['ranked_worse_by'])} (--orientation and --mirrored tell the matcher)"
         )
     print(f"wrote {out / 'correspondences.json'}, {out / 'matches.png'}")
     if args.reference is not None:

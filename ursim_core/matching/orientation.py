@@ -46,6 +46,7 @@ __all__ = [
     "same_reading",
     "next_reading",
     "CLOSE_READING",
+    "describe_gap",
 ]
 
 
@@ -117,6 +118,20 @@ def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[flo
     best = min(own)
     value, tried = min(others)
     return (float(tried[0]), bool(tried[1])), round((value - best) / best, 12)
+
+
+def describe_gap(gap: float) -> str:
+    """How much worse the runner-up reading ranked (:func:`next_reading`), in words, with the hint
+    to check the orientation when the call was close (:data:`CLOSE_READING`); what ``ursim match``
+    prints and the app shows.
+
+    Examples
+    --------
+    >>> describe_gap(0.25), describe_gap(0.004)
+    ('ranked 25.0% worse', 'ranked 0.4% worse: a close call, check the orientation')
+    """
+    text = f"ranked {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}"
+    return text + (": a close call, check the orientation" if gap < CLOSE_READING else "")
 
 
 #: Wall-angle differences below this many degrees are taken as none: the candidates are then the

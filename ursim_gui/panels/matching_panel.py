@@ -24,7 +24,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from ursim_core.matching.orientation import CLOSE_READING
+from ursim_core.matching.orientation import describe_gap
 from ursim_gui.model.orientation import SketchOrientation
 from ursim_gui.model.pair_settings import MAX_SCALE
 
@@ -93,10 +93,7 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
         if runner_up is not None:
             # How close the matcher came to reading it otherwise: a small gap asks for a look.
             other, gap = runner_up
-            side = "worse" if gap >= 0 else "better"
-            text += f"\nnext best: {other.describe()}, ranked {abs(gap):.1%} {side}"
-            if gap < CLOSE_READING:
-                text += ": a close call, check the orientation"
+            text += f"\nnext best: {other.describe()}, {describe_gap(gap)}"
     if result is not None and result.reason:
         text += f"\n{result.reason}"
     return text
