@@ -265,7 +265,7 @@ def bench_kth(dataset_root=None, *, m: float = 0.1, repeats: int = 3) -> dict:
 
 def bench_kth_turned(dataset_root=None, *, degrees: float = 30.0) -> dict:
     """Time the default matcher on the KTH sketches turned by ``degrees``: resampled onto their wall
-    axes and segmented in six resamplings, whose answers the planar matcher votes over
+    axes and segmented in several resamplings, whose answers the planar matcher votes over
     (:mod:`ursim_core.matching.resampling`); and with one segmentation (``resampling_vote=False``).
 
     Prints and returns the median prepare-and-match time (automatic m) of each, milliseconds;
@@ -297,7 +297,7 @@ def bench_kth_turned(dataset_root=None, *, degrees: float = 30.0) -> dict:
         figures[f"turned_{label}_median_ms"] = 1000 * statistics.median(times)
     print(
         f"kth turned by {degrees:g} degrees: prepare + automatic m median {figures['turned_voted_median_ms']:.1f} ms "
-        f"with the vote over {1 + len(sketches[0].resampled)} resamplings, "
+        f"with the vote over {min(1 + len(sketches[0].resampled), MatchConfig().vote_segmentations)} segmentations, "
         f"{figures['turned_single_median_ms']:.1f} ms with one segmentation (segmentations not counted)",
         flush=True,
     )

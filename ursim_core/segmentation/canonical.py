@@ -40,8 +40,10 @@ _MIN_ANGLE = 3.0
 #: axes: MAORIS's regions change with the resampling, so the matcher votes over the answers of
 #: these segmentations and of the map segmented as it is (:mod:`ursim_core.matching.resampling`).
 #: Rounds 30-32 had the first four; the half degrees came in round 33 (ten segmentations, see
-#: ``MatchConfig.vote_segmentations``, which votes over the first ones of this order).
-RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0, -1.5, -0.5, 0.5, 1.5)
+#: ``MatchConfig.vote_segmentations``, which votes over the first ones of this order). Round 37:
+#: eight voted better than ten with the vote's new reading rule, so +0.5 and +1.5, the last two,
+#: are no longer made.
+RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0, -1.5, -0.5)
 
 
 def wall_angle(free: np.ndarray) -> float:
