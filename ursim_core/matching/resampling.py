@@ -12,8 +12,8 @@ segmentation's regions and keeps the pairs that at least half of them hold (:fun
 32 only the answers that read the sketch the way most of them do vote on pairs
 (:func:`most_common_reading`, ``MatchConfig.vote_by_reading``). Since round 33 ten segmentations
 vote instead of six (``MatchConfig.vote_segmentations``): the vote's matches had become cheap
-enough for it; since round 37, eight. Since round 37 the reading they vote in is the one all the segmentations rank best
-on the whole, not the one most of them chose (:func:`lowest_scored_reading`,
+enough for it. Since round 37 eight vote, and the reading they vote in is the one all of them rank
+best on the whole, not the one most of them chose (:func:`lowest_scored_reading`,
 ``MatchConfig.vote_rule``).
 
 ``segment_canonical(..., resampled=True)`` makes the other segmentations
