@@ -36,10 +36,12 @@ import numpy as np
 
 __all__ = [
     "Resampled",
+    "VoteReading",
     "region_correspondence",
     "region_correspondences",
     "vote_pairs",
     "voted_result",
+    "vote_reading",
     "most_common_reading",
     "lowest_scored_reading",
     "mean_rank_values",
@@ -61,11 +63,35 @@ class Resampled:
     correspondences : tuple of dict
         :func:`region_correspondence` of ``labels`` with itself, then with each variant's
         labels: computed once, since a sweep over m votes once per m.
+    reading : VoteReading or None
+        Who votes, in which orientation (:func:`vote_reading`): it depends on the preparations
+        alone, not on m, so it is found once too.
     """
 
     labels: np.ndarray
     variants: tuple
     correspondences: tuple = ()
+    reading: Any = None
+
+
+@dataclass(frozen=True)
+class VoteReading:
+    """The reading a vote is held in (:func:`vote_reading`).
+
+    Attributes
+    ----------
+    voters : list of int
+        The answers that vote (indices, the first segmentation's answer 0).
+    orientation : (float, bool)
+        The orientation the voted answer reports.
+    scan : dict
+        The vote's ``orientation_scan``: each of the first answer's candidates, its reading's mean
+        rank value over the answers (what the score rule ranks).
+    """
+
+    voters: list
+    orientation: tuple
+    scan: dict
 
 
 def region_correspondence(labels: np.ndarray, other: np.ndarray) -> dict[int, int]:
@@ -176,7 +202,12 @@ def vote_pairs(
 
 
 def voted_result(
-    first: Any, labels: np.ndarray, answers: Sequence[tuple[np.ndarray, Any]], *, correspondences=None
+    first: Any,
+    labels: np.ndarray,
+    answers: Sequence[tuple[np.ndarray, Any]],
+    *,
+    correspondences=None,
+    reading: VoteReading | None = None,
 ) -> Any:
     """``first`` (a MatchResult in the segmentation ``labels``) with the pairs that at least half of
     the answers hold (``first`` included, as the answer of ``labels``); its other fields stay the
@@ -202,32 +233,55 @@ def voted_result(
     the quorum was chosen on these sketches). On generated pairs
     not used in the design (``ursim bench invariance`` seeds 32-63) three votes gave 0.862 mean F1,
     four 0.858, one segmentation 0.861. ``correspondences``: as :func:`vote_pairs` takes them, ``first``'s
-    (``labels`` with itself) first."""
+    (``labels`` with itself) first. ``reading``: :func:`vote_reading` of the answers, when known
+    already (it does not depend on m)."""
     every = [(labels, first), *answers]
-    if first.config.vote_by_reading:
-        orientations = [result.orientation for _, result in every]
-        if first.config.vote_rule == "score":
-            voters = lowest_scored_reading(orientations, [result.orientation_scan for _, result in every])
-        else:
-            voters = most_common_reading(orientations)
-        orientation = every[voters[0]][1].orientation
-    else:
-        voters = list(range(len(every)))
-        readings = Counter(tuple(result.orientation) for _, result in every)
-        orientation = max(readings, key=lambda reading: (readings[reading], reading == tuple(first.orientation)))
+    if reading is None:
+        results = [result for _, result in every]
+        reading = vote_reading(
+            first.config, [result.orientation for result in results], [result.orientation_scan for result in results]
+        )
+    voters = reading.voters
     pairs = vote_pairs(
         labels,
         [(every[index][0], every[index][1].pairs) for index in voters],
         quorum=(len(voters) + 1) // 2,
         correspondences=[correspondences[index] for index in voters] if correspondences else None,
     )
-    # The scan of a vote is each candidate's mean over the answers (what the score rule ranks).
-    scans = [result.orientation_scan for _, result in every]
-    keys = list(first.orientation_scan)
-    scan = dict(zip(keys, mean_rank_values(keys, scans), strict=True))
     return dataclasses.replace(
-        first, pairs=pairs, orientation=tuple(orientation), resampling_votes=len(every), orientation_scan=scan
+        first,
+        pairs=pairs,
+        orientation=tuple(reading.orientation),
+        resampling_votes=len(every),
+        orientation_scan=reading.scan,
     )
+
+
+def vote_reading(config: Any, orientations: Sequence[tuple], scans: Sequence[dict]) -> VoteReading:
+    """Which answers vote and in which orientation, from each answer's ``(degrees, mirrored)``
+    orientation and ``orientation_scan`` (the first segmentation's first), as :func:`voted_result`
+    describes it for ``config`` (``vote_by_reading``, ``vote_rule``).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as Config
+    >>> scans = [{(0.0, False): 0.3, (90.0, True): 0.5}, {(0.2, False): 0.4, (90.2, True): 0.35}]
+    >>> reading = vote_reading(Config(vote_by_reading=True, vote_rule="score"), [(0.0, False), (90.2, True)], scans)
+    >>> reading.voters, reading.orientation, reading.scan
+    ([0], (0.0, False), {(0.0, False): 0.35, (90.0, True): 0.425})
+    """
+    if config.vote_by_reading:
+        if config.vote_rule == "score":
+            voters = lowest_scored_reading(orientations, scans)
+        else:
+            voters = most_common_reading(orientations)
+        orientation = orientations[voters[0]]
+    else:
+        voters = list(range(len(orientations)))
+        readings = Counter(tuple(orientation) for orientation in orientations)
+        orientation = max(readings, key=lambda reading: (readings[reading], reading == tuple(orientations[0])))
+    keys = list(scans[0])
+    return VoteReading(voters, tuple(orientation), dict(zip(keys, mean_rank_values(keys, scans), strict=True)))
 
 
 def most_common_reading(orientations: Sequence[tuple[float, bool]]) -> list[int]:
@@ -355,7 +409,14 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
     labels = sketch_seg.labels
     # The first answer's is ``labels`` with itself (the identity on its regions), in the same pass.
     correspondences = tuple(region_correspondences(labels, [labels, *(other for other, _ in variants)]))
-    resampled = Resampled(labels=labels, variants=variants, correspondences=correspondences)
+    # Every answer, at any m, is in its preparation's orientation and carries its scan.
+    preparations = [prepared, *(variant for _, variant in variants)]
+    reading = vote_reading(
+        config,
+        [preparation.orientation for preparation in preparations],
+        [preparation.orientation_scan for preparation in preparations],
+    )
+    resampled = Resampled(labels=labels, variants=variants, correspondences=correspondences, reading=reading)
     return dataclasses.replace(prepared, resampled=resampled)
 
 
@@ -365,4 +426,6 @@ def voted_answer(prepared: Any, m: float | None, match_one) -> Any:
     first = match_one(prepared, m)
     resampled = prepared.resampled
     answers = [(labels, match_one(variant, m)) for labels, variant in resampled.variants]
-    return voted_result(first, resampled.labels, answers, correspondences=resampled.correspondences)
+    return voted_result(
+        first, resampled.labels, answers, correspondences=resampled.correspondences, reading=resampled.reading
+    )

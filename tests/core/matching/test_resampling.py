@@ -17,6 +17,7 @@ from ursim_core.matching.resampling import (
     region_correspondence,
     region_correspondences,
     vote_pairs,
+    vote_reading,
     voted_result,
 )
 from ursim_core.segmentation import segment_canonical
@@ -204,6 +205,14 @@ def test_a_resampled_sketch_is_matched_in_every_segmentation_and_voted(turned_pa
     # Each answer alone, carried over: the vote keeps what at least half of them hold.
     first = match(sketch, plan, config=MatchConfig(resampling_vote=False))
     assert sorted(voted.pairs) == sorted(_voted_by_hand(sketch, first, prepared.resampled.variants))
+    # The reading found once per preparation is the one the answers at any m give.
+    for m in (None, 0.1, 0.3):
+        alone = dataclasses.replace(prepared, resampled=None)  # the first segmentation's own answer
+        answers = [match_prepared(alone, m), *(match_prepared(v, m) for _, v in prepared.resampled.variants)]
+        from_answers = vote_reading(
+            MatchConfig(), [a.orientation for a in answers], [a.orientation_scan for a in answers]
+        )
+        assert from_answers == prepared.resampled.reading
 
 
 @pytest.mark.parametrize("count", [1, 2, 6, 12])
