@@ -22,6 +22,7 @@ Points clicked on the map keep their meaning: the returned labels are in the ori
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -95,13 +96,21 @@ def wall_angle(free: np.ndarray) -> float:
     if mask.size > _ANGLE_MAX_PIXELS:
         step = math.ceil(math.sqrt(mask.size / _ANGLE_MAX_PIXELS))
         mask = mask[::step, ::step]
+    # Remembered by content: a turned map's eight segmentations each ask for the angle of the
+    # same free space (and turned_back before them), and the vote below traces it eight times.
+    return _voted_angle(np.ascontiguousarray(mask, dtype=np.uint8).tobytes(), mask.shape)
+
+
+@functools.lru_cache(maxsize=8)
+def _voted_angle(data: bytes, shape: tuple) -> float:
+    """:func:`wall_angle` of the uint8 image ``data`` of ``shape`` (non-zero is free)."""
     # Every quarter turn and mirror image of the map votes (a mirror image's vote conjugated back),
     # added exactly (fsum): then the angle of each of the 8 copies of a map is exactly the map's,
     # or its negation. Tracing and simplifying one outline alone is not exactly equivariant: the
     # copies of a generated sketch came out up to 0.13 degrees apart, and were resampled apart.
     import cv2
 
-    image = np.ascontiguousarray(mask, dtype=np.uint8)
+    image = np.frombuffer(data, dtype=np.uint8).reshape(shape)
     # dihedral(mask, quarter_turns, mirrored), made by OpenCV: a quarter of numpy's copy time.
     rotations = {1: cv2.ROTATE_90_COUNTERCLOCKWISE, 2: cv2.ROTATE_180, 3: cv2.ROTATE_90_CLOCKWISE}
     votes = []
