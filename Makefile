@@ -22,12 +22,13 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 	$(PIP) install -q -e ".[dev]"
 	touch $@
 
-# The segmentation kernels are C (ursim_core/segmentation/maoris/csrc), compiled into an extension
-# module on first use: do it once here rather than inside the first segmentation (or in both test
-# workers at once).
-$(VENV)/.kernels: $(shell find ursim_core/segmentation/maoris -name '*.py' -o -name '*.c' -o -name '*.h') | $(VENV)/.installed-core
-	@echo "Compiling the segmentation kernels (once; a few seconds)..."
+# The segmentation kernels (ursim_core/segmentation/maoris/csrc) and the planar matcher's loop
+# (ursim_core/matching/csrc) are C, compiled into extension modules on first use: do it once here
+# rather than inside the first segmentation or match (or in both test workers at once).
+$(VENV)/.kernels: $(shell find ursim_core/segmentation/maoris ursim_core/matching/csrc -name '*.py' -o -name '*.c' -o -name '*.h') ursim_core/native.py ursim_core/matching/planar_kernel.py | $(VENV)/.installed-core
+	@echo "Compiling the segmentation and matching kernels (once; a few seconds)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; print(f'{compile_kernels():.1f} s')"
+	$(BIN)/python -c "from ursim_core.matching.planar_kernel import build; print(build())"
 	touch $@
 
 run: $(VENV)/.installed-gui $(VENV)/.kernels

@@ -40,6 +40,10 @@ O(k * d^2) for a hypothesis of k pairs and degree d, so the worst case is O(n1 n
 Consumed seeds are skipped, which in practice removes most of them on consistent graphs.
 :func:`planar_match` takes the seed list from the caller, which may cap it for large graphs
 (see ``ursim_core.matching.MatchConfig.max_seeds``).
+
+Speed: the common case (no constraints, no alternatives kept, sketch-sized graphs) runs the same
+loop in C (:mod:`ursim_core.matching.planar_kernel`; the same answers, which a test checks against
+this code). The code here runs the rest, and everything where no C compiler is.
 """
 
 from __future__ import annotations
@@ -56,6 +60,7 @@ import numpy as np
 from ursim_core.matching.alignment_memo import seed_alignment
 from ursim_core.matching.arcs import expand_locked
 from ursim_core.matching.edit_distance import COMPILED_CELLS
+from ursim_core.matching.planar_kernel import match_compiled
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -335,6 +340,15 @@ def planar_match(
             seeds = [fixed[0]]  # the fixed pairs and what they imply, with no seed of their own
     if not seeds:
         return PlanarResult(pairs=[], cost=math.inf, hypotheses=0, seeds_expanded=0)
+    if constraints is None and not keep_alternatives and rotation_search in ("min", "first"):
+        # The same loop in C (planar_kernel), when it is built and takes graphs of this size.
+        compiled = match_compiled(
+            first, second, same, seeds, rotation_search=rotation_search, reflections=reflections,
+            pair_costs=pair_costs, pair_cost_weight=pair_cost_weight,
+        )  # fmt: skip
+        if compiled is not None:
+            pairs, cost, structure, hypotheses, expanded = compiled
+            return PlanarResult(pairs, cost, hypotheses, expanded, structural_cost=structure)
     n_first, n_second = first.n_vertices, second.n_vertices
     edges_first, edges_second = len(first.edges), len(second.edges)
     weighted = pair_costs is not None and pair_cost_weight != 0

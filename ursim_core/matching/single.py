@@ -134,14 +134,19 @@ def _constrained_costs(c_matrix: np.ndarray, m: float, constraints) -> np.ndarra
     return costs
 
 
-def _cost_of(prepared: Prepared, index_pairs, pair_costs) -> tuple[float, float]:
+def _cost_of(prepared: Prepared, index_pairs, pair_costs, scored=None) -> tuple[float, float]:
+    """The hypothesis score of ``index_pairs`` and its normalised value; ``scored``: that score as
+    the planar matcher computed it (the same sums in the same order), not computed again."""
     first, second = prepared.sketch_planar, prepared.metric_planar
     total = first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges)
     if not index_pairs:
         return math.inf, 1.0
-    cost = float(hypothesis_cost(first, second, index_pairs))
-    if pair_costs is not None:
-        cost += prepared.config.score_weight * float(sum(pair_costs[i, j] for i, j in index_pairs))
+    if scored is not None:
+        cost = float(scored)
+    else:
+        cost = float(hypothesis_cost(first, second, index_pairs))
+        if pair_costs is not None:
+            cost += prepared.config.score_weight * float(sum(pair_costs[i, j] for i, j in index_pairs))
     return cost, (cost / total if total else 0.0)
 
 
@@ -214,6 +219,7 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
     if config.variant in ("T2", "T4") and descriptors is not None and not anchors:
         reasons.append("no anchors: anchor signatures are all zero, matching is structural only")
     index_pairs: list = []
+    scored = None
     seeds_count = 0
     hypotheses = 0
     pair_costs = pair_cost_matrix(config, c_matrix, m) if descriptors is not None else None
@@ -231,6 +237,9 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
                     )
                 index_pairs = outcome.pairs
                 hypotheses = outcome.hypotheses
+                if constraints is None and math.isfinite(outcome.cost):
+                    # The planar score is the hypothesis score with these pair costs and weight.
+                    scored = outcome.cost
         elif config.matcher == "hungarian":
             index_pairs = hungarian_match(_constrained_costs(c_matrix, m, constraints), m)
             if not index_pairs:
@@ -245,7 +254,7 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
                 reasons.append(found.gave_up)
             elif not index_pairs:
                 reasons.append(f"no subgraph isomorphism with c <= m = {m:g}")
-    cost, normalised = _cost_of(prepared, index_pairs, pair_costs)
+    cost, normalised = _cost_of(prepared, index_pairs, pair_costs, scored)
     sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
     pairs = [(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs]
     return MatchResult(

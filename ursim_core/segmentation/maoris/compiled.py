@@ -93,10 +93,11 @@ def sources_digest() -> str:
     The built module is used only while this matches the digest it was built with: an edited
     source is built again on the next :func:`kernels`.
     """
+    from ursim_core import native
     from ursim_core.segmentation.maoris.c_build import source_files
 
     digest = hashlib.sha256(importlib.machinery.EXTENSION_SUFFIXES[0].encode())
-    for source in [*source_files(), _KERNELS_DIR.parent / "c_build.py"]:
+    for source in [*source_files(), _KERNELS_DIR.parent / "c_build.py", Path(native.__file__)]:
         digest.update(source.name.encode() + b"\0" + source.read_bytes() + b"\0")
     return digest.hexdigest()
 

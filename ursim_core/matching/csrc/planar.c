@@ -1,0 +1,506 @@
+/* The planar matcher's seed-and-expand loop in C: the extension module ``_planar_kernel``.
+ *
+ * A port of ursim_core/matching/planar.py's planar_match for its common case (no constraints,
+ * no alternatives kept), which stays the reference: the same seeds in the same order, the same
+ * edit-distance alignments with the same backtrace ties (edit_distance.py), the same FIFO
+ * expansion between locks (arcs.py), the same cost and the same earliest-wins rule. The pair
+ * costs are summed in pair order in doubles, as Python's sum does on 3.11, so the costs are
+ * the same floats. A test compares both on random graphs with many ties and on the KTH pairs.
+ *
+ * Why C: a turned KTH sketch is matched about 740 times (eight segmentations, the finalist
+ * orientations, the m grid, the refits), and Python spent 58 of the 130 ms of such a match in
+ * this loop.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A C-contiguous buffer of a given item size and format kind ('i' signed int, 'f' float, 'b' bool/uint8). */
+static int get_buffer(PyObject *obj, Py_ssize_t itemsize, char kind, int ndim, const char *what, Py_buffer *view)
+{
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        PyErr_Format(PyExc_TypeError, "planar_match: %s must be a C-contiguous array", what);
+        return -1;
+    }
+    const char *format = view->format ? view->format : "B";
+    while (*format == '<' || *format == '=' || *format == '@' || *format == '|') {
+        format++;
+    }
+    int kind_ok = (kind == 'i' && (*format == 'i' || *format == 'l' || *format == 'q'))
+                  || (kind == 'f' && *format == 'd') || (kind == 'b' && (*format == '?' || *format == 'B'));
+    if (view->itemsize != itemsize || !kind_ok || view->ndim != ndim) {
+        PyErr_Format(PyExc_TypeError, "planar_match: %s has the wrong type or shape (format %s, %d dimensions)", what,
+                     view->format ? view->format : "B", view->ndim);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+typedef struct {
+    int32_t n1, n2;
+    const int32_t *off1, *nb1, *off2, *nb2; /* cyclic neighbour orders (CSR) */
+    const uint8_t *same;                    /* n1 x n2 */
+    int32_t *table;                         /* edit-distance table, (max degree 1 + 1) x (max degree 2 + 1) */
+    int32_t *row_buffer;                    /* a rotated or reversed first sequence */
+} Graphs;
+
+/* Levenshtein table of ``a`` (rows) against ``b`` (columns); returns the distance. */
+static int32_t fill_table(const Graphs *g, const int32_t *a, int32_t rows, const int32_t *b, int32_t cols)
+{
+    int32_t *t = g->table;
+    int32_t width = cols + 1;
+    for (int32_t j = 0; j <= cols; j++) {
+        t[j] = j;
+    }
+    for (int32_t i = 1; i <= rows; i++) {
+        const uint8_t *same_row = g->same + (int64_t)a[i - 1] * g->n2;
+        int32_t *above = t + (int64_t)(i - 1) * width, *here = t + (int64_t)i * width;
+        here[0] = i;
+        int32_t left = i;
+        for (int32_t j = 1; j <= cols; j++) {
+            int32_t value = above[j - 1] + (same_row[b[j - 1]] ? 0 : 1);
+            if (above[j] + 1 < value) {
+                value = above[j] + 1;
+            }
+            if (left + 1 < value) {
+                value = left + 1;
+            }
+            here[j] = value;
+            left = value;
+        }
+    }
+    return t[(int64_t)rows * width + cols];
+}
+
+/* aligned_index_pairs: the diagonal steps of the backtrace of the filled table, first to last.
+ * Writes pairs (a_k, b_k) to ``out`` and returns their number. */
+static int32_t backtrace_pairs(const Graphs *g, const int32_t *a, int32_t rows, const int32_t *b, int32_t cols,
+                               int32_t *out)
+{
+    const int32_t *t = g->table;
+    int32_t width = cols + 1, count = 0;
+    int32_t i = rows, j = cols;
+    while (i > 0 && j > 0) {
+        int32_t diagonal = t[(int64_t)(i - 1) * width + j - 1], up = t[(int64_t)(i - 1) * width + j],
+                left = t[(int64_t)i * width + j - 1];
+        if (diagonal <= up && diagonal <= left) {
+            i--;
+            j--;
+            out[2 * count] = a[i];
+            out[2 * count + 1] = b[j];
+            count++;
+        } else if (left <= up) {
+            j--;
+        } else {
+            i--;
+        }
+    }
+    for (int32_t k = 0; k < count / 2; k++) { /* first elements first */
+        int32_t x = out[2 * k], y = out[2 * k + 1];
+        out[2 * k] = out[2 * (count - 1 - k)];
+        out[2 * k + 1] = out[2 * (count - 1 - k) + 1];
+        out[2 * (count - 1 - k)] = x;
+        out[2 * (count - 1 - k) + 1] = y;
+    }
+    return count;
+}
+
+static int32_t aligned_index_pairs(const Graphs *g, const int32_t *a, int32_t rows, const int32_t *b, int32_t cols,
+                                   int32_t *out)
+{
+    if (rows == 0 || cols == 0) {
+        return 0;
+    }
+    if (rows == 1 && cols == 1) {
+        out[0] = a[0];
+        out[1] = b[0];
+        return 1;
+    }
+    fill_table(g, a, rows, b, cols);
+    return backtrace_pairs(g, a, rows, b, cols, out);
+}
+
+/* seed_alignment: the rotation (and reflection) of the sketch region's neighbours with the lowest
+ * distance to the metric region's (ties: the smallest offset, unreflected first; 'first' keeps
+ * offset 0), and the pairs it aligns. Returns the number of pairs; *reflected is set. */
+static int32_t seed_pairs(const Graphs *g, int32_t v, int32_t w, int rotation_min, int reflections, int *reflected,
+                          int32_t *out)
+{
+    const int32_t *a = g->nb1 + g->off1[v], *b = g->nb2 + g->off2[w];
+    int32_t rows = g->off1[v + 1] - g->off1[v], cols = g->off2[w + 1] - g->off2[w];
+    *reflected = 0;
+    if (!rotation_min || rows <= 1) {
+        return aligned_index_pairs(g, a, rows, b, cols, out);
+    }
+    int32_t *rotated = g->row_buffer;
+    int32_t best = -1, best_offset = 0;
+    int best_reflected = 0;
+    for (int flip = 0; flip <= (reflections ? 1 : 0) && best != 0; flip++) {
+        for (int32_t offset = 0; offset < rows; offset++) {
+            for (int32_t k = 0; k < rows; k++) {
+                int32_t position = (offset + k) % rows;
+                rotated[k] = flip ? a[rows - 1 - position] : a[position];
+            }
+            int32_t distance = fill_table(g, rotated, rows, b, cols);
+            if (best < 0 || distance < best) {
+                best = distance;
+                best_offset = offset;
+                best_reflected = flip;
+                if (distance == 0) {
+                    break;
+                }
+            }
+        }
+    }
+    for (int32_t k = 0; k < rows; k++) {
+        int32_t position = (best_offset + k) % rows;
+        rotated[k] = best_reflected ? a[rows - 1 - position] : a[position];
+    }
+    *reflected = best_reflected;
+    return aligned_index_pairs(g, rotated, rows, b, cols, out);
+}
+
+/* arc(): the elements strictly between positions start and stop walking forward (all the others
+ * after start when they are equal). Returns the length written to ``out``. */
+static int32_t arc(const int32_t *order, int32_t size, int32_t start, int32_t stop, int32_t *out)
+{
+    int32_t n = 0;
+    if (start < stop) {
+        for (int32_t k = start + 1; k < stop; k++) {
+            out[n++] = order[k];
+        }
+    } else {
+        for (int32_t k = start + 1; k < size; k++) {
+            out[n++] = order[k];
+        }
+        for (int32_t k = 0; k < stop; k++) {
+            out[n++] = order[k];
+        }
+    }
+    return n;
+}
+
+static int32_t *int_sequence_arg(PyObject *seeds, Py_ssize_t *count)
+{
+    PyObject *fast = PySequence_Fast(seeds, "planar_match: seeds must be a sequence of (int, int)");
+    if (fast == NULL) {
+        return NULL;
+    }
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(fast);
+    int32_t *out = malloc(sizeof(int32_t) * 2 * (size_t)(n > 0 ? n : 1));
+    if (out == NULL) {
+        Py_DECREF(fast);
+        PyErr_NoMemory();
+        return NULL;
+    }
+    PyObject **items = PySequence_Fast_ITEMS(fast);
+    for (Py_ssize_t k = 0; k < n; k++) {
+        PyObject *pair = items[k];
+        if (!PyTuple_Check(pair) || PyTuple_GET_SIZE(pair) != 2) {
+            PyErr_SetString(PyExc_TypeError, "planar_match: every seed must be a (int, int) tuple");
+            goto fail;
+        }
+        for (int side = 0; side < 2; side++) {
+            long value = PyLong_AsLong(PyTuple_GET_ITEM(pair, side));
+            if (value == -1 && PyErr_Occurred()) {
+                goto fail;
+            }
+            out[2 * k + side] = (int32_t)value;
+        }
+    }
+    Py_DECREF(fast);
+    *count = n;
+    return out;
+fail:
+    Py_DECREF(fast);
+    free(out);
+    return NULL;
+}
+
+/* planar_match(off1, nb1, off2, nb2, edges1, edges2, same, seeds, pair_costs, weight, rotation_min,
+ * reflections) -> (pairs, cost, structural_cost, hypotheses, seeds_expanded).
+ * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). */
+static PyObject *planar_match(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 12) {
+        PyErr_Format(PyExc_TypeError, "planar_match takes 12 arguments (%zd given)", nargs);
+        return NULL;
+    }
+    Py_buffer views[6];
+    int n_views = 0;
+    PyObject *result = NULL;
+    int32_t *seeds = NULL, *work = NULL;
+    int32_t *stamps = NULL;
+    uint8_t *consumed = NULL;
+    if (get_buffer(args[0], 4, 'i', 1, "off1", &views[n_views]) < 0) goto done;
+    n_views++;
+    if (get_buffer(args[1], 4, 'i', 1, "nb1", &views[n_views]) < 0) goto done;
+    n_views++;
+    if (get_buffer(args[2], 4, 'i', 1, "off2", &views[n_views]) < 0) goto done;
+    n_views++;
+    if (get_buffer(args[3], 4, 'i', 1, "nb2", &views[n_views]) < 0) goto done;
+    n_views++;
+    if (get_buffer(args[6], 1, 'b', 2, "same", &views[n_views]) < 0) goto done;
+    n_views++;
+    int weighted = args[8] != Py_None;
+    const double *costs = NULL;
+    if (weighted) {
+        if (get_buffer(args[8], 8, 'f', 2, "pair_costs", &views[n_views]) < 0) goto done;
+        costs = views[n_views].buf;
+        n_views++;
+    }
+    long edges1 = PyLong_AsLong(args[4]), edges2 = PyLong_AsLong(args[5]);
+    double weight = PyFloat_AsDouble(args[9]);
+    long rotation_min = PyLong_AsLong(args[10]), reflections = PyLong_AsLong(args[11]);
+    if (PyErr_Occurred()) goto done;
+
+    Graphs g;
+    g.n1 = (int32_t)(views[0].shape[0] - 1);
+    g.n2 = (int32_t)(views[2].shape[0] - 1);
+    g.off1 = views[0].buf;
+    g.nb1 = views[1].buf;
+    g.off2 = views[2].buf;
+    g.nb2 = views[3].buf;
+    g.same = views[4].buf;
+    int32_t n1 = g.n1, n2 = g.n2;
+    if (n1 < 0 || n2 < 0 || views[4].shape[0] != n1 || views[4].shape[1] != n2
+        || (weighted && (views[5].shape[0] != n1 || views[5].shape[1] != n2))) {
+        PyErr_SetString(PyExc_ValueError, "planar_match: same and pair_costs must be n1 x n2");
+        goto done;
+    }
+    int32_t degree1 = 0, degree2 = 0;
+    for (int32_t v = 0; v < n1; v++) {
+        int32_t d = g.off1[v + 1] - g.off1[v];
+        degree1 = d > degree1 ? d : degree1;
+    }
+    for (int32_t v = 0; v < n2; v++) {
+        int32_t d = g.off2[v + 1] - g.off2[v];
+        degree2 = d > degree2 ? d : degree2;
+    }
+    Py_ssize_t n_seeds = 0;
+    seeds = int_sequence_arg(args[7], &n_seeds);
+    if (seeds == NULL) goto done;
+    for (Py_ssize_t k = 0; k < n_seeds; k++) {
+        if (seeds[2 * k] < 0 || seeds[2 * k] >= n1 || seeds[2 * k + 1] < 0 || seeds[2 * k + 1] >= n2) {
+            PyErr_SetString(PyExc_IndexError, "planar_match: a seed is outside the graphs");
+            goto done;
+        }
+    }
+    if (n_seeds == 0) {
+        PyErr_SetString(PyExc_ValueError, "planar_match: no seed");
+        goto done;
+    }
+    int32_t n_min = n1 < n2 ? n1 : n2;
+    int32_t d_max = degree1 > degree2 ? degree1 : degree2;
+    /* Scratch: table, row buffer, two arcs, locks (2 per), aligned pairs (2 per), queue and pairs
+     * (2 per, at most n1 + 1 each), the best pairs, the partners. */
+    size_t table_cells = (size_t)(degree1 + 1) * (size_t)(degree2 + 1);
+    size_t words = table_cells + 3 * (size_t)(d_max + 1) + 4 * (size_t)(d_max + 1)
+                   + 2 * 2 * (size_t)(n1 + 2) + 2 * (size_t)(n_min + 1) + (size_t)n1;
+    work = malloc(sizeof(int32_t) * words);
+    stamps = calloc((size_t)(2 * n1 + n2 + 1), sizeof(int32_t));
+    consumed = calloc((size_t)n1 * (size_t)n2 + 1, 1);
+    if (work == NULL || stamps == NULL || consumed == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    g.table = work;
+    g.row_buffer = g.table + table_cells;
+    int32_t *arc1 = g.row_buffer + (d_max + 1), *arc2 = arc1 + (d_max + 1);
+    int32_t *locks = arc2 + (d_max + 1), *aligned = locks + 2 * (d_max + 1);
+    int32_t *queue = aligned + 2 * (d_max + 1), *pairs = queue + 2 * (n1 + 2);
+    int32_t *best_pairs = pairs + 2 * (n1 + 2), *partner = best_pairs + 2 * (n_min + 1);
+    /* Per hypothesis stamps: seen in the sketch, matched in the sketch, seen in the metric map. */
+    int32_t *seen1 = stamps, *matched1 = stamps + n1, *seen2 = stamps + 2 * n1;
+
+    int64_t single_structure = (int64_t)(n1 - 1) + (n2 - 1) + edges1 + edges2;
+    Py_ssize_t best_seed = 0;
+    double best_term = 0.0;
+    if (weighted) {
+        best_term = weight * costs[(int64_t)seeds[0] * n2 + seeds[1]];
+        for (Py_ssize_t k = 1; k < n_seeds; k++) {
+            double term = weight * costs[(int64_t)seeds[2 * k] * n2 + seeds[2 * k + 1]];
+            if (term < best_term) {
+                best_term = term;
+                best_seed = k;
+            }
+        }
+    }
+    int32_t n_best = 1;
+    best_pairs[0] = seeds[2 * best_seed];
+    best_pairs[1] = seeds[2 * best_seed + 1];
+    int64_t best_structure = single_structure;
+    double best_cost = (double)single_structure + best_term;
+    int64_t hypotheses = n_seeds, expanded = 0;
+    int32_t stamp = 0;
+
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t k = 0; k < n_seeds; k++) {
+        int32_t v = seeds[2 * k], w = seeds[2 * k + 1];
+        if (consumed[(int64_t)v * n2 + w]) {
+            continue;
+        }
+        consumed[(int64_t)v * n2 + w] = 1;
+        expanded++;
+        stamp++;
+        int reflected = 0;
+        int32_t n_aligned = seed_pairs(&g, v, w, (int)rotation_min, (int)reflections, &reflected, aligned);
+        seen1[v] = stamp;
+        seen2[w] = stamp;
+        matched1[v] = stamp;
+        partner[v] = w;
+        int32_t n_pairs = 1, head = 0, tail = 0;
+        pairs[0] = v;
+        pairs[1] = w;
+        for (int32_t q = 0; q < n_aligned; q++) {
+            int32_t a = aligned[2 * q], b = aligned[2 * q + 1];
+            if (seen1[a] == stamp || seen2[b] == stamp) {
+                continue;
+            }
+            queue[2 * tail] = a;
+            queue[2 * tail + 1] = b;
+            tail++;
+            seen1[a] = stamp;
+            seen2[b] = stamp;
+            consumed[(int64_t)a * n2 + b] = 1;
+        }
+        while (head < tail) {
+            int32_t vertex = queue[2 * head], other = queue[2 * head + 1];
+            head++;
+            if (matched1[vertex] != stamp) {
+                pairs[2 * n_pairs] = vertex;
+                pairs[2 * n_pairs + 1] = other;
+                n_pairs++;
+                matched1[vertex] = stamp;
+                partner[vertex] = other;
+            }
+            int32_t size1 = g.off1[vertex + 1] - g.off1[vertex], size2 = g.off2[other + 1] - g.off2[other];
+            if (size1 <= 1 || size2 <= 1) {
+                continue; /* one neighbour on either side: every arc between locks is empty */
+            }
+            const int32_t *order2 = g.nb2 + g.off2[other];
+            const int32_t *base1 = g.nb1 + g.off1[vertex];
+            int32_t *order1 = g.row_buffer;
+            for (int32_t p = 0; p < size1; p++) {
+                order1[p] = reflected ? base1[size1 - 1 - p] : base1[p];
+            }
+            int32_t n_locks = 0;
+            for (int32_t p = 0; p < size1; p++) {
+                int32_t u = order1[p];
+                if (matched1[u] != stamp) {
+                    continue;
+                }
+                int32_t target = partner[u];
+                for (int32_t r = 0; r < size2; r++) {
+                    if (order2[r] == target) {
+                        locks[2 * n_locks] = p;
+                        locks[2 * n_locks + 1] = r;
+                        n_locks++;
+                        break;
+                    }
+                }
+            }
+            for (int32_t l = 0; l < n_locks; l++) {
+                int32_t next = (l + 1) % n_locks;
+                int32_t length1 = arc(order1, size1, locks[2 * l], locks[2 * next], arc1);
+                int32_t length2 = arc(order2, size2, locks[2 * l + 1], locks[2 * next + 1], arc2);
+                if (length1 == 0 || length2 == 0) {
+                    continue;
+                }
+                /* order1 lives in row_buffer, which the alignment does not touch (it is only the
+                 * seed alignment's rotation buffer). */
+                int32_t found = aligned_index_pairs(&g, arc1, length1, arc2, length2, aligned);
+                for (int32_t q = 0; q < found; q++) {
+                    int32_t a = aligned[2 * q], b = aligned[2 * q + 1];
+                    if (seen1[a] == stamp || seen2[b] == stamp) {
+                        continue;
+                    }
+                    queue[2 * tail] = a;
+                    queue[2 * tail + 1] = b;
+                    tail++;
+                    seen1[a] = stamp;
+                    seen2[b] = stamp;
+                    consumed[(int64_t)a * n2 + b] = 1;
+                }
+            }
+        }
+        hypotheses++;
+        /* Edges among the matched vertices, each seen from both ends. At the end of an expansion
+         * every queued pair is matched, so "seen" is "matched" on both sides. */
+        int64_t inner1 = 0, inner2 = 0;
+        for (int32_t p = 0; p < n_pairs; p++) {
+            int32_t a = pairs[2 * p], b = pairs[2 * p + 1];
+            for (int32_t e = g.off1[a]; e < g.off1[a + 1]; e++) {
+                inner1 += matched1[g.nb1[e]] == stamp;
+            }
+            for (int32_t e = g.off2[b]; e < g.off2[b + 1]; e++) {
+                inner2 += seen2[g.nb2[e]] == stamp;
+            }
+        }
+        inner1 /= 2;
+        inner2 /= 2;
+        int64_t structure = (int64_t)(n1 - n_pairs) + (n2 - n_pairs) + (edges1 - inner1) + (edges2 - inner2)
+                            + (inner1 > inner2 ? inner1 - inner2 : inner2 - inner1);
+        double cost = (double)structure;
+        if (weighted) {
+            double sum = 0.0;
+            for (int32_t p = 0; p < n_pairs; p++) {
+                sum += costs[(int64_t)pairs[2 * p] * n2 + pairs[2 * p + 1]];
+            }
+            cost = (double)structure + weight * sum;
+        }
+        /* A small tolerance so that float sums of pair costs do not break the earliest-wins rule. */
+        if (cost < best_cost - 1e-12) {
+            best_cost = cost;
+            best_structure = structure;
+            n_best = n_pairs;
+            memcpy(best_pairs, pairs, sizeof(int32_t) * 2 * (size_t)n_pairs);
+        }
+    }
+    Py_END_ALLOW_THREADS
+
+    PyObject *listed = PyList_New(n_best);
+    if (listed == NULL) goto done;
+    for (int32_t p = 0; p < n_best; p++) {
+        PyObject *pair = Py_BuildValue("(ii)", best_pairs[2 * p], best_pairs[2 * p + 1]);
+        if (pair == NULL) {
+            Py_DECREF(listed);
+            goto done;
+        }
+        PyList_SET_ITEM(listed, p, pair);
+    }
+    PyObject *cost_object = weighted ? PyFloat_FromDouble(best_cost) : PyLong_FromLongLong((long long)best_structure);
+    if (cost_object == NULL) {
+        Py_DECREF(listed);
+        goto done;
+    }
+    result = Py_BuildValue("(NNLLL)", listed, cost_object, (long long)best_structure, (long long)hypotheses,
+                           (long long)expanded);
+done:
+    for (int k = 0; k < n_views; k++) {
+        PyBuffer_Release(&views[k]);
+    }
+    free(seeds);
+    free(work);
+    free(stamps);
+    free(consumed);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"planar_match", (PyCFunction)(void (*)(void))planar_match, METH_FASTCALL, NULL},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_planar_kernel",
+    "The planar matcher's seed-and-expand loop in C (ursim_core/matching/csrc), a port of planar.py.", -1, methods,
+};
+
+PyMODINIT_FUNC PyInit__planar_kernel(void)
+{
+    return PyModule_Create(&module);
+}

@@ -1,0 +1,129 @@
+"""The planar matcher's seed-and-expand loop in C (:file:`csrc/planar.c`), and when it is used.
+
+:func:`~ursim_core.matching.planar.planar_match` hands its common case to :func:`match_compiled`:
+no constraints, no alternatives kept, and graphs whose alignments are sketch-sized (the Python
+code stays for the rest, and is the reference: a test compares both on random graphs with many
+ties and on the KTH pairs). The C loop gives the same pairs in the same order, the same cost (the
+pair costs summed in pair order, as Python 3.11's ``sum``) and the same counts.
+
+The module is compiled on the installed machine (:class:`ursim_core.native.NativeModule`; ``make``
+builds it with the segmentation kernels, else the first match does, in about a second). With no C
+compiler, or ``URSIM_KERNELS=jit`` (which also keeps the MAORIS kernels in numba), the matcher
+runs in Python, a little over twice as slow on a turned KTH sketch.
+
+Examples
+--------
+>>> from ursim_core.matching.planar import PlanarGraph
+>>> p = PlanarGraph(nodes=[0, 1, 2], neighbours=[[1], [0, 2], [1]], edges=[(0, 1), (1, 2)])
+>>> same = np.eye(3, dtype=bool)
+>>> match_compiled(p, p, same, [(0, 0), (1, 1), (2, 2)]) is None or match_compiled(p, p, same, [(0, 0)])[:2]
+True
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ursim_core.native import NativeModule
+
+__all__ = ["MODULE", "LARGEST_CELLS", "kernel", "build", "match_compiled", "forget"]
+
+MODULE = NativeModule("_planar_kernel", Path(__file__).resolve().parent / "csrc")
+"""The extension module: its sources and where it is built."""
+
+#: Pairs of graphs with more than this many (sketch, metric) cells go to Python: its packed
+#: alignments of long neighbour lists (a building's corridors) are faster than a C table, and the
+#: kernel's "consumed" bitmap is one byte a cell.
+LARGEST_CELLS = 1 << 20
+#: Nor do graphs whose two longest neighbour lists make an alignment table this large.
+LARGEST_TABLE = 1 << 16
+
+_UNSET = object()
+_loaded = _UNSET
+
+
+def build() -> Path:
+    """Compile the kernel (:meth:`NativeModule.build`) and load it on the next :func:`kernel`."""
+    path = MODULE.build()
+    forget()
+    return path
+
+
+def kernel():
+    """The loaded module, or None (no C compiler, ``URSIM_KERNELS=jit``, or a failed build).
+
+    The first call builds the module when it is missing or stale; a failure is warned about once
+    and the matcher runs in Python.
+    """
+    global _loaded
+    if _loaded is _UNSET:
+        _loaded = None
+        if os.environ.get("URSIM_KERNELS", "auto").strip().lower() != "jit":
+            try:
+                path = MODULE.built_path() or MODULE.build()
+                _loaded = MODULE.load(path)
+            except (RuntimeError, ImportError, OSError) as error:
+                warnings.warn(
+                    f"could not build the planar matcher's C kernel ({type(error).__name__}: {error}); "
+                    "matching runs in Python, about twice as slow",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
+    return _loaded
+
+
+def forget() -> None:
+    """Look for the module again on the next :func:`kernel` (after a build, or in tests)."""
+    global _loaded
+    _loaded = _UNSET
+
+
+def _csr(graph) -> tuple[np.ndarray, np.ndarray, int]:
+    """The graph's cyclic neighbour orders as offsets and one flat array (int32), and the longest
+    order's length; kept on the graph (a sweep matches the same graphs at every m)."""
+    found = graph.__dict__.get("_csr")
+    if found is None:
+        lengths = [len(order) for order in graph.neighbours]
+        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
+        np.cumsum(lengths, out=offsets[1:])
+        flat = np.fromiter((v for order in graph.neighbours for v in order), dtype=np.int32, count=int(offsets[-1]))
+        # PlanarGraph is frozen: the arrays are stored as its cached properties are.
+        found = graph.__dict__["_csr"] = (offsets, flat, max(lengths, default=0))
+    return found
+
+
+def match_compiled(
+    first, second, same, seeds, *, rotation_search="min", reflections=False, pair_costs=None, pair_cost_weight=0.0
+):
+    """``(pairs, cost, structural_cost, hypotheses, seeds_expanded)`` from the C loop, or None
+    when it does not take this case (see the module docstring); ``seeds`` must not be empty."""
+    if first.n_vertices * second.n_vertices > LARGEST_CELLS:
+        return None
+    module = kernel()
+    if module is None:
+        return None
+    first_offsets, first_orders, longest_first = _csr(first)
+    second_offsets, second_orders, longest_second = _csr(second)
+    if (longest_first + 1) * (longest_second + 1) > LARGEST_TABLE:
+        return None
+    same = np.ascontiguousarray(same, dtype=np.bool_)
+    weighted = pair_costs is not None and pair_cost_weight != 0
+    costs = np.ascontiguousarray(pair_costs, dtype=np.float64) if weighted else None
+    return module.planar_match(
+        first_offsets,
+        first_orders,
+        second_offsets,
+        second_orders,
+        len(first.edges),
+        len(second.edges),
+        same,
+        seeds,
+        costs,
+        float(pair_cost_weight),
+        int(rotation_search == "min"),
+        int(bool(reflections)),
+    )
