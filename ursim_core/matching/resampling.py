@@ -14,7 +14,8 @@ segmentation's regions and keeps the pairs that at least half of them hold (:fun
 vote instead of six (``MatchConfig.vote_segmentations``): the vote's matches had become cheap
 enough for it. Since round 37 eight vote, and the reading they vote in is the one all of them rank
 best on the whole, not the one most of them chose (:func:`lowest_scored_reading`,
-``MatchConfig.vote_rule``).
+``MatchConfig.vote_rule``). Since round 39 six vote again, as leave-one-sketch-out chose once the
+turned sketches were smoothed (round 38).
 
 ``segment_canonical(..., resampled=True)`` makes the other segmentations
 (``Segmentation.resampled``); :func:`ursim_core.matching.prepare` prepares each when

@@ -53,8 +53,9 @@ _MIN_ANGLE = 3.0
 #: Rounds 30-32 had the first four; the half degrees came in round 33 (ten segmentations, see
 #: ``MatchConfig.vote_segmentations``, which votes over the first ones of this order). Round 37:
 #: eight voted better than ten with the vote's new reading rule, so +0.5 and +1.5, the last two,
-#: are no longer made.
-RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0, -1.5, -0.5)
+#: were no longer made; round 39: six, chosen held out once the turned maps were smoothed, so
+#: -1.5 and -0.5 are not either (and the offsets are symmetric, as a mirrored map's are).
+RESAMPLING_OFFSETS = (-2.0, -1.0, 1.0, 2.0)
 #: A map resampled onto its wall axes is smoothed before it is segmented by a median filter whose
 #: side is its free space's median distance to a wall divided by this (:func:`smoothed_turn`).
 #: Round 38, chosen on the 18 KTH sketches turned by 15, 30, ..., 345 degrees among thirteen
@@ -96,7 +97,7 @@ def wall_angle(free: np.ndarray) -> float:
     if mask.size > _ANGLE_MAX_PIXELS:
         step = math.ceil(math.sqrt(mask.size / _ANGLE_MAX_PIXELS))
         mask = mask[::step, ::step]
-    # Remembered by content: a turned map's eight segmentations each ask for the angle of the
+    # Remembered by content: a turned map's six segmentations each ask for the angle of the
     # same free space (and turned_back before them), and the vote below traces it eight times.
     return _voted_angle(np.ascontiguousarray(mask, dtype=np.uint8).tobytes(), mask.shape)
 

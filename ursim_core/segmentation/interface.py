@@ -377,7 +377,7 @@ def segment_canonical(
     ``resampled=True``: when the map is resampled onto its wall axes (walls 3 degrees or more off
     the image axes), also segment it turned back by the other angles of
     :data:`~ursim_core.segmentation.canonical.RESAMPLING_OFFSETS` and not turned back, into
-    ``Segmentation.resampled`` (seven more segmentations), for the matcher to vote over. The
+    ``Segmentation.resampled`` (five more segmentations), for the matcher to vote over. The
     regions of a resampled sketch depend on the resampling: on the 18 KTH sketches turned by
     15, 30, ..., 345 degrees, the better of two such segmentations per sketch scores 0.76 mean F1
     against 0.69 for the default one (round 30).

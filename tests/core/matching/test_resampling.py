@@ -194,11 +194,11 @@ def _voted_by_hand(sketch, first_answer, variants, m=None, correspondences=None)
 
 def test_a_resampled_sketch_is_matched_in_every_segmentation_and_voted(turned_pair):
     sketch, plan = turned_pair
-    assert len(sketch.resampled) == len(RESAMPLING_OFFSETS) + 1 == 7
+    assert len(sketch.resampled) == len(RESAMPLING_OFFSETS) + 1 == 5
     prepared = prepare(sketch, plan)
-    assert prepared.resampled is not None and len(prepared.resampled.variants) == 7
+    assert prepared.resampled is not None and len(prepared.resampled.variants) == 5
     voted = match(sketch, plan)
-    assert voted.resampling_votes == MatchConfig().vote_segmentations == 8
+    assert voted.resampling_votes == MatchConfig().vote_segmentations == 6
     # The voted pairs are in the first segmentation's regions, one to one.
     assert {a for a, _ in voted.pairs} <= set(sketch.graph.nodes)
     assert len({a for a, _ in voted.pairs}) == len(voted.pairs) == len({b for _, b in voted.pairs})
@@ -281,7 +281,7 @@ def test_the_metric_maps_wall_angle_is_measured_once_for_the_whole_vote(turned_p
     original = canonical.wall_angle
     monkeypatch.setattr(canonical, "wall_angle", lambda labels: measured.append(labels) or original(labels))
     prepared = prepare(sketch, plan)
-    assert len(prepared.resampled.variants) == 7
+    assert len(prepared.resampled.variants) == 5
     assert sum(labels is plan.labels for labels in measured) == 1
     # Each segmentation of the sketch at most once too (earlier tests may have measured them).
     segmentations = [sketch, *sketch.resampled]
@@ -336,8 +336,8 @@ def test_the_other_segmentations_try_the_first_ones_finalist_orientations(turned
     prepared = prepare(sketch, plan)
     finalists = list(prepared.orientation_scan)
     assert 1 < len(finalists) < 8  # the first segmentation screened eight and kept a few
-    # Eight for the first segmentation; the finalists only for each of the seven others.
-    assert len(made) == 7 + 7 * (len(finalists) - 1) and len(prepared.resampled.variants) == 7
+    # Eight for the first segmentation; the finalists only for each of the five others.
+    assert len(made) == 7 + 5 * (len(finalists) - 1) and len(prepared.resampled.variants) == 5
     for _, variant in prepared.resampled.variants:
         tried = list(variant.orientation_scan)
         assert 1 <= len(tried) <= len(finalists)
