@@ -25,10 +25,10 @@ $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 # The segmentation kernels (ursim_core/segmentation/maoris/csrc) and the planar matcher's loop
 # (ursim_core/matching/csrc) are C, compiled into extension modules on first use: do it once here
 # rather than inside the first segmentation or match (or in both test workers at once).
-$(VENV)/.kernels: $(shell find ursim_core/segmentation/maoris ursim_core/matching/csrc -name '*.py' -o -name '*.c' -o -name '*.h') ursim_core/native.py ursim_core/matching/planar_kernel.py | $(VENV)/.installed-core
+$(VENV)/.kernels: $(shell find ursim_core/segmentation/maoris ursim_core/matching/csrc -name '*.py' -o -name '*.c' -o -name '*.h') ursim_core/native.py ursim_core/matching/kernels.py | $(VENV)/.installed-core
 	@echo "Compiling the segmentation and matching kernels (once; a few seconds)..."
 	$(BIN)/python -c "from ursim_core.segmentation.maoris import compile_kernels; print(f'{compile_kernels():.1f} s')"
-	$(BIN)/python -c "from ursim_core.matching.planar_kernel import build; print(build())"
+	$(BIN)/python -c "from ursim_core.matching.kernels import build; print(build())"
 	touch $@
 
 run: $(VENV)/.installed-gui $(VENV)/.kernels

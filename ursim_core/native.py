@@ -2,7 +2,7 @@
 
 The project ships C sources, not binaries: the MAORIS kernels
 (:mod:`ursim_core.segmentation.maoris.compiled`) and the planar matcher's loop
-(:mod:`ursim_core.matching.planar_kernel`) are compiled once per install by the C compiler Python
+(:mod:`ursim_core.matching.kernels`) are compiled once per install by the C compiler Python
 was built with (``make`` does it; the first use does when nothing did). A :class:`NativeModule`
 names one such module: its sources, where its build may live (beside the sources in a checkout
 or writable install, else the user's cache), and the digest of the sources it was built from, so

@@ -42,7 +42,7 @@ Consumed seeds are skipped, which in practice removes most of them on consistent
 (see ``ursim_core.matching.MatchConfig.max_seeds``).
 
 Speed: the common case (no constraints, no alternatives kept, sketch-sized graphs) runs the same
-loop in C (:mod:`ursim_core.matching.planar_kernel`; the same answers, which a test checks against
+loop in C (:mod:`ursim_core.matching.kernels`; the same answers, which a test checks against
 this code). The code here runs the rest, and everything where no C compiler is.
 """
 
@@ -60,7 +60,7 @@ import numpy as np
 from ursim_core.matching.alignment_memo import seed_alignment
 from ursim_core.matching.arcs import expand_locked
 from ursim_core.matching.edit_distance import COMPILED_CELLS
-from ursim_core.matching.planar_kernel import match_compiled
+from ursim_core.matching.kernels import match_compiled
 
 __all__ = ["PlanarGraph", "PlanarResult", "planar_graph", "cyclic_neighbours", "hypothesis_cost", "planar_match"]
 
@@ -341,7 +341,7 @@ def planar_match(
     if not seeds:
         return PlanarResult(pairs=[], cost=math.inf, hypotheses=0, seeds_expanded=0)
     if constraints is None and not keep_alternatives and rotation_search in ("min", "first"):
-        # The same loop in C (planar_kernel), when it is built and takes graphs of this size.
+        # The same loop in C (matching.kernels), when it is built and takes graphs of this size.
         compiled = match_compiled(
             first, second, same, seeds, rotation_search=rotation_search, reflections=reflections,
             pair_costs=pair_costs, pair_cost_weight=pair_cost_weight,

@@ -1,4 +1,4 @@
-/* The planar matcher's seed-and-expand loop in C: the extension module ``_planar_kernel``.
+/* The planar matcher's seed-and-expand loop in C (module ``_matching_kernels``, see module.c).
  *
  * A port of ursim_core/matching/planar.py's planar_match for its common case (no constraints,
  * no alternatives kept), which stays the reference: the same seeds in the same order, the same
@@ -11,33 +11,10 @@
  * orientations, the m grid, the refits), and Python spent 58 of the 130 ms of such a match in
  * this loop.
  */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <stdint.h>
+#include "kernels.h"
+
 #include <stdlib.h>
 #include <string.h>
-
-/* A C-contiguous buffer of a given item size and format kind ('i' signed int, 'f' float, 'b' bool/uint8). */
-static int get_buffer(PyObject *obj, Py_ssize_t itemsize, char kind, int ndim, const char *what, Py_buffer *view)
-{
-    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
-        PyErr_Format(PyExc_TypeError, "planar_match: %s must be a C-contiguous array", what);
-        return -1;
-    }
-    const char *format = view->format ? view->format : "B";
-    while (*format == '<' || *format == '=' || *format == '@' || *format == '|') {
-        format++;
-    }
-    int kind_ok = (kind == 'i' && (*format == 'i' || *format == 'l' || *format == 'q'))
-                  || (kind == 'f' && *format == 'd') || (kind == 'b' && (*format == '?' || *format == 'B'));
-    if (view->itemsize != itemsize || !kind_ok || view->ndim != ndim) {
-        PyErr_Format(PyExc_TypeError, "planar_match: %s has the wrong type or shape (format %s, %d dimensions)", what,
-                     view->format ? view->format : "B", view->ndim);
-        PyBuffer_Release(view);
-        return -1;
-    }
-    return 0;
-}
 
 typedef struct {
     int32_t n1, n2;
@@ -223,7 +200,7 @@ fail:
 /* planar_match(off1, nb1, off2, nb2, edges1, edges2, same, seeds, pair_costs, weight, rotation_min,
  * reflections) -> (pairs, cost, structural_cost, hypotheses, seeds_expanded).
  * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). */
-static PyObject *planar_match(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+KERNEL(planar_match)
 {
     if (nargs != 12) {
         PyErr_Format(PyExc_TypeError, "planar_match takes 12 arguments (%zd given)", nargs);
@@ -235,20 +212,20 @@ static PyObject *planar_match(PyObject *self, PyObject *const *args, Py_ssize_t 
     int32_t *seeds = NULL, *work = NULL;
     int32_t *stamps = NULL;
     uint8_t *consumed = NULL;
-    if (get_buffer(args[0], 4, 'i', 1, "off1", &views[n_views]) < 0) goto done;
+    if (get_buffer(args[0], 4, 'i', 1, "planar_match: off1", &views[n_views]) < 0) goto done;
     n_views++;
-    if (get_buffer(args[1], 4, 'i', 1, "nb1", &views[n_views]) < 0) goto done;
+    if (get_buffer(args[1], 4, 'i', 1, "planar_match: nb1", &views[n_views]) < 0) goto done;
     n_views++;
-    if (get_buffer(args[2], 4, 'i', 1, "off2", &views[n_views]) < 0) goto done;
+    if (get_buffer(args[2], 4, 'i', 1, "planar_match: off2", &views[n_views]) < 0) goto done;
     n_views++;
-    if (get_buffer(args[3], 4, 'i', 1, "nb2", &views[n_views]) < 0) goto done;
+    if (get_buffer(args[3], 4, 'i', 1, "planar_match: nb2", &views[n_views]) < 0) goto done;
     n_views++;
-    if (get_buffer(args[6], 1, 'b', 2, "same", &views[n_views]) < 0) goto done;
+    if (get_buffer(args[6], 1, 'b', 2, "planar_match: same", &views[n_views]) < 0) goto done;
     n_views++;
     int weighted = args[8] != Py_None;
     const double *costs = NULL;
     if (weighted) {
-        if (get_buffer(args[8], 8, 'f', 2, "pair_costs", &views[n_views]) < 0) goto done;
+        if (get_buffer(args[8], 8, 'f', 2, "planar_match: pair_costs", &views[n_views]) < 0) goto done;
         costs = views[n_views].buf;
         n_views++;
     }
@@ -488,19 +465,4 @@ done:
     free(stamps);
     free(consumed);
     return result;
-}
-
-static PyMethodDef methods[] = {
-    {"planar_match", (PyCFunction)(void (*)(void))planar_match, METH_FASTCALL, NULL},
-    {NULL, NULL, 0, NULL},
-};
-
-static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "_planar_kernel",
-    "The planar matcher's seed-and-expand loop in C (ursim_core/matching/csrc), a port of planar.py.", -1, methods,
-};
-
-PyMODINIT_FUNC PyInit__planar_kernel(void)
-{
-    return PyModule_Create(&module);
 }

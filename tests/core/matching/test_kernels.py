@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 
 from ursim_core.bench.matching import perturbed_copy, random_region_graph
-from ursim_core.matching import planar_kernel
+from ursim_core.matching import kernels
 from ursim_core.matching.planar import planar_graph, planar_match
 from ursim_core.native import NativeModule
 
 
 @pytest.fixture
 def c_kernel():
-    module = planar_kernel.kernel()
+    module = kernels.kernel()
     if module is None:
         pytest.skip("the planar kernel could not be built here (no C compiler)")
     return module
@@ -25,7 +25,7 @@ def c_kernel():
 
 def _python(monkeypatch):
     """Run the next planar_match calls in Python."""
-    monkeypatch.setattr(planar_kernel, "kernel", lambda: None)
+    monkeypatch.setattr(kernels, "kernel", lambda: None)
 
 
 def _answer(result):
@@ -111,7 +111,7 @@ def test_the_kernel_runs_the_common_case_and_python_the_rest(c_kernel, monkeypat
     with pytest.raises(AssertionError, match="Python loop"):
         planar_match(line, line, same, keep_alternatives=True)
     # Graphs too large for the kernel's tables go to Python as well.
-    monkeypatch.setattr(planar_kernel, "LARGEST_CELLS", 15)
+    monkeypatch.setattr(kernels, "LARGEST_CELLS", 15)
     with pytest.raises(AssertionError, match="Python loop"):
         planar_match(line, line, same)
 
@@ -122,19 +122,19 @@ def test_bad_arguments_are_refused_by_the_kernel(c_kernel):
     line = planar_graph(graph)
     same = np.ones((3, 3), dtype=bool)
     with pytest.raises(IndexError, match="outside the graphs"):
-        planar_kernel.match_compiled(line, line, same, [(0, 3)])
+        kernels.match_compiled(line, line, same, [(0, 3)])
     with pytest.raises(TypeError, match="seed must be a"):
-        planar_kernel.match_compiled(line, line, same, [(0, 1, 2)])
+        kernels.match_compiled(line, line, same, [(0, 1, 2)])
     with pytest.raises(ValueError, match="n1 x n2"):
-        planar_kernel.match_compiled(line, line, same[:2], [(0, 0)])
+        kernels.match_compiled(line, line, same[:2], [(0, 0)])
 
 
 def test_an_edited_source_is_built_again(tmp_path):
-    if planar_kernel.kernel() is None:
+    if kernels.kernel() is None:
         pytest.skip("no C compiler here")
     sources = tmp_path / "csrc"
-    shutil.copytree(planar_kernel.MODULE.source_dir, sources, ignore=shutil.ignore_patterns("__pycache__"))
-    module = NativeModule("_planar_kernel", sources)
+    shutil.copytree(kernels.MODULE.source_dir, sources, ignore=shutil.ignore_patterns("__pycache__"))
+    module = NativeModule("_matching_kernels", sources)
     assert module.built_path() is None
     built = module.build()
     assert module.built_path() == built
@@ -145,26 +145,26 @@ def test_an_edited_source_is_built_again(tmp_path):
 
 def test_without_a_compiler_the_matcher_warns_once_and_runs_in_python(tmp_path, monkeypatch):
     sources = tmp_path / "csrc"
-    shutil.copytree(planar_kernel.MODULE.source_dir, sources, ignore=shutil.ignore_patterns("__pycache__"))
-    monkeypatch.setattr(planar_kernel, "MODULE", NativeModule("_planar_kernel", sources))
+    shutil.copytree(kernels.MODULE.source_dir, sources, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(kernels, "MODULE", NativeModule("_matching_kernels", sources))
     monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    planar_kernel.forget()
+    kernels.forget()
     try:
         with pytest.warns(RuntimeWarning, match="no C compiler.*runs in Python"):
-            assert planar_kernel.kernel() is None
+            assert kernels.kernel() is None
         graph = nx.path_graph(3)
         nx.set_node_attributes(graph, {i: (0.0, 10.0 * i) for i in range(3)}, "centroid")
         line = planar_graph(graph)
         assert planar_match(line, line, np.eye(3, dtype=bool)).cost == 0
     finally:
-        planar_kernel.forget()
+        kernels.forget()
 
 
 def test_ursim_kernels_jit_keeps_the_matcher_in_python(monkeypatch):
     monkeypatch.setenv("URSIM_KERNELS", "jit")
-    planar_kernel.forget()
+    kernels.forget()
     try:
-        assert planar_kernel.kernel() is None
+        assert kernels.kernel() is None
     finally:
-        planar_kernel.forget()
+        kernels.forget()

@@ -1,10 +1,12 @@
-"""The planar matcher's seed-and-expand loop in C (:file:`csrc/planar.c`), and when it is used.
+"""The matcher's loops in C (:file:`csrc`), and when they are used.
 
-:func:`~ursim_core.matching.planar.planar_match` hands its common case to :func:`match_compiled`:
-no constraints, no alternatives kept, and graphs whose alignments are sketch-sized (the Python
-code stays for the rest, and is the reference: a test compares both on random graphs with many
-ties and on the KTH pairs). The C loop gives the same pairs in the same order, the same cost (the
-pair costs summed in pair order, as Python 3.11's ``sum``) and the same counts.
+The planar matcher's seed-and-expand loop runs in C (:file:`csrc/planar.c`), a port of
+:mod:`ursim_core.matching.planar`, which stays the reference (tests compare both) and runs where
+the C module cannot be built. The module has room for more loops (:file:`csrc/module.c`).
+
+:func:`match_compiled` takes the planar matcher's common case (no constraints, no alternatives
+kept, graphs whose alignments are sketch-sized) and gives the same pairs in the same order, the
+same cost (the pair costs summed in pair order, as Python 3.11's ``sum``) and the same counts.
 
 The module is compiled on the installed machine (:class:`ursim_core.native.NativeModule`; ``make``
 builds it with the segmentation kernels, else the first match does, in about a second). With no C
@@ -15,8 +17,8 @@ Examples
 --------
 >>> from ursim_core.matching.planar import PlanarGraph
 >>> p = PlanarGraph(nodes=[0, 1, 2], neighbours=[[1], [0, 2], [1]], edges=[(0, 1), (1, 2)])
->>> same = np.eye(3, dtype=bool)
->>> match_compiled(p, p, same, [(0, 0), (1, 1), (2, 2)]) is None or match_compiled(p, p, same, [(0, 0)])[:2]
+>>> result = match_compiled(p, p, np.eye(3, dtype=bool), [(0, 0), (1, 1), (2, 2)])
+>>> result is None or result[:2] == ([(0, 0), (1, 1), (2, 2)], 0)
 True
 """
 
@@ -32,7 +34,7 @@ from ursim_core.native import NativeModule
 
 __all__ = ["MODULE", "LARGEST_CELLS", "kernel", "build", "match_compiled", "forget"]
 
-MODULE = NativeModule("_planar_kernel", Path(__file__).resolve().parent / "csrc")
+MODULE = NativeModule("_matching_kernels", Path(__file__).resolve().parent / "csrc")
 """The extension module: its sources and where it is built."""
 
 #: Pairs of graphs with more than this many (sketch, metric) cells go to Python: its packed
@@ -68,7 +70,7 @@ def kernel():
                 _loaded = MODULE.load(path)
             except (RuntimeError, ImportError, OSError) as error:
                 warnings.warn(
-                    f"could not build the planar matcher's C kernel ({type(error).__name__}: {error}); "
+                    f"could not build the matcher's C kernels ({type(error).__name__}: {error}); "
                     "matching runs in Python, about twice as slow",
                     RuntimeWarning,
                     stacklevel=2,

@@ -1,0 +1,22 @@
+/* The extension module ``_matching_kernels``: every kernel of kernels.h (built by
+ * ursim_core.matching.kernels with ursim_core.native). */
+#include "kernels.h"
+
+#define ENTRY(name) {#name, (PyCFunction)(void (*)(void))kernel_##name, METH_FASTCALL, NULL}
+
+static PyMethodDef methods[] = {
+    ENTRY(planar_match),
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_matching_kernels",
+    "The matcher's loops in C (ursim_core/matching/csrc): the planar matcher's seed-and-expand loop, "
+    "a port of planar.py.",
+    -1, methods,
+};
+
+PyMODINIT_FUNC PyInit__matching_kernels(void)
+{
+    return PyModule_Create(&module);
+}
