@@ -1,4 +1,4 @@
-"""First-run preparation of the segmentation kernels, as a fresh install pays it.
+"""First-run preparation of the segmentation and matching kernels, as a fresh install pays it.
 
 ``bench_compile()`` prepares the MAORIS kernels in a new process on empty caches, both ways
 :mod:`ursim_core.segmentation.maoris.compiled` knows: compiling the C kernels (the default,
@@ -6,7 +6,8 @@ into an empty temporary folder; the C compiler runs once per source file, as man
 there are CPUs) and numba's JIT (``URSIM_KERNELS=jit``, into an empty ``NUMBA_CACHE_DIR``). It
 prints the seconds: wall clock (what the user waits) and CPU (less sensitive to a busy
 machine; it counts the compiler processes), and the kernels' load time in a later process
-(what every later command pays before its first segmentation).
+(what every later command pays before its first segmentation). It also builds the matcher's C
+module (:mod:`ursim_core.matching.kernels`, one source file) into an empty folder.
 """
 
 from __future__ import annotations
@@ -33,6 +34,15 @@ import json, resource, time
 start = time.perf_counter()
 from ursim_core.segmentation.maoris import compile_kernels
 compile_kernels(jit=True, processes={processes})
+own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+print(json.dumps({{"process_s": time.perf_counter() - start,
+    "cpu_s": own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime}}))
+"""
+_MATCHING = """
+import json, resource, time
+start = time.perf_counter()
+from ursim_core.matching.kernels import MODULE
+MODULE.build({folder!r})
 own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
 print(json.dumps({{"process_s": time.perf_counter() - start,
     "cpu_s": own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime}}))
@@ -68,9 +78,9 @@ def bench_compile(*, processes: int = 1, repeats: int = 1) -> list[dict]:
     Returns
     -------
     list of dict
-        Per run: ``way`` ("ahead" or "jit"), ``process_s`` (the preparing process less the
-        interpreter's start), ``cpu_s`` (user + system, with its helper processes) and
-        ``load_s`` (a later process: import, load the kernels, segment a 40 x 40 map).
+        Per run: ``way`` ("ahead", "jit" or "matching": the matcher's C module), ``process_s`` (the preparing process less the
+        interpreter's start), ``cpu_s`` (user + system, with its helper processes) and, for the
+        MAORIS kernels, ``load_s`` (a later process: import, load the kernels, segment a 40 x 40 map).
     """
     from ursim_core.segmentation.maoris import compile_kernels
 
@@ -88,7 +98,12 @@ def bench_compile(*, processes: int = 1, repeats: int = 1) -> list[dict]:
             jit = {"way": "jit", **_child(_JIT.format(processes=int(processes)), {**base, "URSIM_KERNELS": "jit"})}
             jit["load_s"] = _child(_LOAD, {**base, "URSIM_KERNELS": "jit"})["load_s"]
             rows.append(jit)
+            matching = os.path.join(scratch, "matching")
+            rows.append({"way": "matching", **_child(_MATCHING.format(folder=matching), base)})
     for row in rows:
+        if row["way"] == "matching":
+            print(f"matching kernels (C) on an empty folder: {row['process_s']:.1f} s (CPU {row['cpu_s']:.1f} s)")
+            continue
         load = f"{row['load_s']:.2f} s"
         print(
             f"kernels {row['way']:>5} on empty caches: {row['process_s']:.1f} s (CPU {row['cpu_s']:.1f} s); "
