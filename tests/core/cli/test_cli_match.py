@@ -245,7 +245,7 @@ def test_a_turned_sketch_is_matched_in_its_resamplings_and_voted(tmp_path, capsy
     out = tmp_path / "out"
     assert main(["match", str(tmp_path / "sketch.png"), str(tmp_path / "plan.png"), "-o", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "voted over 8 resamplings" in printed
+    assert "voted over 6 resamplings" in printed
     corr = load_correspondences(out / "correspondences.json")
     assert corr.extra["matcher"]["config"]["resampling_vote"] is True
     # The reading ranked next, printed and kept in the file: another reading, ranked no better

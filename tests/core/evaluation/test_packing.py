@@ -51,7 +51,7 @@ def test_the_resamplings_come_back_as_they_were(turned_sketch):
     assert alone.resampled == () and alone.labels is turned_sketch.labels
     assert packed.nbytes < sum(o.labels.nbytes for o in turned_sketch.resampled) / 10
     again = with_unpacked(alone, packed)
-    assert len(again.resampled) == len(turned_sketch.resampled) == 7
+    assert len(again.resampled) == len(turned_sketch.resampled) == 5
     for got, want in zip(again.resampled, turned_sketch.resampled, strict=True):
         assert np.array_equal(got.labels, want.labels) and got.labels.dtype == want.labels.dtype
         assert (got.method, got.params, got.source) == (want.method, want.params, want.source)
@@ -71,12 +71,12 @@ def test_segment_all_keeps_the_resamplings_packed_and_the_caches_whole(tmp_path,
     memory: dict = {}
     packed: dict = {}
     found, _ = segment_all([job], 1, Progress(None, 1), memory, tmp_path / "cache", packed=packed)
-    assert found[job.key].resampled == () and len(packed[job.key].items) == 7
+    assert found[job.key].resampled == () and len(packed[job.key].items) == 5
     assert isinstance(memory[job.key], Packed)  # the memory cache holds the packed form
     # Read back, from the packed memory cache or from disk, it is whole and the same.
     for source in (memory, None):
         whole = read_cached(job, source, tmp_path / "cache")
-        assert len(whole.resampled) == 7
+        assert len(whole.resampled) == 5
         unpacked = with_unpacked(found[job.key], packed[job.key])
         for a, b in zip(whole.resampled, unpacked.resampled, strict=True):
             assert np.array_equal(a.labels, b.labels)
