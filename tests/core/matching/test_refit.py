@@ -176,3 +176,21 @@ def test_without_keep_refit_the_answer_is_the_one_from_before_the_refit():
     # Told the orientation, there is nothing to rank: no refit at all.
     one = MatchConfig(keep_refit=False, orientation=degrees, mirrored=mirrored)
     assert sorted(match(sketch, plan, config=one).pairs) == sorted(first.pairs)
+
+
+def test_the_weighted_line_is_lstsqs_fit():
+    """The closed form gives what least squares on the weighted rows gives: random points, zero
+    weights among them, and points that share one x (lstsq's minimum-norm answer)."""
+    from ursim_core.matching.refit import _weighted_line
+
+    rng = np.random.default_rng(0)
+    for trial in range(200):
+        n = int(rng.integers(2, 12))
+        x = rng.uniform(-500, 500, n) if trial % 10 else np.full(n, rng.uniform(0, 100))
+        y = 1.7 * x + 30 + rng.normal(0, 5, n)
+        weights = rng.uniform(0, 3, n) * (rng.uniform(size=n) > 0.2)
+        if np.count_nonzero(weights) < 2:
+            continue
+        design = np.stack([x, np.ones(n)], axis=1)
+        expected = np.linalg.lstsq(design * weights[:, None], y * weights, rcond=None)[0]
+        assert np.allclose(_weighted_line(x, y, weights), expected, rtol=1e-9, atol=1e-7)
