@@ -42,6 +42,7 @@ F1 between .61 and .65: 18 sketches are too few to tune more than a couple of nu
 
 from __future__ import annotations
 
+import copy
 from dataclasses import replace
 
 import numpy as np
@@ -96,11 +97,13 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
         # Building-sized pairs (never screened by sweeps, see pipeline.prepare): nothing is known.
         return _sweep_shared(prepared, grid, selector, helper, progress), {}
     results = []
-    previous_mask = None
+    # Two values of m select the same pairs when as many values of c are <= each (the pairs with
+    # c <= m grow with m): counted in the sorted values, not compared mask by mask.
+    selected = np.searchsorted(np.sort(np.asarray(c_matrix).ravel()), np.asarray(grid, dtype=float), side="right")
+    previous = None
     for index, m in enumerate(grid, start=1):
-        mask = c_matrix <= float(m)
-        if previous_mask is not None and np.array_equal(mask, previous_mask) and results:
-            results.append(replace(results[-1], m=float(m)))
+        if previous is not None and selected[index - 1] == previous and results:
+            results.append(_at_m(results[-1], float(m)))
         else:
             earlier = known.get(float(m))
             # match_at reads no option of the grid: a result found at m under another grid is
@@ -111,10 +114,18 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
                 result = match_at(prepared, float(m), seed_selector=selector)
             matched[float(m)] = result
             results.append(result)
-            previous_mask = mask
+            previous = selected[index - 1]
         if progress is not None:
             progress(index / len(grid), f"matching at m = {float(m):.3f}")
     return results, matched
+
+
+def _at_m(result, m: float):
+    """``dataclasses.replace(result, m=m)`` for a MatchResult (no field is computed at init), by a
+    shallow copy: the sweeps of a turned sketch make hundreds of these."""
+    moved = copy.copy(result)
+    object.__setattr__(moved, "m", m)
+    return moved
 
 
 def _sweep_shared(prepared, grid, selector, helper, progress) -> list:
