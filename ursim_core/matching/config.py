@@ -60,6 +60,9 @@ M_GRID = tuple(round(0.025 * i, 10) for i in range(20))
 MATCHERS = ("auto", "planar", "hungarian", "vf2", "overlay")
 #: How the segmentations of a resampled sketch choose the reading they vote in (``MatchConfig.vote_rule``).
 VOTE_RULES = ("score", "count")
+#: Which orientations the other segmentations of a resampled sketch are matched in
+#: (``MatchConfig.vote_orientations``).
+VOTE_ORIENTATIONS = ("own", "first")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -208,6 +211,17 @@ class MatchConfig:
         not used in any design (``ursim bench invariance --seeds 32 --first-seed 32``) False lost:
         turned 0.956 -> 0.932, all 0.719 -> 0.691, mean 0.862 -> 0.854 (seeds 0-31 unchanged,
         0.912). So the default keeps the start in every segmentation.
+    vote_orientations : {'own', 'first'}
+        With ``resampling_vote``: the orientations the other segmentations of a turned sketch are
+        matched in. 'own' (the default): their own candidates (from their label image's wall
+        angle) nearest to the first segmentation's finalists, a fraction of a degree from them.
+        'first': the first one's finalists as they are, so no other label image has its wall
+        angle measured (its eight outline tracings, about 1.9 ms each on a turned KTH sketch).
+        Round 39: a KTH pair turned by 30 degrees 59-60 -> 48-49 ms (``bench_kth_turned``,
+        interleaved x2), for 14 of the 864 runs at free angles changed (in sample 0.7702 / 0.7717
+        -> 0.7686 / 0.7689: 07 0.49 -> 0.46, 12 0.47 -> 0.47, 04 0.84 -> 0.84) and generated
+        pairs seeds 0-63 unchanged, 64-95 0.916 / 0.914 -> 0.911 / 0.909 (``ursim bench
+        invariance``). The faster choice, not the default.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -283,6 +297,7 @@ class MatchConfig:
     vote_rule: str = "score"
     vote_segmentations: int = 6
     vote_signature_refit: bool = True
+    vote_orientations: str = "own"
     hypothesis_score: str = "signature"
     score_weight: float = 8.0
     orientation: Any = "any"
@@ -304,6 +319,7 @@ class MatchConfig:
             "signature_method": ("auto", "eigh", "expm"),
             "hypothesis_score": ("signature", "substitutions", "structure"),
             "vote_rule": VOTE_RULES,
+            "vote_orientations": VOTE_ORIENTATIONS,
         }
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:

@@ -150,9 +150,14 @@ def _prepare_one(
             )
     if config.matcher == "overlay":
         return _prepare_overlay(sketch_seg, metric_seg, config, constraints)
-    candidates = orientations_to_try(config, sketch_seg, metric_seg)
-    if orientations:
-        candidates = nearest_orientations(candidates, orientations)
+    if orientations and config.vote_orientations == "first":
+        # Another segmentation of a resampled sketch, in the first one's finalists as they are:
+        # its own wall angle is not measured (MatchConfig.vote_orientations).
+        candidates = list(orientations)
+    else:
+        candidates = orientations_to_try(config, sketch_seg, metric_seg)
+        if orientations:
+            candidates = nearest_orientations(candidates, orientations)
     outlines = sketch_outlines(sketch_seg, sketch_graph, candidates)
     base = prepare_oriented(sketch_graph, metric_graph, config, candidates[0], outlines)
     if constraints is not None:

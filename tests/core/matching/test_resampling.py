@@ -378,3 +378,30 @@ def test_no_vote_when_switched_off_given_constraints_or_another_matcher(turned_p
     constrained = match(sketch, plan, constraints=MatchConstraints(fixed=(first,)))
     assert constrained.resampling_votes == 0 and first in constrained.pairs
     assert not MatchConfig.paper().resampling_vote and not MatchConfig.released().resampling_vote
+
+
+@pytest.mark.parametrize("value", [None, "all", True])
+def test_the_vote_orientations_option_is_checked(value):
+    with pytest.raises(ParameterError, match="vote_orientations"):
+        MatchConfig(vote_orientations=value)
+
+
+def test_the_others_can_take_the_first_ones_finalists_as_they_are(turned_pair, monkeypatch):
+    """vote_orientations='first': every other segmentation is matched in exactly the first one's
+    finalists, and only the first label image (and the metric map's) has its wall angle measured."""
+    import copy
+
+    from ursim_core.segmentation import canonical
+
+    sketch, plan = turned_pair
+    sketch = copy.copy(sketch)  # a Segmentation that has not measured its wall angle yet
+    measured = []
+    original = canonical.wall_angle
+    monkeypatch.setattr(canonical, "wall_angle", lambda labels: measured.append(labels) or original(labels))
+    prepared = prepare(sketch, plan, MatchConfig(vote_orientations="first"))
+    finalists = list(prepared.orientation_scan)
+    for _, variant in prepared.resampled.variants:
+        assert set(variant.orientation_scan) <= set(finalists)
+    others = [other.labels for other in sketch.resampled]
+    assert not any(labels is other for labels in measured for other in others)
+    assert match(sketch, plan, config=MatchConfig(vote_orientations="first")).resampling_votes == 6
