@@ -91,6 +91,14 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--released", action="store_true", help="start from the released C++ code's options")
     parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="any other matching option (a MatchConfig field, e.g. vote_orientations=first); repeatable, "
+        "and it wins over the options above",
+    )
+    parser.add_argument(
         "--sketch-preset",
         default=MATCH_PRESETS["sketch"],
         help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)",
@@ -142,6 +150,19 @@ def match_config(args: argparse.Namespace):
         overrides["scale"] = args.scale
     if getattr(args, "input_kind", None) is not None:
         overrides["input_kind"] = args.input_kind
+    if getattr(args, "set", None):
+        import dataclasses
+
+        from ursim_core.evaluation.crossval import parse_option
+
+        known = {f.name for f in dataclasses.fields(MatchConfig)}
+        for text in args.set:
+            name, value = parse_option(text)
+            if name not in known:
+                raise ParameterError(
+                    f"unknown matching option '{name}' (known: {', '.join(sorted(known))})", field="set"
+                )
+            overrides[name] = value
     return base.replace(**overrides)
 
 
@@ -208,6 +229,7 @@ OPTION_NAMES = (
     "scale",
     "input_kind",
     "released",
+    "set",
     "sketch_preset",
     "metric_preset",
     "param",

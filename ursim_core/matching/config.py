@@ -217,8 +217,8 @@ class MatchConfig:
         angle) nearest to the first segmentation's finalists, a fraction of a degree from them.
         'first': the first one's finalists as they are, so no other label image has its wall
         angle measured (its eight outline tracings, about 1.9 ms each on a turned KTH sketch).
-        Round 39: a KTH pair turned by 30 degrees 59-60 -> 48-49 ms (``bench_kth_turned``,
-        interleaved x2), for 14 of the 864 runs at free angles changed (in sample 0.7702 / 0.7717
+        Round 39: a KTH pair turned by 30 degrees 56-57 -> 47 ms (``bench_kth_turned``, three
+        runs), for 14 of the 864 runs at free angles changed (in sample 0.7702 / 0.7717
         -> 0.7686 / 0.7689: 07 0.49 -> 0.46, 12 0.47 -> 0.47, 04 0.84 -> 0.84) and generated
         pairs seeds 0-63 unchanged, 64-95 0.916 / 0.914 -> 0.911 / 0.909 (``ursim bench
         invariance``). The faster choice, not the default.

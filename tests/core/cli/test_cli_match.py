@@ -267,3 +267,22 @@ def test_a_told_orientation_has_no_runner_up(tmp_path, pair, capsys):
     assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out), "--orientation", "upright"]) == 0
     assert "next best reading" not in capsys.readouterr().out
     assert "next_reading" not in load_correspondences(out / "correspondences.json").extra["matcher"]
+
+
+def test_any_matching_option_is_set_with_set_and_a_wrong_one_is_refused_first(tmp_path, capsys):
+    sketch, metric = two_rooms(tmp_path / "a.png"), two_rooms(tmp_path / "b.png")
+    out = tmp_path / "out"
+    argv = ["match", str(sketch), str(metric), "-o", str(out)]
+    assert main([*argv, "--set", "vote_orientations=first", "--set", "orientation_finalists=2"]) == 0
+    config = load_correspondences(out / "correspondences.json").extra["matcher"]["config"]
+    assert config["vote_orientations"] == "first" and config["orientation_finalists"] == 2
+    capsys.readouterr()
+    for wrong, message in (
+        ("nonsense=1", "unknown matching option 'nonsense'"),
+        ("vote_orientations=sideways", "must be one of"),
+        ("novalue", "expected NAME=VALUE"),
+    ):
+        elsewhere = tmp_path / wrong.replace("=", "_")
+        assert main(["match", str(sketch), str(metric), "-o", str(elsewhere), "--set", wrong]) == 1
+        assert message in capsys.readouterr().err
+        assert not elsewhere.exists()  # refused before any work
