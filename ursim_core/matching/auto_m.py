@@ -97,12 +97,12 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
         # Building-sized pairs (never screened by sweeps, see pipeline.prepare): nothing is known.
         return _sweep_shared(prepared, grid, selector, helper, progress), {}
     results = []
-    # Two values of m select the same pairs when as many values of c are <= each (the pairs with
-    # c <= m grow with m): counted in the sorted values, not compared mask by mask.
-    selected = np.searchsorted(np.sort(np.asarray(c_matrix).ravel()), np.asarray(grid, dtype=float), side="right")
     previous = None
     for index, m in enumerate(grid, start=1):
-        if previous is not None and selected[index - 1] == previous and results:
+        # Two values of m select the same pairs when as many values of c are <= each (the pairs
+        # with c <= m grow with m): counted, not compared mask by mask.
+        selected = np.count_nonzero(c_matrix <= float(m))
+        if previous is not None and selected == previous and results:
             results.append(_at_m(results[-1], float(m)))
         else:
             earlier = known.get(float(m))
@@ -114,7 +114,7 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
                 result = match_at(prepared, float(m), seed_selector=selector)
             matched[float(m)] = result
             results.append(result)
-            previous = selected[index - 1]
+            previous = selected
         if progress is not None:
             progress(index / len(grid), f"matching at m = {float(m):.3f}")
     return results, matched
