@@ -18,14 +18,12 @@ import hashlib
 import importlib.machinery
 import importlib.util
 import os
-import shlex
-import subprocess
-import sysconfig
-import tempfile
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
+
+# The compiler's modules (subprocess, sysconfig, tempfile, threads) are imported by the functions
+# that build: a process that only loads a built module does not pay for them.
 
 __all__ = ["CFLAGS", "NativeModule", "compile_extension"]
 
@@ -34,6 +32,9 @@ CFLAGS = ("-O3", "-std=gnu11", "-pthread", "-ffp-contract=off", "-fno-strict-ali
 
 
 def _run(command: list[str], cwd: Path) -> None:
+    import shlex
+    import subprocess
+
     done = subprocess.run(command, cwd=cwd, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         output = (done.stderr or done.stdout).strip()
@@ -53,6 +54,10 @@ def compile_extension(
     RuntimeError
         When there is no C compiler or it fails (with the end of its messages).
     """
+    import shlex
+    import sysconfig
+    from concurrent.futures import ThreadPoolExecutor
+
     output = Path(output)
     includes = [f"-I{sysconfig.get_paths()['include']}", *(f"-I{folder}" for folder in include_dirs)]
     if numpy:
@@ -149,6 +154,8 @@ class NativeModule:
         The old digest is removed first, then the module and the new digest are put in place by
         a rename, so a reader never sees a digest without its module.
         """
+        import tempfile
+
         target = Path(directory) if directory is not None else self.directories()[0]
         target.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix=f"{self.name}-", dir=target) as scratch:
