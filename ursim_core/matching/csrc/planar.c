@@ -160,6 +160,26 @@ static int32_t arc(const int32_t *order, int32_t size, int32_t start, int32_t st
     return n;
 }
 
+/* Queue the aligned pairs whose two regions are both unseen in this hypothesis, in order; mark them
+ * seen and consumed (a seed equal to one no longer starts a hypothesis). Returns the new tail. */
+static int32_t enqueue(const int32_t *aligned, int32_t count, int32_t *queue, int32_t tail, int32_t *seen1,
+                       int32_t *seen2, int32_t stamp, uint8_t *consumed, int32_t n2)
+{
+    for (int32_t q = 0; q < count; q++) {
+        int32_t a = aligned[2 * q], b = aligned[2 * q + 1];
+        if (seen1[a] == stamp || seen2[b] == stamp) {
+            continue;
+        }
+        queue[2 * tail] = a;
+        queue[2 * tail + 1] = b;
+        tail++;
+        seen1[a] = stamp;
+        seen2[b] = stamp;
+        consumed[(int64_t)a * n2 + b] = 1;
+    }
+    return tail;
+}
+
 static int32_t *int_sequence_arg(PyObject *seeds, Py_ssize_t *count)
 {
     PyObject *fast = PySequence_Fast(seeds, "planar_match: seeds must be a sequence of (int, int)");
@@ -332,18 +352,7 @@ KERNEL(planar_match)
         int32_t n_pairs = 1, head = 0, tail = 0;
         pairs[0] = v;
         pairs[1] = w;
-        for (int32_t q = 0; q < n_aligned; q++) {
-            int32_t a = aligned[2 * q], b = aligned[2 * q + 1];
-            if (seen1[a] == stamp || seen2[b] == stamp) {
-                continue;
-            }
-            queue[2 * tail] = a;
-            queue[2 * tail + 1] = b;
-            tail++;
-            seen1[a] = stamp;
-            seen2[b] = stamp;
-            consumed[(int64_t)a * n2 + b] = 1;
-        }
+        tail = enqueue(aligned, n_aligned, queue, tail, seen1, seen2, stamp, consumed, n2);
         while (head < tail) {
             int32_t vertex = queue[2 * head], other = queue[2 * head + 1];
             head++;
@@ -390,18 +399,7 @@ KERNEL(planar_match)
                 /* order1 lives in row_buffer, which the alignment does not touch (it is only the
                  * seed alignment's rotation buffer). */
                 int32_t found = aligned_index_pairs(&g, arc1, length1, arc2, length2, aligned);
-                for (int32_t q = 0; q < found; q++) {
-                    int32_t a = aligned[2 * q], b = aligned[2 * q + 1];
-                    if (seen1[a] == stamp || seen2[b] == stamp) {
-                        continue;
-                    }
-                    queue[2 * tail] = a;
-                    queue[2 * tail + 1] = b;
-                    tail++;
-                    seen1[a] = stamp;
-                    seen2[b] = stamp;
-                    consumed[(int64_t)a * n2 + b] = 1;
-                }
+                tail = enqueue(aligned, found, queue, tail, seen1, seen2, stamp, consumed, n2);
             }
         }
         hypotheses++;
