@@ -134,22 +134,27 @@ class NativeModule:
     def module_path(self, folder: Path) -> Path:
         return Path(folder) / (self.name + importlib.machinery.EXTENSION_SUFFIXES[0])
 
-    def built_path(self) -> Path | None:
-        """The built module of these sources, or None when it is missing or stale."""
+    def built_path(self, directories=None, digest=None) -> Path | None:
+        """The built module of these sources, or None when it is missing or stale.
+
+        ``directories`` (default :meth:`directories`) and ``digest`` (a callable, default
+        :meth:`digest`, called only when a digest file is found) let a caller substitute its own.
+        """
         wanted = None
-        for folder in self.directories():
+        for folder in self.directories() if directories is None else directories:
             try:
-                recorded = (folder / self.digest_name).read_text(encoding="ascii").strip()
+                recorded = (Path(folder) / self.digest_name).read_text(encoding="ascii").strip()
             except OSError:
                 continue
-            wanted = wanted or self.digest()
+            wanted = wanted or (self.digest if digest is None else digest)()
             if recorded == wanted and self.module_path(folder).is_file():
                 return self.module_path(folder)
         return None
 
-    def build(self, directory: str | Path | None = None) -> Path:
+    def build(self, directory: str | Path | None = None, *, digest: str | None = None) -> Path:
         """Compile the sources into ``directory`` (default: the first writable of
-        :meth:`directories`); return the module's path.
+        :meth:`directories`); return the module's path. ``digest``: what to record (default
+        :meth:`digest`).
 
         The old digest is removed first, then the module and the new digest are put in place by
         a rename, so a reader never sees a digest without its module.
@@ -166,7 +171,7 @@ class NativeModule:
             (target / self.digest_name).unlink(missing_ok=True)
             os.replace(built, self.module_path(target))
             digest_path = Path(scratch) / "digest"
-            digest_path.write_text(self.digest() + "\n", encoding="ascii")
+            digest_path.write_text((self.digest() if digest is None else digest) + "\n", encoding="ascii")
             os.replace(digest_path, target / self.digest_name)
         return self.module_path(target)
 

@@ -25,12 +25,10 @@ split large images into bands of rows (or parts), one thread each, with the resu
 
 from __future__ import annotations
 
-import hashlib
 import importlib.machinery
 import importlib.util
 import os
 import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -86,49 +84,35 @@ _KERNELS_DIR = Path(__file__).resolve().parent / "kernels"
 _loaded: SimpleNamespace | None = None
 
 
+def _native():
+    """The module as a :class:`~ursim_core.native.NativeModule`: its sources, how they are built
+    (:mod:`.c_build`, in the digest), where the build lives."""
+    from ursim_core.native import NativeModule
+    from ursim_core.segmentation.maoris.c_build import SOURCE_DIR
+
+    return NativeModule(MODULE_NAME, SOURCE_DIR, digest_extra=(_KERNELS_DIR.parent / "c_build.py",), numpy=True)
+
+
 def sources_digest() -> str:
-    """SHA-256 of the C sources (:file:`csrc`), of how they are built (:mod:`.c_build`) and of
-    the Python ABI.
+    """SHA-256 of the C sources (:file:`csrc`), of how they are built (:mod:`.c_build`,
+    :mod:`ursim_core.native`) and of the Python ABI.
 
     The built module is used only while this matches the digest it was built with: an edited
     source is built again on the next :func:`kernels`.
     """
-    from ursim_core import native
-    from ursim_core.segmentation.maoris.c_build import source_files
-
-    digest = hashlib.sha256(importlib.machinery.EXTENSION_SUFFIXES[0].encode())
-    for source in [*source_files(), _KERNELS_DIR.parent / "c_build.py", Path(native.__file__)]:
-        digest.update(source.name.encode() + b"\0" + source.read_bytes() + b"\0")
-    return digest.hexdigest()
+    return _native().digest()
 
 
 def build_directories() -> list[Path]:
-    """Where the built module may live, in the order looked at: beside the kernels (a
-    checkout or a writable install), then the user's cache (``$XDG_CACHE_HOME/ursim``)."""
-    xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    folder = hashlib.sha1(str(_KERNELS_DIR).encode()).hexdigest()[:16]
-    own = _KERNELS_DIR / "__pycache__"
-    user = Path(xdg) / "ursim" / f"kernels-{folder}"
-    return [own, user] if os.access(_KERNELS_DIR, os.W_OK) else [user, own]
-
-
-def _module_path(folder: Path, name: str) -> Path:
-    return folder / (name + importlib.machinery.EXTENSION_SUFFIXES[0])
+    """Where the built module may live, in the order looked at: beside the sources (a checkout
+    or a writable install), then the user's cache (``$XDG_CACHE_HOME/ursim``)."""
+    return _native().directories()
 
 
 def ahead_module_path() -> Path | None:
     """The built module (:data:`MODULE_NAME`) of these kernel sources, or None when it is
     missing or stale."""
-    wanted = None
-    for folder in build_directories():
-        try:
-            recorded = (folder / DIGEST_NAME).read_text(encoding="ascii").strip()
-        except OSError:
-            continue
-        wanted = wanted or sources_digest()
-        if recorded == wanted and _module_path(folder, MODULE_NAME).is_file():
-            return _module_path(folder, MODULE_NAME)
-    return None
+    return _native().built_path(build_directories(), sources_digest)
 
 
 def _load_ahead(path: Path) -> SimpleNamespace:
@@ -224,31 +208,23 @@ def forget() -> None:
 
 
 def build_ahead(directory: str | Path | None = None) -> Path:
-    """Compile the kernels in C (:mod:`.c_build`) into the module loaded here; return its path.
+    """Compile the kernels in C into the module loaded here; return its path.
 
     The module and its digest file are written to ``directory`` (default: the first writable
-    of :func:`build_directories`): the old digest is removed first, then the module and the
-    new digest are put in place by a rename, so a reader never sees a digest without its
-    module. ``ursim bench compile`` measures how long it takes.
+    of :func:`build_directories`) by :meth:`ursim_core.native.NativeModule.build`: the old digest
+    is removed first, then the module and the new digest are put in place by a rename, so a
+    reader never sees a digest without its module. ``ursim bench compile`` measures how long it
+    takes.
 
     Raises
     ------
     RuntimeError
         When there is no C compiler or it fails (with the end of its messages).
     """
-    from ursim_core.segmentation.maoris.c_build import build_module
-
     target = Path(directory) if directory is not None else build_directories()[0]
-    target.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix="ursim-kernels-", dir=target) as scratch:
-        built = build_module(_module_path(Path(scratch), MODULE_NAME))
-        (target / DIGEST_NAME).unlink(missing_ok=True)
-        os.replace(built, _module_path(target, MODULE_NAME))
-        digest_path = Path(scratch) / "digest"
-        digest_path.write_text(sources_digest() + "\n", encoding="ascii")
-        os.replace(digest_path, target / DIGEST_NAME)
+    path = _native().build(target, digest=sources_digest())
     forget()
-    return _module_path(target, MODULE_NAME)
+    return path
 
 
 def _main() -> None:  # ``python -m ursim_core.segmentation.maoris.compiled``
