@@ -58,24 +58,41 @@ def build() -> Path:
 def kernel():
     """The loaded module, or None (no C compiler, ``URSIM_KERNELS=jit``, or a failed build).
 
-    The first call builds the module when it is missing or stale; a failure is warned about once
-    and the matcher runs in Python.
+    The first call builds the module when it is missing or stale, or cannot be loaded; a failure
+    is warned about once and the matcher runs in Python.
     """
     global _loaded
     if _loaded is _UNSET:
         _loaded = None
         if os.environ.get("URSIM_KERNELS", "auto").strip().lower() != "jit":
-            try:
-                path = MODULE.built_path() or MODULE.build()
-                _loaded = MODULE.load(path)
-            except (RuntimeError, ImportError, OSError) as error:
-                warnings.warn(
-                    f"could not build the matcher's C kernels ({type(error).__name__}: {error}); "
-                    "matching runs in Python, about twice as slow",
-                    RuntimeWarning,
-                    stacklevel=2,
-                )
+            _loaded = _built_and_loaded()
     return _loaded
+
+
+def _built_and_loaded():
+    """The module, built first when missing or stale, and built again when the one on disk cannot
+    be loaded (cut short, foreign); None, with a warning, when that fails too."""
+    path = MODULE.built_path()
+    if path is not None:
+        try:
+            return MODULE.load(path)
+        except (ImportError, OSError) as error:
+            warnings.warn(
+                f"the matcher's C kernels at {path} cannot be loaded ({type(error).__name__}: {error}); "
+                "building them again",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+    try:
+        return MODULE.load(MODULE.build())
+    except (RuntimeError, ImportError, OSError) as error:
+        warnings.warn(
+            f"could not build the matcher's C kernels ({type(error).__name__}: {error}); "
+            "matching runs in Python, about twice as slow",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return None
 
 
 def forget() -> None:

@@ -168,3 +168,24 @@ def test_ursim_kernels_jit_keeps_the_matcher_in_python(monkeypatch):
         assert kernels.kernel() is None
     finally:
         kernels.forget()
+
+
+def test_a_module_that_cannot_be_loaded_is_built_again(tmp_path, monkeypatch):
+    """A module cut short (its digest still right) is reported and built again, then used."""
+    if kernels.kernel() is None:
+        pytest.skip("no C compiler here")
+    sources = tmp_path / "csrc"
+    shutil.copytree(kernels.MODULE.source_dir, sources, ignore=shutil.ignore_patterns("__pycache__"))
+    module = NativeModule("_matching_kernels", sources)
+    built = module.build()
+    built.write_bytes(b"\x7fELF cut short")
+    assert module.built_path() == built  # the digest still names these sources
+    monkeypatch.setattr(kernels, "MODULE", module)
+    kernels.forget()
+    try:
+        with pytest.warns(RuntimeWarning, match="cannot be loaded.*building them again"):
+            loaded = kernels.kernel()
+        assert loaded is not None and loaded.planar_match is not None
+        assert built.stat().st_size > 1000
+    finally:
+        kernels.forget()
