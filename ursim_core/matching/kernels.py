@@ -101,20 +101,6 @@ def forget() -> None:
     _loaded = _UNSET
 
 
-def _csr(graph) -> tuple[np.ndarray, np.ndarray, int]:
-    """The graph's cyclic neighbour orders as offsets and one flat array (int32), and the longest
-    order's length; kept on the graph (a sweep matches the same graphs at every m)."""
-    found = graph.__dict__.get("_csr")
-    if found is None:
-        lengths = [len(order) for order in graph.neighbours]
-        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
-        np.cumsum(lengths, out=offsets[1:])
-        flat = np.fromiter((v for order in graph.neighbours for v in order), dtype=np.int32, count=int(offsets[-1]))
-        # PlanarGraph is frozen: the arrays are stored as its cached properties are.
-        found = graph.__dict__["_csr"] = (offsets, flat, max(lengths, default=0))
-    return found
-
-
 def match_compiled(
     first, second, same, seeds, *, rotation_search="min", reflections=False, pair_costs=None, pair_cost_weight=0.0
 ):
@@ -125,8 +111,8 @@ def match_compiled(
     module = kernel()
     if module is None:
         return None
-    first_offsets, first_orders, longest_first = _csr(first)
-    second_offsets, second_orders, longest_second = _csr(second)
+    first_offsets, first_orders, longest_first = first.flat_orders
+    second_offsets, second_orders, longest_second = second.flat_orders
     if (longest_first + 1) * (longest_second + 1) > LARGEST_TABLE:
         return None
     same = np.ascontiguousarray(same, dtype=np.bool_)

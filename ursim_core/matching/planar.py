@@ -111,6 +111,16 @@ class PlanarGraph:
     def adjacency_ends(self) -> tuple[np.ndarray, np.ndarray]:
         return _adjacency_ends(self.neighbour_sets)
 
+    @cached_property
+    def flat_orders(self) -> tuple[np.ndarray, np.ndarray, int]:
+        """The cyclic orders as offsets and one flat int32 array, and the longest order's length
+        (what the C loop reads, :mod:`ursim_core.matching.kernels`)."""
+        lengths = [len(order) for order in self.neighbours]
+        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
+        np.cumsum(lengths, out=offsets[1:])
+        flat = np.fromiter((v for order in self.neighbours for v in order), dtype=np.int32, count=int(offsets[-1]))
+        return offsets, flat, max(lengths, default=0)
+
 
 @dataclass(frozen=True)
 class PlanarResult:
