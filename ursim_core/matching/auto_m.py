@@ -82,7 +82,7 @@ def sweep(prepared, grid=None, *, progress=None, known=None) -> list:
 
 def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[list, dict]:
     """:func:`sweep`, and the results it matched (not reused from the previous m), by m."""
-    from ursim_core.matching.single import SeedSelector, match_at, seed_cap
+    from ursim_core.matching.single import SeedSelector, match_at, match_sweep, seed_cap
 
     grid = prepared.config.m_grid if grid is None else grid
     known = known or {}
@@ -96,27 +96,32 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
     if helper is not None:
         # Building-sized pairs (never screened by sweeps, see pipeline.prepare): nothing is known.
         return _sweep_shared(prepared, grid, selector, helper, progress), {}
+    # Two values of m select the same pairs when as many values of c are <= each (the pairs with
+    # c <= m grow with m): counted, not compared mask by mask; the later one reuses the result.
+    selected = selector.selected_counts(grid) if selector is not None else None
+    if selected is None:
+        selected = [np.count_nonzero(c_matrix <= float(m)) for m in grid]
+    fresh = [index == 0 or selected[index] != selected[index - 1] for index in range(len(grid))]
+    # match_at reads no option of the grid: a result found at m under another grid is this
+    # sweep's, but for the options it records.
+    to_match = [float(m) for m, new in zip(grid, fresh) if new and known.get(float(m)) is None]
+    swept = match_sweep(prepared, to_match, selector) if len(to_match) > 1 else None
+    found = dict(zip(to_match, swept)) if swept is not None else {}
     results = []
-    previous = None
     for index, m in enumerate(grid, start=1):
-        # Two values of m select the same pairs when as many values of c are <= each (the pairs
-        # with c <= m grow with m): counted, not compared mask by mask.
-        selected = np.count_nonzero(c_matrix <= float(m))
-        if previous is not None and selected == previous and results:
-            results.append(_at_m(results[-1], float(m)))
+        m = float(m)
+        if not fresh[index - 1]:
+            results.append(_at_m(results[-1], m))
         else:
-            earlier = known.get(float(m))
-            # match_at reads no option of the grid: a result found at m under another grid is
-            # this sweep's, but for the options it records.
+            earlier = known.get(m)
             if earlier is not None:
                 result = replace(earlier, config=prepared.config)
             else:
-                result = match_at(prepared, float(m), seed_selector=selector)
-            matched[float(m)] = result
+                result = found.get(m) or match_at(prepared, m, seed_selector=selector)
+            matched[m] = result
             results.append(result)
-            previous = selected
         if progress is not None:
-            progress(index / len(grid), f"matching at m = {float(m):.3f}")
+            progress(index / len(grid), f"matching at m = {m:.3f}")
     return results, matched
 
 

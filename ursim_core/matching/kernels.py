@@ -2,7 +2,10 @@
 
 The planar matcher's seed-and-expand loop runs in C (:file:`csrc/planar.c`), a port of
 :mod:`ursim_core.matching.planar`, which stays the reference (tests compare both) and runs where
-the C module cannot be built. The module has room for more loops (:file:`csrc/module.c`).
+the C module cannot be built. :func:`sweep_compiled` runs it over every m of a sweep in one call
+(:file:`csrc/sweep.c`): seeds, relation and pair costs at each m as
+:func:`~ursim_core.matching.single.match_at` makes them. :func:`fit_axes_compiled` is the position
+refit's robust line fit (:file:`csrc/refit.c`, a port of :mod:`ursim_core.matching.refit`).
 
 :func:`match_compiled` takes the planar matcher's common case (no constraints, no alternatives
 kept, graphs whose alignments are sketch-sized) and gives the same pairs in the same order, the
@@ -32,7 +35,16 @@ import numpy as np
 
 from ursim_core.native import NativeModule
 
-__all__ = ["MODULE", "LARGEST_CELLS", "kernel", "build", "match_compiled", "forget"]
+__all__ = [
+    "MODULE",
+    "LARGEST_CELLS",
+    "kernel",
+    "build",
+    "match_compiled",
+    "sweep_compiled",
+    "fit_axes_compiled",
+    "forget",
+]
 
 MODULE = NativeModule("_matching_kernels", Path(__file__).resolve().parent / "csrc")
 """The extension module: its sources and where it is built."""
@@ -132,3 +144,79 @@ def match_compiled(
         int(rotation_search == "min"),
         int(bool(reflections)),
     )
+
+
+#: ``hypothesis_score`` of :class:`~ursim_core.matching.MatchConfig` as the sweep kernel's ``score``
+#: argument (see :func:`~ursim_core.matching.single.pair_cost_matrix`).
+SWEEP_SCORES = {"structure": 0, "signature": 1, "substitutions": 2}
+
+
+def sweep_compiled(
+    first, second, c_matrix, order, values, cap, ms, *, score="signature", weight=0.0, rotation_search="min",
+    reflections=False,
+):  # fmt: skip
+    """The planar matcher at every m of ``ms`` from the C loop, or None when it does not take this
+    case (see the module docstring; also a ``c_matrix`` with NaN).
+
+    ``order``, ``values`` and ``cap`` are a :class:`~ursim_core.matching.single.SeedSelector`'s:
+    the positions of the lowest values of the flattened c, sorted by value (ties by position),
+    their values, and the seed cap. ``score`` is the ``hypothesis_score`` (with ``weight`` 0 the
+    structural cost alone). Returns, per m, ``(pairs, cost, structural_cost, hypotheses,
+    seeds_expanded, seeds_count)``; with no seed at m, ``([], None, 0, 0, 0, 0)``.
+    """
+    if first.n_vertices * second.n_vertices > LARGEST_CELLS or rotation_search not in ("min", "first"):
+        return None
+    module = kernel()
+    if module is None:
+        return None
+    first_offsets, first_orders, longest_first = first.flat_orders
+    second_offsets, second_orders, longest_second = second.flat_orders
+    if (longest_first + 1) * (longest_second + 1) > LARGEST_TABLE:
+        return None
+    c_matrix = np.ascontiguousarray(c_matrix, dtype=np.float64)
+    if np.isnan(c_matrix).any():
+        return None
+    return module.planar_sweep(
+        first_offsets,
+        first_orders,
+        second_offsets,
+        second_orders,
+        len(first.edges),
+        len(second.edges),
+        c_matrix,
+        np.ascontiguousarray(order, dtype=np.int64),
+        np.ascontiguousarray(values, dtype=np.float64),
+        int(cap),
+        np.ascontiguousarray(ms, dtype=np.float64),
+        SWEEP_SCORES[score] if weight != 0 else 0,
+        float(weight),
+        int(rotation_search == "min"),
+        int(bool(reflections)),
+    )
+
+
+#: What :func:`fit_axes_compiled` returns when a reweighting round keeps fewer than two pairs.
+NO_FIT = "no fit"
+
+
+def fit_axes_compiled(source, target, weights, *, rounds: int, cutoff: float):
+    """The refit's scale and shift per axis (:func:`~ursim_core.matching.refit.fit_axis_transform`
+    after the ptp checks, before the scale check) from the C loop: ``((row scale, row shift), (col
+    scale, col shift))``, :data:`NO_FIT`, or None where NumPy must fit (no C module, or an axis
+    whose weighted points all but share one x, where NumPy keeps lstsq's minimum-norm answer).
+
+    The sums run in index order: the fits equal NumPy's to rounding (a test compares them).
+    """
+    module = kernel()
+    if module is None:
+        return None
+    found = module.fit_axes(
+        np.ascontiguousarray(source, dtype=np.float64),
+        np.ascontiguousarray(target, dtype=np.float64),
+        np.ascontiguousarray(weights, dtype=np.float64),
+        int(rounds),
+        float(cutoff),
+    )
+    if found == 1:
+        return NO_FIT
+    return None if found == 2 else found

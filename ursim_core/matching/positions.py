@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import networkx as nx
 import numpy as np
 
-__all__ = ["region_types", "region_positions", "position_distance", "blend_positions"]
+__all__ = ["region_types", "region_positions", "position_distance", "blend_positions", "blend_position_arrays"]
 
 
 def region_types(graph: nx.Graph, *, nodes: Sequence | None = None) -> np.ndarray:
@@ -96,9 +96,25 @@ def blend_positions(c_matrix, sketch_graph, sketch_nodes, metric_graph, metric_n
     """``(c + beta * d_position) / (1 + beta)`` with beta = ``position_weight`` (c itself when 0)."""
     if not position_weight:
         return c_matrix
-    distances = position_distance(
-        region_positions(sketch_graph, nodes=sketch_nodes), region_positions(metric_graph, nodes=metric_nodes)
+    return blend_position_arrays(
+        c_matrix,
+        region_positions(sketch_graph, nodes=sketch_nodes),
+        region_positions(metric_graph, nodes=metric_nodes),
+        position_weight,
     )
+
+
+def blend_position_arrays(c_matrix, sketch_positions, metric_positions, position_weight):
+    """:func:`blend_positions` of positions already normalised (:func:`region_positions`).
+
+    Examples
+    --------
+    >>> blend_position_arrays(np.zeros((1, 1)), np.array([[0.0, 0.0]]), np.array([[0.6, 0.8]]), 1.0).tolist()
+    [[0.5]]
+    """
+    if not position_weight:
+        return c_matrix
+    distances = position_distance(sketch_positions, metric_positions)
     # In place, in the order of ``(c + w * d) / (1 + w)``: the same values without two temporaries.
     distances *= position_weight
     distances += c_matrix

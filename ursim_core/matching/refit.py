@@ -32,9 +32,17 @@ import dataclasses
 import networkx as nx
 import numpy as np
 
-from ursim_core.matching.positions import blend_positions
+from ursim_core.matching.kernels import NO_FIT, fit_axes_compiled
+from ursim_core.matching.positions import blend_position_arrays, region_positions
 
-__all__ = ["fit_axis_transform", "refitted_graph", "refit_from", "refit_positions", "signature_start"]
+__all__ = [
+    "fit_axis_transform",
+    "refitted_graph",
+    "refitted_positions",
+    "refit_from",
+    "refit_positions",
+    "signature_start",
+]
 
 #: Reweighting rounds of the fit; pairs whose residual exceeds ``_CUTOFF`` median residuals
 #: get no weight in the next round (Tukey's biweight).
@@ -114,6 +122,22 @@ def fit_axis_transform(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) ->
         return None  # every pair on one line: no scale along the other axis
     sizes = [min(sketch_graph.nodes[a]["size"], metric_graph.nodes[b]["size"]) for a, b in pairs]
     weights = np.sqrt(np.maximum(np.asarray(sizes, float), 0.0))
+    compiled = fit_axes_compiled(source, target, weights, rounds=_ROUNDS, cutoff=_CUTOFF)
+    if compiled is NO_FIT:
+        return None
+    if compiled is not None:
+        transform = np.array(compiled)
+    else:
+        transform = _fitted_in_numpy(source, target, weights)
+        if transform is None:
+            return None
+    if np.any(transform[:, 0] * source_spread / target_spread < _SMALLEST_SCALE):
+        return None
+    return transform
+
+
+def _fitted_in_numpy(source: np.ndarray, target: np.ndarray, weights: np.ndarray) -> np.ndarray | None:
+    """The fit of :func:`fit_axis_transform` in NumPy (the reference; the C loop's fallback)."""
     transform = np.zeros((2, 2))
     for axis in range(2):
         x, y = source[:, axis], target[:, axis]
@@ -126,21 +150,36 @@ def fit_axis_transform(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) ->
             spread = _CUTOFF * _median(residuals) + 1e-9
             current = weights * np.clip(1.0 - (residuals / spread) ** 2, 0.0, 1.0) ** 2
         transform[axis] = (slope, intercept)
-    if np.any(transform[:, 0] * source_spread / target_spread < _SMALLEST_SCALE):
-        return None
     return transform
+
+
+def refitted_positions(sketch_graph: nx.Graph, sketch_nodes, metric_graph: nx.Graph, transform) -> np.ndarray:
+    """``region_positions(refitted_graph(sketch_graph, metric_graph, transform), nodes=sketch_nodes)``
+    without copying the graph: the sketch's centroids moved by ``transform`` and normalised by the
+    metric map's extent (the same values)."""
+    extent = _extent_of(metric_graph)
+    nodes = sketch_graph.nodes
+    centroids = np.array([nodes[node]["centroid"] for node in sketch_nodes], dtype=np.float64).reshape(-1, 2)
+    moved = transform[:, 0] * centroids + transform[:, 1]
+    low, high = np.array(extent[:2], dtype=np.float64), np.array(extent[2:], dtype=np.float64)
+    size = high - low
+    return np.where(size > 0, (moved - low) / np.where(size > 0, size, 1.0), 0.5)
+
+
+def _extent_of(metric_graph: nx.Graph) -> tuple:
+    """The metric map's extent ``(row0, col0, row1, col1)``: its regions' boxes, or their centroids."""
+    boxes = np.array([box for _, box in metric_graph.nodes(data="bbox")], float).reshape(-1, 4)
+    if len(boxes):
+        return (*boxes[:, :2].min(axis=0).tolist(), *boxes[:, 2:].max(axis=0).tolist())
+    centroids = np.array([c for _, c in metric_graph.nodes(data="centroid")], float).reshape(-1, 2)
+    return (*centroids.min(axis=0).tolist(), *centroids.max(axis=0).tolist())
 
 
 def refitted_graph(sketch_graph: nx.Graph, metric_graph: nx.Graph, transform: np.ndarray) -> nx.Graph:
     """A copy of the sketch graph whose centroids are moved into the metric map's frame and whose
     extent is the metric map's, so :func:`~ursim_core.matching.positions.region_positions`
     normalises both maps alike."""
-    boxes = np.array([box for _, box in metric_graph.nodes(data="bbox")], float).reshape(-1, 4)
-    if len(boxes):
-        extent = (*boxes[:, :2].min(axis=0).tolist(), *boxes[:, 2:].max(axis=0).tolist())
-    else:
-        centroids = np.array([c for _, c in metric_graph.nodes(data="centroid")], float).reshape(-1, 2)
-        extent = (*centroids.min(axis=0).tolist(), *centroids.max(axis=0).tolist())
+    extent = _extent_of(metric_graph)
     moved = sketch_graph.copy()
     for _, data in moved.nodes(data=True):
         row, col = data["centroid"]
@@ -178,13 +217,10 @@ def refit_from(prepared, pairs, match_once):
     transform = fit_axis_transform(pairs, prepared.sketch_graph, prepared.metric_graph)
     if transform is None:
         return None
-    moved = refitted_graph(prepared.sketch_graph, prepared.metric_graph, transform)
-    c_matrix = blend_positions(
+    c_matrix = blend_position_arrays(
         descriptors.signature_c,
-        moved,
-        descriptors.sketch_nodes,
-        prepared.metric_graph,
-        descriptors.metric_nodes,
+        refitted_positions(prepared.sketch_graph, descriptors.sketch_nodes, prepared.metric_graph, transform),
+        region_positions(prepared.metric_graph, nodes=descriptors.metric_nodes),
         config.position_weight,
     )
     candidate = dataclasses.replace(

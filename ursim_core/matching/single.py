@@ -9,10 +9,20 @@ import numpy as np
 
 from ursim_core.matching.baselines import hungarian_match, vf2_match
 from ursim_core.matching.config import MatchConfig
+from ursim_core.matching.kernels import sweep_compiled
 from ursim_core.matching.planar import hypothesis_cost, planar_match
 from ursim_core.matching.results import MatchResult, Prepared
 
-__all__ = ["seed_pairs", "SeedSelector", "seed_cap", "pair_cost_matrix", "planar_seeds", "planar_outcome", "match_at"]
+__all__ = [
+    "seed_pairs",
+    "SeedSelector",
+    "seed_cap",
+    "pair_cost_matrix",
+    "planar_seeds",
+    "planar_outcome",
+    "match_at",
+    "match_sweep",
+]
 
 
 def seed_pairs(c_matrix: np.ndarray, m: float, *, max_seeds: int | None = None) -> list[tuple[int, int]]:
@@ -81,6 +91,19 @@ class SeedSelector:
         # A sketch-sized pair's seeds are found at every m of many sweeps: as lists, bisect and a
         # sort of a few dozen ints cost a third of NumPy's calls (the same seeds).
         self._listed = (order.tolist(), self._values.tolist()) if order.size <= _LISTED_SEEDS else None
+
+    @property
+    def ordered(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The positions it keeps in the flattened c, sorted by value (ties by position), and
+        their values; None when c has NaN (then :meth:`at` reads c itself)."""
+        return (self._order, self._values) if self._exact else None
+
+    def selected_counts(self, ms) -> list[int] | None:
+        """``np.count_nonzero(c <= m)`` for every m of ``ms``, from the kept values when they are
+        all of c (else None)."""
+        if not self._exact or self._order.size != self._c_matrix.size:
+            return None
+        return np.searchsorted(self._values, np.asarray(ms, dtype=np.float64), side="right").tolist()
 
     def at(self, m: float) -> list[tuple[int, int]]:
         """``seed_pairs(c_matrix, m, max_seeds=max_seeds)``."""
@@ -287,3 +310,69 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
         orientation=prepared.orientation,
         orientation_scan=prepared.orientation_scan,
     )
+
+
+def match_sweep(prepared: Prepared, ms, seed_selector: SeedSelector | None) -> list[MatchResult] | None:
+    """``[match_at(prepared, m, seed_selector=seed_selector) for m in ms]`` from one call of the
+    planar matcher's C loop (:func:`~ursim_core.matching.kernels.sweep_compiled`), or None when
+    it does not take the case: another matcher, constraints, no selector with the configured
+    cap, NaN in c, graphs the C loop leaves to Python, or no C module.
+
+    The same results, field by field: a test compares them. A sweep of a sketch-sized pair spent
+    more time in the Python around each m's C call than in the calls.
+    """
+    config, descriptors = prepared.config, prepared.descriptors
+    if config.matcher != "planar" or descriptors is None or seed_selector is None or not ms:
+        return None
+    c_matrix = prepared.c_matrix
+    ordered = seed_selector.ordered
+    cap = seed_cap(config.max_seeds, *c_matrix.shape)
+    if ordered is None or cap != seed_selector._max_seeds or prepared.index_constraints is not None:
+        return None
+    weighted = config.hypothesis_score != "structure" and config.score_weight != 0
+    outcomes = sweep_compiled(
+        prepared.sketch_planar, prepared.metric_planar, c_matrix, *ordered, cap, ms,
+        score=config.hypothesis_score, weight=config.score_weight if weighted else 0.0,
+        rotation_search=config.rotation_search, reflections=config.reflections,
+    )  # fmt: skip
+    if outcomes is None:
+        return None
+    first, second = prepared.sketch_planar, prepared.metric_planar
+    total = first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges)
+    sketch_nodes, metric_nodes = first.nodes, second.nodes
+    notes = list(prepared.notes)
+    if config.variant in ("T2", "T4") and not descriptors.anchors:
+        notes.append("no anchors: anchor signatures are all zero, matching is structural only")
+    signatures = None
+    if descriptors.sketch_signatures is not None:
+        signatures = (descriptors.sketch_signatures, descriptors.metric_signatures)
+    results = []
+    for m, (index_pairs, scored, _, hypotheses, _, seeds_count) in zip(ms, outcomes):
+        m = float(m)
+        reasons = notes
+        if seeds_count:
+            cost = float(scored)
+            normalised = cost / total if total else 0.0
+        else:
+            reasons = [*notes, f"no seeds: no pair of regions has c <= m = {m:g}"]
+            cost, normalised = math.inf, 1.0
+        results.append(
+            MatchResult(
+                pairs=[(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs],
+                anchors=list(descriptors.anchors),
+                unique_sketch=list(descriptors.unique_sketch),
+                unique_metric=list(descriptors.unique_metric),
+                m=m,
+                cost=cost,
+                normalised_cost=normalised,
+                signatures=signatures,
+                c_matrix=c_matrix,
+                seeds_count=seeds_count,
+                hypotheses=hypotheses,
+                reason="; ".join(dict.fromkeys(reasons)),
+                config=config,
+                orientation=prepared.orientation,
+                orientation_scan=prepared.orientation_scan,
+            )
+        )
+    return results

@@ -10,7 +10,7 @@ from ursim_core.bench.invariance import run_case
 from ursim_core.errors import ParameterError
 from ursim_core.matching import MatchConfig, match, match_prepared, prepare
 from ursim_core.matching.positions import region_positions
-from ursim_core.matching.refit import fit_axis_transform, refitted_graph
+from ursim_core.matching.refit import fit_axis_transform, refitted_graph, refitted_positions
 
 
 def _grid_graph(transform=((1.0, 0.0), (1.0, 0.0))):
@@ -62,8 +62,11 @@ def test_refitted_positions_are_the_partners_positions():
     everything = sorted(metric.nodes)
     partners = region_positions(metric, nodes=everything)[[everything.index(n) for n in nodes]]
     assert not np.allclose(plain, partners)
-    moved = refitted_graph(sketch, metric, fit_axis_transform([(n, n) for n in nodes], sketch, metric))
+    transform = fit_axis_transform([(n, n) for n in nodes], sketch, metric)
+    moved = refitted_graph(sketch, metric, transform)
     assert np.allclose(region_positions(moved, nodes=nodes), partners)
+    # What the refit blends: the same positions, bit for bit, without the copy of the graph.
+    assert np.array_equal(refitted_positions(sketch, nodes, metric, transform), region_positions(moved, nodes=nodes))
 
 
 def test_refits_are_an_option_off_in_the_paper_and_released_configurations():

@@ -31,7 +31,41 @@ static inline int get_buffer(PyObject *obj, Py_ssize_t itemsize, char kind, int 
     return 0;
 }
 
-/* planar.c */
+/* planar.c: the seed-and-expand loop, shared by planar_match and planar_sweep (sweep.c). */
+typedef struct {
+    int32_t n1, n2;
+    const int32_t *off1, *nb1, *off2, *nb2; /* cyclic neighbour orders (CSR) */
+    const uint8_t *same;                    /* n1 x n2: c <= m */
+    int32_t *table;                         /* edit-distance table, (max degree 1 + 1) x (max degree 2 + 1) */
+    int32_t *row_buffer;                    /* a rotated or reversed first sequence */
+} Graphs;
+
+typedef struct {
+    Graphs g;
+    int64_t edges1, edges2;
+    int rotation_min, reflections;
+    int32_t n_min, stamp;
+    int32_t *work, *stamps; /* scratch; stamps: seen in the sketch, matched in the sketch, seen in the metric map */
+    uint8_t *consumed;      /* n1 x n2: seeds no longer starting a hypothesis */
+    int32_t *arc1, *arc2, *locks, *aligned, *queue, *pairs, *best_pairs, *partner;
+} Planar;
+
+typedef struct {
+    int32_t n_pairs;
+    int64_t structure, hypotheses, expanded;
+    double cost;
+} PlanarOutcome;
+
+int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *name);
+void planar_close(Planar *p);
+void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const double *costs, double weight,
+                PlanarOutcome *out);
+PyObject *planar_outcome_tuple(const int32_t *pairs, const PlanarOutcome *outcome, int weighted);
+
 KERNEL(planar_match);
+/* sweep.c */
+KERNEL(planar_sweep);
+/* refit.c */
+KERNEL(fit_axes);
 
 #endif

@@ -16,13 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct {
-    int32_t n1, n2;
-    const int32_t *off1, *nb1, *off2, *nb2; /* cyclic neighbour orders (CSR) */
-    const uint8_t *same;                    /* n1 x n2 */
-    int32_t *table;                         /* edit-distance table, (max degree 1 + 1) x (max degree 2 + 1) */
-    int32_t *row_buffer;                    /* a rotated or reversed first sequence */
-} Graphs;
 
 /* Levenshtein table of ``a`` (rows) against ``b`` (columns); returns the distance. */
 static int32_t fill_table(const Graphs *g, const int32_t *a, int32_t rows, const int32_t *b, int32_t cols)
@@ -217,103 +210,22 @@ fail:
     return NULL;
 }
 
-/* planar_match(off1, nb1, off2, nb2, edges1, edges2, same, seeds, pair_costs, weight, rotation_min,
- * reflections) -> (pairs, cost, structural_cost, hypotheses, seeds_expanded).
- * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). */
-KERNEL(planar_match)
+/* One planar match from ``seeds`` (n_seeds >= 1, inside the graphs) over ``p->g.same``; ``costs``
+ * NULL: not weighted. The best pairs are left in ``p->best_pairs``. Needs no Python (the GIL may
+ * be released). Stamps are unique over the calls on one Planar, so they are never cleared. */
+void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const double *costs, double weight,
+                PlanarOutcome *out)
 {
-    if (nargs != 12) {
-        PyErr_Format(PyExc_TypeError, "planar_match takes 12 arguments (%zd given)", nargs);
-        return NULL;
-    }
-    Py_buffer views[6];
-    int n_views = 0;
-    PyObject *result = NULL;
-    int32_t *seeds = NULL, *work = NULL;
-    int32_t *stamps = NULL;
-    uint8_t *consumed = NULL;
-    if (get_buffer(args[0], 4, 'i', 1, "planar_match: off1", &views[n_views]) < 0) goto done;
-    n_views++;
-    if (get_buffer(args[1], 4, 'i', 1, "planar_match: nb1", &views[n_views]) < 0) goto done;
-    n_views++;
-    if (get_buffer(args[2], 4, 'i', 1, "planar_match: off2", &views[n_views]) < 0) goto done;
-    n_views++;
-    if (get_buffer(args[3], 4, 'i', 1, "planar_match: nb2", &views[n_views]) < 0) goto done;
-    n_views++;
-    if (get_buffer(args[6], 1, 'b', 2, "planar_match: same", &views[n_views]) < 0) goto done;
-    n_views++;
-    int weighted = args[8] != Py_None;
-    const double *costs = NULL;
-    if (weighted) {
-        if (get_buffer(args[8], 8, 'f', 2, "planar_match: pair_costs", &views[n_views]) < 0) goto done;
-        costs = views[n_views].buf;
-        n_views++;
-    }
-    long edges1 = PyLong_AsLong(args[4]), edges2 = PyLong_AsLong(args[5]);
-    double weight = PyFloat_AsDouble(args[9]);
-    long rotation_min = PyLong_AsLong(args[10]), reflections = PyLong_AsLong(args[11]);
-    if (PyErr_Occurred()) goto done;
+    Graphs *g = &p->g;
+    int32_t n1 = g->n1, n2 = g->n2;
+    int weighted = costs != NULL;
+    int32_t *seen1 = p->stamps, *matched1 = p->stamps + n1, *seen2 = p->stamps + 2 * n1;
+    int32_t *arc1 = p->arc1, *arc2 = p->arc2, *locks = p->locks, *aligned = p->aligned, *queue = p->queue;
+    int32_t *pairs = p->pairs, *best_pairs = p->best_pairs, *partner = p->partner;
+    uint8_t *consumed = p->consumed;
+    memset(consumed, 0, (size_t)n1 * (size_t)n2);
 
-    Graphs g;
-    g.n1 = (int32_t)(views[0].shape[0] - 1);
-    g.n2 = (int32_t)(views[2].shape[0] - 1);
-    g.off1 = views[0].buf;
-    g.nb1 = views[1].buf;
-    g.off2 = views[2].buf;
-    g.nb2 = views[3].buf;
-    g.same = views[4].buf;
-    int32_t n1 = g.n1, n2 = g.n2;
-    if (n1 < 0 || n2 < 0 || views[4].shape[0] != n1 || views[4].shape[1] != n2
-        || (weighted && (views[5].shape[0] != n1 || views[5].shape[1] != n2))) {
-        PyErr_SetString(PyExc_ValueError, "planar_match: same and pair_costs must be n1 x n2");
-        goto done;
-    }
-    int32_t degree1 = 0, degree2 = 0;
-    for (int32_t v = 0; v < n1; v++) {
-        int32_t d = g.off1[v + 1] - g.off1[v];
-        degree1 = d > degree1 ? d : degree1;
-    }
-    for (int32_t v = 0; v < n2; v++) {
-        int32_t d = g.off2[v + 1] - g.off2[v];
-        degree2 = d > degree2 ? d : degree2;
-    }
-    Py_ssize_t n_seeds = 0;
-    seeds = int_sequence_arg(args[7], &n_seeds);
-    if (seeds == NULL) goto done;
-    for (Py_ssize_t k = 0; k < n_seeds; k++) {
-        if (seeds[2 * k] < 0 || seeds[2 * k] >= n1 || seeds[2 * k + 1] < 0 || seeds[2 * k + 1] >= n2) {
-            PyErr_SetString(PyExc_IndexError, "planar_match: a seed is outside the graphs");
-            goto done;
-        }
-    }
-    if (n_seeds == 0) {
-        PyErr_SetString(PyExc_ValueError, "planar_match: no seed");
-        goto done;
-    }
-    int32_t n_min = n1 < n2 ? n1 : n2;
-    int32_t d_max = degree1 > degree2 ? degree1 : degree2;
-    /* Scratch: table, row buffer, two arcs, locks (2 per), aligned pairs (2 per), queue and pairs
-     * (2 per, at most n1 + 1 each), the best pairs, the partners. */
-    size_t table_cells = (size_t)(degree1 + 1) * (size_t)(degree2 + 1);
-    size_t words = table_cells + 3 * (size_t)(d_max + 1) + 4 * (size_t)(d_max + 1)
-                   + 2 * 2 * (size_t)(n1 + 2) + 2 * (size_t)(n_min + 1) + (size_t)n1;
-    work = malloc(sizeof(int32_t) * words);
-    stamps = calloc((size_t)(2 * n1 + n2 + 1), sizeof(int32_t));
-    consumed = calloc((size_t)n1 * (size_t)n2 + 1, 1);
-    if (work == NULL || stamps == NULL || consumed == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    g.table = work;
-    g.row_buffer = g.table + table_cells;
-    int32_t *arc1 = g.row_buffer + (d_max + 1), *arc2 = arc1 + (d_max + 1);
-    int32_t *locks = arc2 + (d_max + 1), *aligned = locks + 2 * (d_max + 1);
-    int32_t *queue = aligned + 2 * (d_max + 1), *pairs = queue + 2 * (n1 + 2);
-    int32_t *best_pairs = pairs + 2 * (n1 + 2), *partner = best_pairs + 2 * (n_min + 1);
-    /* Per hypothesis stamps: seen in the sketch, matched in the sketch, seen in the metric map. */
-    int32_t *seen1 = stamps, *matched1 = stamps + n1, *seen2 = stamps + 2 * n1;
-
-    int64_t single_structure = (int64_t)(n1 - 1) + (n2 - 1) + edges1 + edges2;
+    int64_t single_structure = (int64_t)(n1 - 1) + (n2 - 1) + p->edges1 + p->edges2;
     Py_ssize_t best_seed = 0;
     double best_term = 0.0;
     if (weighted) {
@@ -332,9 +244,7 @@ KERNEL(planar_match)
     int64_t best_structure = single_structure;
     double best_cost = (double)single_structure + best_term;
     int64_t hypotheses = n_seeds, expanded = 0;
-    int32_t stamp = 0;
 
-    Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t k = 0; k < n_seeds; k++) {
         int32_t v = seeds[2 * k], w = seeds[2 * k + 1];
         if (consumed[(int64_t)v * n2 + w]) {
@@ -342,9 +252,9 @@ KERNEL(planar_match)
         }
         consumed[(int64_t)v * n2 + w] = 1;
         expanded++;
-        stamp++;
+        int32_t stamp = ++p->stamp;
         int reflected = 0;
-        int32_t n_aligned = seed_pairs(&g, v, w, (int)rotation_min, (int)reflections, &reflected, aligned);
+        int32_t n_aligned = seed_pairs(g, v, w, p->rotation_min, p->reflections, &reflected, aligned);
         seen1[v] = stamp;
         seen2[w] = stamp;
         matched1[v] = stamp;
@@ -363,26 +273,26 @@ KERNEL(planar_match)
                 matched1[vertex] = stamp;
                 partner[vertex] = other;
             }
-            int32_t size1 = g.off1[vertex + 1] - g.off1[vertex], size2 = g.off2[other + 1] - g.off2[other];
+            int32_t size1 = g->off1[vertex + 1] - g->off1[vertex], size2 = g->off2[other + 1] - g->off2[other];
             if (size1 <= 1 || size2 <= 1) {
                 continue; /* one neighbour on either side: every arc between locks is empty */
             }
-            const int32_t *order2 = g.nb2 + g.off2[other];
-            const int32_t *base1 = g.nb1 + g.off1[vertex];
-            int32_t *order1 = g.row_buffer;
-            for (int32_t p = 0; p < size1; p++) {
-                order1[p] = reflected ? base1[size1 - 1 - p] : base1[p];
+            const int32_t *order2 = g->nb2 + g->off2[other];
+            const int32_t *base1 = g->nb1 + g->off1[vertex];
+            int32_t *order1 = g->row_buffer;
+            for (int32_t q = 0; q < size1; q++) {
+                order1[q] = reflected ? base1[size1 - 1 - q] : base1[q];
             }
             int32_t n_locks = 0;
-            for (int32_t p = 0; p < size1; p++) {
-                int32_t u = order1[p];
+            for (int32_t q = 0; q < size1; q++) {
+                int32_t u = order1[q];
                 if (matched1[u] != stamp) {
                     continue;
                 }
                 int32_t target = partner[u];
                 for (int32_t r = 0; r < size2; r++) {
                     if (order2[r] == target) {
-                        locks[2 * n_locks] = p;
+                        locks[2 * n_locks] = q;
                         locks[2 * n_locks + 1] = r;
                         n_locks++;
                         break;
@@ -398,7 +308,7 @@ KERNEL(planar_match)
                 }
                 /* order1 lives in row_buffer, which the alignment does not touch (it is only the
                  * seed alignment's rotation buffer). */
-                int32_t found = aligned_index_pairs(&g, arc1, length1, arc2, length2, aligned);
+                int32_t found = aligned_index_pairs(g, arc1, length1, arc2, length2, aligned);
                 tail = enqueue(aligned, found, queue, tail, seen1, seen2, stamp, consumed, n2);
             }
         }
@@ -406,24 +316,24 @@ KERNEL(planar_match)
         /* Edges among the matched vertices, each seen from both ends. At the end of an expansion
          * every queued pair is matched, so "seen" is "matched" on both sides. */
         int64_t inner1 = 0, inner2 = 0;
-        for (int32_t p = 0; p < n_pairs; p++) {
-            int32_t a = pairs[2 * p], b = pairs[2 * p + 1];
-            for (int32_t e = g.off1[a]; e < g.off1[a + 1]; e++) {
-                inner1 += matched1[g.nb1[e]] == stamp;
+        for (int32_t q = 0; q < n_pairs; q++) {
+            int32_t a = pairs[2 * q], b = pairs[2 * q + 1];
+            for (int32_t e = g->off1[a]; e < g->off1[a + 1]; e++) {
+                inner1 += matched1[g->nb1[e]] == stamp;
             }
-            for (int32_t e = g.off2[b]; e < g.off2[b + 1]; e++) {
-                inner2 += seen2[g.nb2[e]] == stamp;
+            for (int32_t e = g->off2[b]; e < g->off2[b + 1]; e++) {
+                inner2 += seen2[g->nb2[e]] == stamp;
             }
         }
         inner1 /= 2;
         inner2 /= 2;
-        int64_t structure = (int64_t)(n1 - n_pairs) + (n2 - n_pairs) + (edges1 - inner1) + (edges2 - inner2)
+        int64_t structure = (int64_t)(n1 - n_pairs) + (n2 - n_pairs) + (p->edges1 - inner1) + (p->edges2 - inner2)
                             + (inner1 > inner2 ? inner1 - inner2 : inner2 - inner1);
         double cost = (double)structure;
         if (weighted) {
             double sum = 0.0;
-            for (int32_t p = 0; p < n_pairs; p++) {
-                sum += costs[(int64_t)pairs[2 * p] * n2 + pairs[2 * p + 1]];
+            for (int32_t q = 0; q < n_pairs; q++) {
+                sum += costs[(int64_t)pairs[2 * q] * n2 + pairs[2 * q + 1]];
             }
             cost = (double)structure + weight * sum;
         }
@@ -435,32 +345,74 @@ KERNEL(planar_match)
             memcpy(best_pairs, pairs, sizeof(int32_t) * 2 * (size_t)n_pairs);
         }
     }
-    Py_END_ALLOW_THREADS
+    out->n_pairs = n_best;
+    out->structure = best_structure;
+    out->cost = best_cost;
+    out->hypotheses = hypotheses;
+    out->expanded = expanded;
+}
 
-    PyObject *listed = PyList_New(n_best);
-    if (listed == NULL) goto done;
-    for (int32_t p = 0; p < n_best; p++) {
-        PyObject *pair = Py_BuildValue("(ii)", best_pairs[2 * p], best_pairs[2 * p + 1]);
-        if (pair == NULL) {
-            Py_DECREF(listed);
-            goto done;
-        }
-        PyList_SET_ITEM(listed, p, pair);
+/* planar_match(off1, nb1, off2, nb2, edges1, edges2, same, seeds, pair_costs, weight, rotation_min,
+ * reflections) -> (pairs, cost, structural_cost, hypotheses, seeds_expanded).
+ * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). */
+KERNEL(planar_match)
+{
+    if (nargs != 12) {
+        PyErr_Format(PyExc_TypeError, "planar_match takes 12 arguments (%zd given)", nargs);
+        return NULL;
     }
-    PyObject *cost_object = weighted ? PyFloat_FromDouble(best_cost) : PyLong_FromLongLong((long long)best_structure);
-    if (cost_object == NULL) {
-        Py_DECREF(listed);
+    Planar p;
+    Py_buffer views[6];
+    int n_views = 0;
+    PyObject *result = NULL;
+    int32_t *seeds = NULL;
+    if (planar_open(&p, args, views, "planar_match") < 0) {
+        return NULL;
+    }
+    n_views = 4;
+    if (get_buffer(args[6], 1, 'b', 2, "planar_match: same", &views[n_views]) < 0) goto done;
+    n_views++;
+    int weighted = args[8] != Py_None;
+    const double *costs = NULL;
+    if (weighted) {
+        if (get_buffer(args[8], 8, 'f', 2, "planar_match: pair_costs", &views[n_views]) < 0) goto done;
+        costs = views[n_views].buf;
+        n_views++;
+    }
+    double weight = PyFloat_AsDouble(args[9]);
+    p.rotation_min = (int)PyLong_AsLong(args[10]);
+    p.reflections = (int)PyLong_AsLong(args[11]);
+    if (PyErr_Occurred()) goto done;
+    int32_t n1 = p.g.n1, n2 = p.g.n2;
+    if (views[4].shape[0] != n1 || views[4].shape[1] != n2
+        || (weighted && (views[5].shape[0] != n1 || views[5].shape[1] != n2))) {
+        PyErr_SetString(PyExc_ValueError, "planar_match: same and pair_costs must be n1 x n2");
         goto done;
     }
-    result = Py_BuildValue("(NNLLL)", listed, cost_object, (long long)best_structure, (long long)hypotheses,
-                           (long long)expanded);
+    p.g.same = views[4].buf;
+    Py_ssize_t n_seeds = 0;
+    seeds = int_sequence_arg(args[7], &n_seeds);
+    if (seeds == NULL) goto done;
+    for (Py_ssize_t k = 0; k < n_seeds; k++) {
+        if (seeds[2 * k] < 0 || seeds[2 * k] >= n1 || seeds[2 * k + 1] < 0 || seeds[2 * k + 1] >= n2) {
+            PyErr_SetString(PyExc_IndexError, "planar_match: a seed is outside the graphs");
+            goto done;
+        }
+    }
+    if (n_seeds == 0) {
+        PyErr_SetString(PyExc_ValueError, "planar_match: no seed");
+        goto done;
+    }
+    PlanarOutcome outcome;
+    Py_BEGIN_ALLOW_THREADS
+    planar_run(&p, seeds, n_seeds, costs, weight, &outcome);
+    Py_END_ALLOW_THREADS
+    result = planar_outcome_tuple(p.best_pairs, &outcome, weighted);
 done:
     for (int k = 0; k < n_views; k++) {
         PyBuffer_Release(&views[k]);
     }
     free(seeds);
-    free(work);
-    free(stamps);
-    free(consumed);
+    planar_close(&p);
     return result;
 }
