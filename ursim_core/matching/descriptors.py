@@ -55,7 +55,13 @@ import networkx as nx
 import numpy as np
 
 from ursim_core.matching.config import SIZE_WEIGHT_FLOOR, VARIANTS
-from ursim_core.matching.positions import blend_positions, position_distance, region_positions, region_types
+from ursim_core.matching.positions import (
+    blend_position_arrays,
+    blend_positions,
+    position_distance,
+    region_positions,
+    region_types,
+)
 from ursim_core.matching.signatures import (
     DEFAULT_TIMES,
     DENSE_LIMIT,
@@ -90,6 +96,7 @@ __all__ = [
     "position_distance",
     "pair_descriptors",
     "blend_positions",
+    "metric_positions_of",
 ]
 
 ATTRIBUTES = ("size", "pca_shape")
@@ -337,6 +344,16 @@ class PairDescriptors:
     #: The signature (or type) comparison alone, before the position blend: what a turned
     #: sketch shares with the upright one (see ``ursim_core.matching.orientation``).
     signature_c: np.ndarray | None = None
+    #: The metric map's region positions (:func:`region_positions`, ``metric_nodes`` order): the
+    #: same in every orientation and refit of the sketch, which blend them again and again.
+    metric_positions: np.ndarray | None = None
+
+
+def metric_positions_of(descriptors: PairDescriptors, metric_graph: nx.Graph) -> np.ndarray:
+    """The metric map's region positions of ``descriptors`` (kept when they were computed)."""
+    if descriptors.metric_positions is not None:
+        return descriptors.metric_positions
+    return region_positions(metric_graph, nodes=descriptors.metric_nodes)
 
 
 def pair_descriptors(
@@ -412,6 +429,7 @@ def pair_descriptors(
     if variant == "baseline":
         sketch_types = region_types(sketch_graph, nodes=sketch_nodes)
         metric_types = region_types(metric_graph, nodes=metric_nodes)
+        metric_positions = region_positions(metric_graph, nodes=metric_nodes) if position_weight else None
         c_matrix = blend_positions(
             (sketch_types[:, None] != metric_types[None, :]).astype(np.float64),
             sketch_graph,
@@ -422,8 +440,9 @@ def pair_descriptors(
         )
         types_c = (sketch_types[:, None] != metric_types[None, :]).astype(np.float64)
         return PairDescriptors(
-            sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [], None, None, None, None, c_matrix, notes, types_c
-        )
+            sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [], None, None, None, None, c_matrix, notes,
+            types_c, metric_positions,
+        )  # fmt: skip
 
     uses_anchors = variant in ("T2", "T4")
     if weights is None:
@@ -465,14 +484,13 @@ def pair_descriptors(
             heat_kernel_signatures(laplacian, anchors=anchor_rows if uses_anchors else None, times=times, method=method)
         )
     signature_c = signature_distance(signatures[0], signatures[1])
-    c_matrix = blend_positions(
-        signature_c,
-        sketch_graph,
-        sketch_nodes,
-        metric_graph,
-        metric_nodes,
-        position_weight,
-    )
+    metric_positions = None
+    c_matrix = signature_c
+    if position_weight:
+        metric_positions = region_positions(metric_graph, nodes=metric_nodes)
+        c_matrix = blend_position_arrays(
+            signature_c, region_positions(sketch_graph, nodes=sketch_nodes), metric_positions, position_weight
+        )
     return PairDescriptors(
         sketch_nodes,
         metric_nodes,
@@ -488,4 +506,5 @@ def pair_descriptors(
         c_matrix,
         notes,
         signature_c,
+        metric_positions,
     )

@@ -283,10 +283,16 @@ def oriented_graph(graph: nx.Graph, *, degrees: float, mirrored: bool, outlines:
         turned = transform_points(corners, degrees=degrees, mirrored=mirrored).reshape(-1, 4, 2)
         low, high = turned.min(axis=1), turned.max(axis=1)
         if outlines and degrees % 90.0 != 0.0:
-            for i, node in enumerate(with_box):
-                if node in outlines:
-                    outline = transform_points(outlines[node], degrees=degrees, mirrored=mirrored)
-                    low[i], high[i] = outline.min(axis=0), outline.max(axis=0)
+            outlined = [i for i, node in enumerate(with_box) if node in outlines and len(outlines[node])]
+            if outlined:
+                # All outlines turned by one call, each one's box by a segmented reduction: the
+                # same values as turning them one by one (elementwise arithmetic), at a tenth of
+                # the calls (a turned sketch's regions are turned about twenty times a match).
+                points = [outlines[with_box[i]] for i in outlined]
+                starts = np.cumsum([0] + [len(outline) for outline in points[:-1]])
+                turned_points = transform_points(np.concatenate(points), degrees=degrees, mirrored=mirrored)
+                low[outlined] = np.minimum.reduceat(turned_points, starts, axis=0)
+                high[outlined] = np.maximum.reduceat(turned_points, starts, axis=0)
         for i, node in enumerate(with_box):
             out.nodes[node]["bbox"] = (float(low[i, 0]), float(low[i, 1]), float(high[i, 0]), float(high[i, 1]))
     for i, node in enumerate(nodes):

@@ -14,9 +14,10 @@ import dataclasses
 import networkx as nx
 
 from ursim_core.matching.config import MatchConfig
-from ursim_core.matching.descriptors import blend_positions, pair_descriptors
+from ursim_core.matching.descriptors import metric_positions_of, pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines, turn_between
 from ursim_core.matching.planar import planar_graph
+from ursim_core.matching.positions import blend_position_arrays, region_positions
 from ursim_core.matching.results import Prepared
 from ursim_core.segmentation.canonical import wall_angle
 from ursim_core.segmentation.interface import Segmentation
@@ -121,12 +122,10 @@ def reoriented(
     turned = oriented_graph(sketch_graph, degrees=orientation[0], mirrored=orientation[1], outlines=outlines)
     descriptors = base.descriptors
     if descriptors is not None and descriptors.signature_c is not None:
-        c_matrix = blend_positions(
+        c_matrix = blend_position_arrays(
             descriptors.signature_c,
-            turned,
-            descriptors.sketch_nodes,
-            base.metric_graph,
-            descriptors.metric_nodes,
+            region_positions(turned, nodes=descriptors.sketch_nodes),
+            metric_positions_of(descriptors, base.metric_graph),
             base.config.position_weight,
         )
         descriptors = dataclasses.replace(descriptors, c_matrix=c_matrix)

@@ -32,8 +32,9 @@ import dataclasses
 import networkx as nx
 import numpy as np
 
+from ursim_core.matching.descriptors import metric_positions_of
 from ursim_core.matching.kernels import NO_FIT, fit_axes_compiled
-from ursim_core.matching.positions import blend_position_arrays, region_positions
+from ursim_core.matching.positions import blend_position_arrays
 
 __all__ = [
     "fit_axis_transform",
@@ -220,7 +221,7 @@ def refit_from(prepared, pairs, match_once):
     c_matrix = blend_position_arrays(
         descriptors.signature_c,
         refitted_positions(prepared.sketch_graph, descriptors.sketch_nodes, prepared.metric_graph, transform),
-        region_positions(prepared.metric_graph, nodes=descriptors.metric_nodes),
+        metric_positions_of(descriptors, prepared.metric_graph),
         config.position_weight,
     )
     candidate = dataclasses.replace(

@@ -93,6 +93,26 @@ def test_a_map_drawn_at_an_angle_turned_back_gets_its_upright_positions(degrees)
     assert np.allclose(_span(tight), _span(upright), atol=3)
 
 
+@pytest.mark.parametrize("degrees, mirrored", [(30.0, False), (161.5, True), (301.25, False)])
+def test_the_boxes_of_turned_outlines_are_each_outlines_own(degrees, mirrored):
+    """All outlines are turned together; each box is the one around that region's turned
+    outline, bit for bit, and a region without an outline keeps the box around its turned box."""
+    from ursim_core.matching.orientation import transform_points
+
+    labels = _three_rooms()
+    graph = region_graph(labels)
+    outlines = region_outlines(graph, labels)
+    missing = sorted(outlines)[0]
+    del outlines[missing]
+    turned = oriented_graph(graph, degrees=degrees, mirrored=mirrored, outlines=outlines)
+    for node, outline in outlines.items():
+        points = transform_points(outline, degrees=degrees, mirrored=mirrored)
+        expected = (*points.min(axis=0).tolist(), *points.max(axis=0).tolist())
+        assert turned.nodes[node]["bbox"] == expected
+    plain = oriented_graph(graph, degrees=degrees, mirrored=mirrored)
+    assert turned.nodes[missing]["bbox"] == plain.nodes[missing]["bbox"]
+
+
 def test_outlines_leave_quarter_turns_and_mirrors_alone():
     labels = _three_rooms()
     graph = region_graph(labels)
