@@ -9,12 +9,14 @@ refit's robust line fit (:file:`csrc/refit.c`, a port of :mod:`ursim_core.matchi
 
 :func:`match_compiled` takes the planar matcher's common case (no constraints, no alternatives
 kept, graphs whose alignments are sketch-sized) and gives the same pairs in the same order, the
-same cost (the pair costs summed in pair order, as Python 3.11's ``sum``) and the same counts.
+same cost (the pair costs summed in pair order, as Python 3.11's ``sum``) and the same counts;
+:func:`sweep_compiled` gives, at every m, what :func:`~ursim_core.matching.single.match_at` would.
 
 The module is compiled on the installed machine (:class:`ursim_core.native.NativeModule`; ``make``
 builds it with the segmentation kernels, else the first match does, in about a second). With no C
 compiler, or ``URSIM_KERNELS=jit`` (which also keeps the MAORIS kernels in numba), the matcher
-runs in Python, a little over twice as slow on a turned KTH sketch.
+runs in Python, about two and a half times as slow on a turned KTH sketch (115 ms against 47 ms,
+round 40).
 
 Examples
 --------
@@ -100,7 +102,7 @@ def _built_and_loaded():
     except (RuntimeError, ImportError, OSError) as error:
         warnings.warn(
             f"could not build the matcher's C kernels ({type(error).__name__}: {error}); "
-            "matching runs in Python, about twice as slow",
+            "matching runs in Python, about two and a half times as slow",
             RuntimeWarning,
             stacklevel=3,
         )

@@ -1,4 +1,4 @@
-"""One run of the configured matcher at one fixed m: seeds, the planar matcher or a baseline, the score."""
+"""One run of the configured matcher at one fixed m (seeds, the planar matcher or a baseline, the score), and a sweep of such runs over many m in one call of the C loop."""
 
 from __future__ import annotations
 

@@ -178,3 +178,24 @@ def test_no_unique_region_is_reported():
     assert any("no anchors" in note for note in result.notes)
     assert any("zero variance" in note for note in result.notes)
     assert np.allclose(result.c_matrix, 0)
+
+
+@pytest.mark.parametrize("variant", ["T4", "baseline"])
+def test_the_metric_maps_positions_are_kept_for_every_blend_of_the_pair(variant):
+    """``metric_positions`` are the metric map's positions; blending them again gives ``c``; with
+    no position term there are none to keep (and no centroid is read)."""
+    from ursim_core.bench.matching import random_region_graph
+    from ursim_core.matching.descriptors import metric_positions_of
+    from ursim_core.matching.positions import blend_position_arrays, region_positions
+
+    sketch, metric = random_region_graph(7, seed=1), random_region_graph(9, seed=2)
+    descriptors = d.pair_descriptors(sketch, metric, variant=variant, position_weight=2.0)
+    expected = region_positions(metric, nodes=descriptors.metric_nodes)
+    assert np.array_equal(descriptors.metric_positions, expected)
+    assert metric_positions_of(descriptors, metric) is descriptors.metric_positions
+    sketch_positions = region_positions(sketch, nodes=descriptors.sketch_nodes)
+    base = descriptors.signature_c
+    assert np.array_equal(blend_position_arrays(base, sketch_positions, expected, 2.0), descriptors.c_matrix)
+    plain = d.pair_descriptors(sketch, metric, variant=variant, position_weight=0.0)
+    assert plain.metric_positions is None
+    assert np.array_equal(metric_positions_of(plain, metric), expected)
