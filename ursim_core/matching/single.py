@@ -1,4 +1,7 @@
-"""One run of the configured matcher at one fixed m (seeds, the planar matcher or a baseline, the score), and a sweep of such runs over many m in one call of the C loop."""
+"""One run of the configured matcher at one fixed m: seeds, the planar matcher or a baseline, the score.
+
+:func:`match_sweep` gives the runs at many values of m from one call of the planar matcher's C loop.
+"""
 
 from __future__ import annotations
 
