@@ -96,7 +96,6 @@ __all__ = [
     "position_distance",
     "pair_descriptors",
     "blend_positions",
-    "metric_positions_of",
 ]
 
 ATTRIBUTES = ("size", "pca_shape")
@@ -347,13 +346,6 @@ class PairDescriptors:
     #: The metric map's region positions (:func:`region_positions`, ``metric_nodes`` order): the
     #: same in every orientation and refit of the sketch, which blend them again and again.
     metric_positions: np.ndarray | None = None
-
-
-def metric_positions_of(descriptors: PairDescriptors, metric_graph: nx.Graph) -> np.ndarray:
-    """The metric map's region positions of ``descriptors`` (kept when they were computed)."""
-    if descriptors.metric_positions is not None:
-        return descriptors.metric_positions
-    return region_positions(metric_graph, nodes=descriptors.metric_nodes)
 
 
 def pair_descriptors(

@@ -14,10 +14,10 @@ import dataclasses
 import networkx as nx
 
 from ursim_core.matching.config import MatchConfig
-from ursim_core.matching.descriptors import metric_positions_of, pair_descriptors
+from ursim_core.matching.descriptors import pair_descriptors
 from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines, turn_between
 from ursim_core.matching.planar import planar_graph
-from ursim_core.matching.positions import blend_position_arrays, region_positions
+from ursim_core.matching.positions import blend_position_arrays, metric_positions_of, region_positions
 from ursim_core.matching.results import Prepared
 from ursim_core.segmentation.canonical import wall_angle
 from ursim_core.segmentation.interface import Segmentation

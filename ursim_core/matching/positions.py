@@ -12,7 +12,14 @@ from collections.abc import Sequence
 import networkx as nx
 import numpy as np
 
-__all__ = ["region_types", "region_positions", "position_distance", "blend_positions", "blend_position_arrays"]
+__all__ = [
+    "region_types",
+    "region_positions",
+    "position_distance",
+    "blend_positions",
+    "blend_position_arrays",
+    "metric_positions_of",
+]
 
 
 def region_types(graph: nx.Graph, *, nodes: Sequence | None = None) -> np.ndarray:
@@ -120,3 +127,12 @@ def blend_position_arrays(c_matrix, sketch_positions, metric_positions, position
     distances += c_matrix
     distances /= 1.0 + position_weight
     return distances
+
+
+def metric_positions_of(descriptors, metric_graph: nx.Graph) -> np.ndarray:
+    """The metric map's region positions of a pair's
+    :class:`~ursim_core.matching.descriptors.PairDescriptors`: those it kept
+    (``metric_positions``), else :func:`region_positions` in its ``metric_nodes`` order."""
+    if descriptors.metric_positions is not None:
+        return descriptors.metric_positions
+    return region_positions(metric_graph, nodes=descriptors.metric_nodes)

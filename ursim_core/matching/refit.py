@@ -32,9 +32,8 @@ import dataclasses
 import networkx as nx
 import numpy as np
 
-from ursim_core.matching.descriptors import metric_positions_of
 from ursim_core.matching.kernels import NO_FIT, fit_axes_compiled
-from ursim_core.matching.positions import blend_position_arrays
+from ursim_core.matching.positions import blend_position_arrays, metric_positions_of
 
 __all__ = [
     "fit_axis_transform",

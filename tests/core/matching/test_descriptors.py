@@ -185,8 +185,7 @@ def test_the_metric_maps_positions_are_kept_for_every_blend_of_the_pair(variant)
     """``metric_positions`` are the metric map's positions; blending them again gives ``c``; with
     no position term there are none to keep (and no centroid is read)."""
     from ursim_core.bench.matching import random_region_graph
-    from ursim_core.matching.descriptors import metric_positions_of
-    from ursim_core.matching.positions import blend_position_arrays, region_positions
+    from ursim_core.matching.positions import blend_position_arrays, metric_positions_of, region_positions
 
     sketch, metric = random_region_graph(7, seed=1), random_region_graph(9, seed=2)
     descriptors = d.pair_descriptors(sketch, metric, variant=variant, position_weight=2.0)
