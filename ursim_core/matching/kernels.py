@@ -115,11 +115,9 @@ def forget() -> None:
     _loaded = _UNSET
 
 
-def match_compiled(
-    first, second, same, seeds, *, rotation_search="min", reflections=False, pair_costs=None, pair_cost_weight=0.0
-):
-    """``(pairs, cost, structural_cost, hypotheses, seeds_expanded)`` from the C loop, or None
-    when it does not take this case (see the module docstring); ``seeds`` must not be empty."""
+def _taken(first, second):
+    """``(module, first's orders, second's orders)`` when the C loop takes these planar graphs
+    (each orders as ``(offsets, flat)``), else None: no module, or graphs too large for it."""
     if first.n_vertices * second.n_vertices > LARGEST_CELLS:
         return None
     module = kernel()
@@ -129,6 +127,18 @@ def match_compiled(
     second_offsets, second_orders, longest_second = second.flat_orders
     if (longest_first + 1) * (longest_second + 1) > LARGEST_TABLE:
         return None
+    return module, (first_offsets, first_orders), (second_offsets, second_orders)
+
+
+def match_compiled(
+    first, second, same, seeds, *, rotation_search="min", reflections=False, pair_costs=None, pair_cost_weight=0.0
+):
+    """``(pairs, cost, structural_cost, hypotheses, seeds_expanded)`` from the C loop, or None
+    when it does not take this case (see the module docstring); ``seeds`` must not be empty."""
+    taken = _taken(first, second)
+    if taken is None:
+        return None
+    module, (first_offsets, first_orders), (second_offsets, second_orders) = taken
     same = np.ascontiguousarray(same, dtype=np.bool_)
     weighted = pair_costs is not None and pair_cost_weight != 0
     costs = np.ascontiguousarray(pair_costs, dtype=np.float64) if weighted else None
@@ -166,15 +176,10 @@ def sweep_compiled(
     structural cost alone). Returns, per m, ``(pairs, cost, structural_cost, hypotheses,
     seeds_expanded, seeds_count)``; with no seed at m, ``([], None, 0, 0, 0, 0)``.
     """
-    if first.n_vertices * second.n_vertices > LARGEST_CELLS or rotation_search not in ("min", "first"):
+    taken = _taken(first, second) if rotation_search in ("min", "first") else None
+    if taken is None:
         return None
-    module = kernel()
-    if module is None:
-        return None
-    first_offsets, first_orders, longest_first = first.flat_orders
-    second_offsets, second_orders, longest_second = second.flat_orders
-    if (longest_first + 1) * (longest_second + 1) > LARGEST_TABLE:
-        return None
+    module, (first_offsets, first_orders), (second_offsets, second_orders) = taken
     c_matrix = np.ascontiguousarray(c_matrix, dtype=np.float64)
     if np.isnan(c_matrix).any():
         return None

@@ -248,15 +248,7 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
     m = float(m)
     descriptors = prepared.descriptors
     c_matrix = prepared.c_matrix
-    reasons = list(prepared.notes)
-    anchors = list(descriptors.anchors) if descriptors else []
-    unique_sketch = list(descriptors.unique_sketch) if descriptors else []
-    unique_metric = list(descriptors.unique_metric) if descriptors else []
-    signatures = None
-    if descriptors is not None and descriptors.sketch_signatures is not None:
-        signatures = (descriptors.sketch_signatures, descriptors.metric_signatures)
-    if config.variant in ("T2", "T4") and descriptors is not None and not anchors:
-        reasons.append("no anchors: anchor signatures are all zero, matching is structural only")
+    reasons = _notes_of(prepared)
     index_pairs: list = []
     scored = None
     seeds_count = 0
@@ -294,22 +286,40 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
             elif not index_pairs:
                 reasons.append(f"no subgraph isomorphism with c <= m = {m:g}")
     cost, normalised = _cost_of(prepared, index_pairs, pair_costs, scored)
+    return _result(prepared, m, index_pairs, cost, normalised, seeds_count, hypotheses, reasons)
+
+
+def _notes_of(prepared: Prepared) -> list[str]:
+    """The reasons every answer of ``prepared`` carries: its notes, and a missing anchor."""
+    reasons = list(prepared.notes)
+    descriptors = prepared.descriptors
+    if prepared.config.variant in ("T2", "T4") and descriptors is not None and not descriptors.anchors:
+        reasons.append("no anchors: anchor signatures are all zero, matching is structural only")
+    return reasons
+
+
+def _result(prepared: Prepared, m, index_pairs, cost, normalised, seeds_count, hypotheses, reasons) -> MatchResult:
+    """The :class:`MatchResult` of index pairs found at m, in region ids, with the pair's anchors,
+    unique regions and signatures."""
+    descriptors = prepared.descriptors
+    signatures = None
+    if descriptors is not None and descriptors.sketch_signatures is not None:
+        signatures = (descriptors.sketch_signatures, descriptors.metric_signatures)
     sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
-    pairs = [(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs]
     return MatchResult(
-        pairs=pairs,
-        anchors=anchors,
-        unique_sketch=unique_sketch,
-        unique_metric=unique_metric,
+        pairs=[(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs],
+        anchors=list(descriptors.anchors) if descriptors else [],
+        unique_sketch=list(descriptors.unique_sketch) if descriptors else [],
+        unique_metric=list(descriptors.unique_metric) if descriptors else [],
         m=m,
         cost=cost,
         normalised_cost=normalised,
         signatures=signatures,
-        c_matrix=c_matrix,
+        c_matrix=prepared.c_matrix,
         seeds_count=seeds_count,
         hypotheses=hypotheses,
         reason="; ".join(dict.fromkeys(reasons)),
-        config=config,
+        config=prepared.config,
         orientation=prepared.orientation,
         orientation_scan=prepared.orientation_scan,
     )
@@ -340,42 +350,11 @@ def match_sweep(prepared: Prepared, ms, seed_selector: SeedSelector | None) -> l
     )  # fmt: skip
     if outcomes is None:
         return None
-    first, second = prepared.sketch_planar, prepared.metric_planar
-    total = first.n_vertices + second.n_vertices + len(first.edges) + len(second.edges)
-    sketch_nodes, metric_nodes = first.nodes, second.nodes
-    notes = list(prepared.notes)
-    if config.variant in ("T2", "T4") and not descriptors.anchors:
-        notes.append("no anchors: anchor signatures are all zero, matching is structural only")
-    signatures = None
-    if descriptors.sketch_signatures is not None:
-        signatures = (descriptors.sketch_signatures, descriptors.metric_signatures)
+    notes = _notes_of(prepared)
     results = []
     for m, (index_pairs, scored, _, hypotheses, _, seeds_count) in zip(ms, outcomes):
         m = float(m)
-        reasons = notes
-        if seeds_count:
-            cost = float(scored)
-            normalised = cost / total if total else 0.0
-        else:
-            reasons = [*notes, f"no seeds: no pair of regions has c <= m = {m:g}"]
-            cost, normalised = math.inf, 1.0
-        results.append(
-            MatchResult(
-                pairs=[(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs],
-                anchors=list(descriptors.anchors),
-                unique_sketch=list(descriptors.unique_sketch),
-                unique_metric=list(descriptors.unique_metric),
-                m=m,
-                cost=cost,
-                normalised_cost=normalised,
-                signatures=signatures,
-                c_matrix=c_matrix,
-                seeds_count=seeds_count,
-                hypotheses=hypotheses,
-                reason="; ".join(dict.fromkeys(reasons)),
-                config=config,
-                orientation=prepared.orientation,
-                orientation_scan=prepared.orientation_scan,
-            )
-        )
+        reasons = notes if seeds_count else [*notes, f"no seeds: no pair of regions has c <= m = {m:g}"]
+        cost, normalised = _cost_of(prepared, index_pairs, None, scored)
+        results.append(_result(prepared, m, index_pairs, cost, normalised, seeds_count, hypotheses, reasons))
     return results

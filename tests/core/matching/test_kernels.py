@@ -15,14 +15,6 @@ from ursim_core.matching.planar import planar_graph, planar_match
 from ursim_core.native import NativeModule
 
 
-@pytest.fixture
-def c_kernel():
-    module = kernels.kernel()
-    if module is None:
-        pytest.skip("the planar kernel could not be built here (no C compiler)")
-    return module
-
-
 def _python(monkeypatch):
     """Run the next planar_match calls in Python."""
     monkeypatch.setattr(kernels, "kernel", lambda: None)

@@ -16,14 +16,6 @@ from ursim_core.matching.refit import _fitted_in_numpy, fit_axis_transform
 from ursim_core.matching.single import SeedSelector, match_at, match_sweep, seed_cap
 
 
-@pytest.fixture
-def c_kernel():
-    module = kernels.kernel()
-    if module is None:
-        pytest.skip("the matcher's kernels could not be built here (no C compiler)")
-    return module
-
-
 def _fields(result):
     """Every field of a MatchResult (arrays by value)."""
     values = []
