@@ -421,16 +421,14 @@ def pair_descriptors(
     if variant == "baseline":
         sketch_types = region_types(sketch_graph, nodes=sketch_nodes)
         metric_types = region_types(metric_graph, nodes=metric_nodes)
-        metric_positions = region_positions(metric_graph, nodes=metric_nodes) if position_weight else None
-        c_matrix = blend_positions(
-            (sketch_types[:, None] != metric_types[None, :]).astype(np.float64),
-            sketch_graph,
-            sketch_nodes,
-            metric_graph,
-            metric_nodes,
-            position_weight,
-        )
         types_c = (sketch_types[:, None] != metric_types[None, :]).astype(np.float64)
+        metric_positions = None
+        c_matrix = types_c.copy()  # the matchers' c, apart from the type comparison kept beside it
+        if position_weight:
+            metric_positions = region_positions(metric_graph, nodes=metric_nodes)
+            c_matrix = blend_position_arrays(
+                types_c, region_positions(sketch_graph, nodes=sketch_nodes), metric_positions, position_weight
+            )
         return PairDescriptors(
             sketch_nodes, metric_nodes, sketch_z, metric_z, [], [], [], None, None, None, None, c_matrix, notes,
             types_c, metric_positions,
