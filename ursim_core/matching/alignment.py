@@ -16,6 +16,11 @@ in 120: the two fail on different sketches.
 
 Everything here is (row, col); a 2 x 3 ``matrix`` maps a sketch pixel ``p`` to
 ``matrix[:, :2] @ p + matrix[:, 2]`` in the metric map.
+
+The search runs in C where the matcher's C module is built (:mod:`ursim_core.matching.kernels`,
+:file:`csrc/overlap.c`): the same points in the same order, with OpenCV's nearest-neighbour warp
+done as OpenCV 4 does it and only its counts made; the same overlaps and matrices, bit for bit (a
+test compares both). The Python search below stays the reference and the fallback.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ursim_core.matching.kernels import overlap_search_compiled
 from ursim_core.matching.orientation import transform_points
 
 __all__ = ["Alignment", "fit_alignment", "fit_alignments", "free_box_corners", "orientation_matrix"]
@@ -226,6 +232,24 @@ def _fit(sketch: _FreeSpace, metric: _FreeSpace, degrees: float, mirrored: bool)
     def matrix_of(params) -> np.ndarray:
         l00, l01, l10, l11, o0, o1 = linear_offset(params)
         return np.array([[l00, l01, o0], [l10, l11, o1]])
+
+    # The same search in C (matching.kernels), OpenCV's warp done as OpenCV does it.
+    numbers = {
+        "turn": (t00, t01, t10, t11),
+        "scale": (scale_rows, scale_cols),
+        "centre": (centre_rows, centre_cols),
+        "metric_centre": metric_centre,
+        "metric_extent": metric_extent,
+        "to_coarse": to_coarse,
+        "factor": metric.factor,
+    }
+    compiled = overlap_search_compiled(
+        sketch.shrunk, target, target_area, numbers,
+        first_steps=_FIRST_STEPS, smallest_step=_SMALLEST_STEP, max_rounds=_MAX_ROUNDS,
+    )  # fmt: skip
+    if compiled is not None:
+        best, params = compiled
+        return Alignment(float(best), matrix_of(list(params)), degrees, mirrored)
 
     # A step back after a move lands on a point already scored: look it up, do not warp again.
     seen: dict[tuple, float] = {}

@@ -5,7 +5,10 @@ The planar matcher's seed-and-expand loop runs in C (:file:`csrc/planar.c`), a p
 the C module cannot be built. :func:`sweep_compiled` runs it over every m of a sweep in one call
 (:file:`csrc/sweep.c`): seeds, relation and pair costs at each m as
 :func:`~ursim_core.matching.single.match_at` makes them. :func:`fit_axes_compiled` is the position
-refit's robust line fit (:file:`csrc/refit.c`, a port of :mod:`ursim_core.matching.refit`).
+refit's robust line fit (:file:`csrc/refit.c`, a port of :mod:`ursim_core.matching.refit`), and
+:func:`overlap_search_compiled` the orientation overlap's pattern search (:file:`csrc/overlap.c`, a
+port of :mod:`ursim_core.matching.alignment`'s, with OpenCV's nearest-neighbour warp done as OpenCV
+does it).
 
 :func:`match_compiled` takes the planar matcher's common case (no constraints, no alternatives
 kept, graphs whose alignments are sketch-sized) and gives the same pairs in the same order, the
@@ -45,6 +48,7 @@ __all__ = [
     "match_compiled",
     "sweep_compiled",
     "fit_axes_compiled",
+    "overlap_search_compiled",
     "forget",
 ]
 
@@ -227,3 +231,32 @@ def fit_axes_compiled(source, target, weights, *, rounds: int, cutoff: float):
     if found == 1:
         return NO_FIT
     return None if found == 2 else found
+
+
+def overlap_search_compiled(sketch, target, target_area: int, numbers: dict, *, first_steps, smallest_step, max_rounds):
+    """The pattern search of :func:`ursim_core.matching.alignment.fit_alignment` in C: ``(best
+    overlap, params)`` as the Python search finds them (a test compares both), or None without
+    the C module.
+
+    ``sketch`` and ``target`` are the shrunk uint8 free-space images; ``numbers`` holds ``turn``
+    (t00, t01, t10, t11), ``scale`` and ``centre`` (rows, cols), ``metric_centre`` and
+    ``metric_extent`` (rows, cols), ``to_coarse`` and ``factor``, as the Python search reads them.
+    """
+    module = kernel()
+    if module is None:
+        return None
+    return module.overlap_search(
+        np.ascontiguousarray(sketch, dtype=np.uint8),
+        np.ascontiguousarray(target, dtype=np.uint8),
+        int(target_area),
+        tuple(map(float, numbers["turn"])),
+        tuple(map(float, numbers["scale"])),
+        tuple(map(float, numbers["centre"])),
+        tuple(map(float, numbers["metric_centre"])),
+        tuple(map(float, numbers["metric_extent"])),
+        float(numbers["to_coarse"]),
+        float(numbers["factor"]),
+        tuple(map(float, first_steps)),
+        float(smallest_step),
+        int(max_rounds),
+    )

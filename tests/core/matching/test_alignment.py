@@ -98,3 +98,46 @@ def test_a_turned_generated_sketch_gets_its_orientation_back(seed):
         if power:
             # The orientation that undoes "mirror, then turn by 270": itself (up to the walls' angle).
             assert mirrored and abs((degrees - 270.0 + 180.0) % 360.0 - 180.0) < 10.0, prepared.orientation
+
+
+def test_the_search_in_c_finds_what_the_python_search_finds(c_kernel, monkeypatch):
+    """Overlap and matrix equal, bit for bit, with OpenCV's warp done in C as OpenCV does it: maps
+    turned by any angle, mirrored, rescaled, cropped (a warp reaching past the sketch's edges),
+    in all eight orientation candidates."""
+    import cv2
+
+    from ursim_core.matching import kernels
+
+    cases = []
+    for seed in range(4):
+        plan, sketch = make_pair(seed=seed)
+        for k, (degrees, mirrored) in enumerate([(0.0, False), (37.0, True), (151.5, False), (290.0, True)]):
+            moved = augment.transform_image(sketch.free, augment.Orientation(degrees, mirrored=mirrored))
+            if k % 2:
+                moved = moved[: moved.shape[0] * 2 // 3]  # cropped: part of the plan
+            scale = (0.6, 1.0, 1.7, 1.2)[(seed + k) % 4]
+            size = (max(1, round(moved.shape[1] * scale)), max(1, round(moved.shape[0] * scale)))
+            moved = cv2.resize(moved.astype(np.uint8), size, interpolation=cv2.INTER_NEAREST)
+            candidates = [((degrees + 90.0 * q) % 360.0, flag) for flag in (False, True) for q in range(4)]
+            cases.append((moved, plan.free, candidates))
+    compiled = [fit_alignments(*case) for case in cases]
+    monkeypatch.setattr(kernels, "kernel", lambda: None)
+    reference = [fit_alignments(*case) for case in cases]
+    fits = [(a, b) for many_a, many_b in zip(compiled, reference) for a, b in zip(many_a, many_b)]
+    assert len(fits) == 16 * 8
+    for a, b in fits:
+        assert a.overlap == b.overlap and np.array_equal(a.matrix, b.matrix)
+    assert len({round(a.overlap, 6) for a, _ in fits}) > 50  # many different fits, not one
+
+
+def test_the_search_in_c_refuses_bad_arguments(c_kernel):
+    image = np.ones((10, 10), np.uint8)
+    numbers = (1.0, 0.0, 0.0, 1.0), (1.0, 1.0), (5.0, 5.0), (5.0, 5.0), (10.0, 10.0)
+    with pytest.raises(TypeError, match="13 arguments"):
+        c_kernel.overlap_search(image, image, 100)
+    with pytest.raises(TypeError, match="tuples of the documented sizes"):
+        c_kernel.overlap_search(image, image, 100, (1.0,), *numbers[1:], 1.0, 1.0, (0.1,) * 5, 0.02, 60)
+    with pytest.raises(ValueError, match="empty image"):
+        c_kernel.overlap_search(np.ones((0, 10), np.uint8), image, 100, *numbers, 1.0, 1.0, (0.1,) * 5, 0.02, 60)
+    with pytest.raises(TypeError, match="sketch"):
+        c_kernel.overlap_search(image.astype(np.float32), image, 100, *numbers, 1.0, 1.0, (0.1,) * 5, 0.02, 60)

@@ -67,5 +67,7 @@ KERNEL(planar_match);
 KERNEL(planar_sweep);
 /* refit.c */
 KERNEL(fit_axes);
+/* overlap.c */
+KERNEL(overlap_search);
 
 #endif

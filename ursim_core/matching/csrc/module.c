@@ -8,13 +8,15 @@ static PyMethodDef methods[] = {
     ENTRY(planar_match),
     ENTRY(planar_sweep),
     ENTRY(fit_axes),
+    ENTRY(overlap_search),
     {NULL, NULL, 0, NULL},
 };
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_matching_kernels",
     "The matcher's loops in C (ursim_core/matching/csrc): the planar matcher's seed-and-expand loop, "
-    "a port of planar.py, at one m or over a sweep of m, and the refit's fit of a scale and shift per axis.",
+    "a port of planar.py, at one m or over a sweep of m; the refit's fit of a scale and shift per axis; "
+    "the orientation overlap's search.",
     -1, methods,
 };
 
