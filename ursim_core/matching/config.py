@@ -221,8 +221,8 @@ class MatchConfig:
         runs), for 14 of the 864 runs at free angles changed (in sample 0.7702 / 0.7717
         -> 0.7686 / 0.7689: 07 0.49 -> 0.46, 12 0.47 -> 0.47, 04 0.84 -> 0.84) and generated
         pairs seeds 0-63 unchanged, 64-95 0.916 / 0.914 -> 0.911 / 0.909 (``ursim bench
-        invariance``). Round 40, with the sweeps and the overlap search in C: 42.5-44.1 -> 34.0-34.5 ms. The faster choice,
-        not the default.
+        invariance``). Round 40, with the sweeps and the overlap search in C: 42.5-44.1 -> 34.0-34.5
+        ms. The faster choice, not the default.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
