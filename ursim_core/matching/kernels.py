@@ -120,8 +120,9 @@ def forget() -> None:
 
 
 def _taken(first, second):
-    """``(module, first's orders, second's orders)`` when the C loop takes these planar graphs
-    (each orders as ``(offsets, flat)``), else None: no module, or graphs too large for it."""
+    """``(module, graphs)`` when the C loop takes these planar graphs, ``graphs`` being the loop's
+    first arguments (both graphs' offsets and flat orders, both edge counts); else None: no
+    module, or graphs too large for it."""
     if first.n_vertices * second.n_vertices > LARGEST_CELLS:
         return None
     module = kernel()
@@ -131,7 +132,7 @@ def _taken(first, second):
     second_offsets, second_orders, longest_second = second.flat_orders
     if (longest_first + 1) * (longest_second + 1) > LARGEST_TABLE:
         return None
-    return module, (first_offsets, first_orders), (second_offsets, second_orders)
+    return module, (first_offsets, first_orders, second_offsets, second_orders, len(first.edges), len(second.edges))
 
 
 def match_compiled(
@@ -142,17 +143,12 @@ def match_compiled(
     taken = _taken(first, second)
     if taken is None:
         return None
-    module, (first_offsets, first_orders), (second_offsets, second_orders) = taken
+    module, graphs = taken
     same = np.ascontiguousarray(same, dtype=np.bool_)
     weighted = pair_costs is not None and pair_cost_weight != 0
     costs = np.ascontiguousarray(pair_costs, dtype=np.float64) if weighted else None
     return module.planar_match(
-        first_offsets,
-        first_orders,
-        second_offsets,
-        second_orders,
-        len(first.edges),
-        len(second.edges),
+        *graphs,
         same,
         seeds,
         costs,
@@ -183,17 +179,12 @@ def sweep_compiled(
     taken = _taken(first, second) if rotation_search in ("min", "first") else None
     if taken is None:
         return None
-    module, (first_offsets, first_orders), (second_offsets, second_orders) = taken
+    module, graphs = taken
     c_matrix = np.ascontiguousarray(c_matrix, dtype=np.float64)
     if np.isnan(c_matrix).any():
         return None
     return module.planar_sweep(
-        first_offsets,
-        first_orders,
-        second_offsets,
-        second_orders,
-        len(first.edges),
-        len(second.edges),
+        *graphs,
         c_matrix,
         np.ascontiguousarray(order, dtype=np.int64),
         np.ascontiguousarray(values, dtype=np.float64),
