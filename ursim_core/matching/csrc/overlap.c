@@ -61,35 +61,42 @@ static void linear_offset(const Search *s, const double *params, double *out)
     out[5] = s->metric_centre[1] + params[3] * s->metric_extent[1] - (l10 * s->centre_rows + l11 * s->centre_cols);
 }
 
+/* OpenCV's source coordinate: (offset + delta) >> AB_BITS in int arithmetic, which wraps (as
+ * OpenCV's does) instead of overflowing, for the absurd matrices of a degenerate fit. */
+static inline int32_t source_coordinate(int32_t offset, int32_t delta)
+{
+    return (int32_t)((uint32_t)offset + (uint32_t)delta) >> AB_BITS;
+}
+
 /* The first and one past the last x in [0, cols) where lo <= value(x) < hi, for a value that is
  * monotone in x (non-decreasing when ``rising``); *first >= *stop when there is none. */
 static void monotone_interval(const int32_t *base, int32_t offset, int32_t cols, int32_t lo, int32_t hi, int rising,
                               int32_t *first, int32_t *stop)
 {
-    /* value(x) = (offset + base[x]) >> AB_BITS */
+    /* value(x) = source_coordinate(offset, base[x]) */
     int32_t low = 0, high = cols;
     if (rising) {
         while (low < high) { /* first x with value >= lo */
             int32_t mid = low + (high - low) / 2;
-            if (((offset + base[mid]) >> AB_BITS) >= lo) high = mid; else low = mid + 1;
+            if (source_coordinate(offset, base[mid]) >= lo) high = mid; else low = mid + 1;
         }
         *first = low;
         low = *first, high = cols;
         while (low < high) { /* first x with value >= hi */
             int32_t mid = low + (high - low) / 2;
-            if (((offset + base[mid]) >> AB_BITS) >= hi) high = mid; else low = mid + 1;
+            if (source_coordinate(offset, base[mid]) >= hi) high = mid; else low = mid + 1;
         }
         *stop = low;
     } else {
         while (low < high) { /* first x with value < hi */
             int32_t mid = low + (high - low) / 2;
-            if (((offset + base[mid]) >> AB_BITS) < hi) high = mid; else low = mid + 1;
+            if (source_coordinate(offset, base[mid]) < hi) high = mid; else low = mid + 1;
         }
         *first = low;
         low = *first, high = cols;
         while (low < high) { /* first x with value < lo */
             int32_t mid = low + (high - low) / 2;
-            if (((offset + base[mid]) >> AB_BITS) < lo) high = mid; else low = mid + 1;
+            if (source_coordinate(offset, base[mid]) < lo) high = mid; else low = mid + 1;
         }
         *stop = low;
     }
@@ -134,7 +141,7 @@ static double overlap_of(const Search *s, const double *params)
         int32_t first = first_x > first_y ? first_x : first_y, stop = stop_x < stop_y ? stop_x : stop_y;
         const uint8_t *target_row = s->target + (int64_t)y * cols;
         for (int32_t x = first; x < stop; x++) {
-            int32_t X = (X0 + s->adelta[x]) >> AB_BITS, Y = (Y0 + s->bdelta[x]) >> AB_BITS;
+            int32_t X = source_coordinate(X0, s->adelta[x]), Y = source_coordinate(Y0, s->bdelta[x]);
             uint8_t value = s->sketch[(int64_t)Y * s->sketch_cols + X];
             warped += value != 0;
             inter += (value & target_row[x]) != 0;
