@@ -18,8 +18,7 @@ same cost (the pair costs summed in pair order, as Python 3.11's ``sum``) and th
 The module is compiled on the installed machine (:class:`ursim_core.native.NativeModule`; ``make``
 builds it with the segmentation kernels, else the first match does, in about a second). With no C
 compiler, or ``URSIM_KERNELS=jit`` (which also keeps the MAORIS kernels in numba), the matcher
-runs in Python, about two and a half times as slow on a turned KTH sketch (115 ms against 47 ms,
-round 40).
+runs in Python, about three times as slow on a turned KTH sketch (127 ms against 44 ms, round 40).
 
 Examples
 --------
@@ -106,7 +105,7 @@ def _built_and_loaded():
     except (RuntimeError, ImportError, OSError) as error:
         warnings.warn(
             f"could not build the matcher's C kernels ({type(error).__name__}: {error}); "
-            "matching runs in Python, about two and a half times as slow",
+            "matching runs in Python, about three times as slow",
             RuntimeWarning,
             stacklevel=3,
         )
