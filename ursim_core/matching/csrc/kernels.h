@@ -9,6 +9,16 @@
 
 #define KERNEL(name) PyObject *kernel_##name(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 
+/* 0, or -1 with a TypeError naming the kernel when it was given another number of arguments. */
+static inline int check_nargs(const char *name, Py_ssize_t nargs, Py_ssize_t expected)
+{
+    if (nargs != expected) {
+        PyErr_Format(PyExc_TypeError, "%s takes %zd arguments (%zd given)", name, expected, nargs);
+        return -1;
+    }
+    return 0;
+}
+
 /* A C-contiguous buffer of a given item size and format kind ('i' signed int, 'f' float, 'b' bool/uint8). */
 static inline int get_buffer(PyObject *obj, Py_ssize_t itemsize, char kind, int ndim, const char *what, Py_buffer *view)
 {

@@ -157,8 +157,7 @@ static double overlap_of(const Search *s, const double *params)
  * ``sketch`` and ``target`` are C-contiguous uint8 images; the numbers are tuples of floats. */
 KERNEL(overlap_search)
 {
-    if (nargs != 13) {
-        PyErr_Format(PyExc_TypeError, "overlap_search takes 13 arguments (%zd given)", nargs);
+    if (check_nargs("overlap_search", nargs, 13) < 0) {
         return NULL;
     }
     Py_buffer views[2];

@@ -357,8 +357,7 @@ void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const doubl
  * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). */
 KERNEL(planar_match)
 {
-    if (nargs != 12) {
-        PyErr_Format(PyExc_TypeError, "planar_match takes 12 arguments (%zd given)", nargs);
+    if (check_nargs("planar_match", nargs, 12) < 0) {
         return NULL;
     }
     Planar p;

@@ -85,8 +85,7 @@ static int fit_axis(const double *x, const double *y, Py_ssize_t stride, const d
  * doubles (row, col), ``weights`` n doubles. */
 KERNEL(fit_axes)
 {
-    if (nargs != 5) {
-        PyErr_Format(PyExc_TypeError, "fit_axes takes 5 arguments (%zd given)", nargs);
+    if (check_nargs("fit_axes", nargs, 5) < 0) {
         return NULL;
     }
     Py_buffer views[3];

@@ -28,8 +28,7 @@ static int by_position(const void *a, const void *b)
  * ('substitutions'). At an m with no seed the entry is ([], None, 0, 0, 0, 0). */
 KERNEL(planar_sweep)
 {
-    if (nargs != 15) {
-        PyErr_Format(PyExc_TypeError, "planar_sweep takes 15 arguments (%zd given)", nargs);
+    if (check_nargs("planar_sweep", nargs, 15) < 0) {
         return NULL;
     }
     Planar p;
