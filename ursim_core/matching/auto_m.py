@@ -42,13 +42,11 @@ F1 between .61 and .65: 18 sketches are too few to tune more than a couple of nu
 
 from __future__ import annotations
 
-import copy
-from dataclasses import replace
-
 import numpy as np
 
 from ursim_core.matching import sweep_helper
 from ursim_core.matching.config import AUTO_RULE_NAMES
+from ursim_core.matching.results import replaced
 
 __all__ = ["AUTO_RULES", "choose_m", "chosen_of", "matched_sweep", "sweep"]
 
@@ -111,11 +109,11 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
     for index, m in enumerate(grid, start=1):
         m = float(m)
         if not fresh[index - 1]:
-            results.append(_at_m(results[-1], m))
+            results.append(replaced(results[-1], m=m))
         else:
             earlier = known.get(m)
             if earlier is not None:
-                result = replace(earlier, config=prepared.config)
+                result = replaced(earlier, config=prepared.config)
             else:
                 result = found.get(m) or match_at(prepared, m, seed_selector=selector)
             matched[m] = result
@@ -123,14 +121,6 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
         if progress is not None:
             progress(index / len(grid), f"matching at m = {m:.3f}")
     return results, matched
-
-
-def _at_m(result, m: float):
-    """``dataclasses.replace(result, m=m)`` for a MatchResult (no field is computed at init), by a
-    shallow copy: the sweeps of a turned sketch make hundreds of these."""
-    moved = copy.copy(result)
-    object.__setattr__(moved, "m", m)
-    return moved
 
 
 def _sweep_shared(prepared, grid, selector, helper, progress) -> list:
@@ -161,7 +151,7 @@ def _sweep_shared(prepared, grid, selector, helper, progress) -> list:
         if index in computed:
             results.append(match_at(prepared, float(m), seed_selector=selector, outcome=by_position.get(index)))
         else:
-            results.append(replace(results[-1], m=float(m)))
+            results.append(replaced(results[-1], m=float(m)))
     if progress is not None:
         progress(1.0, f"matching at m = {float(grid[-1]):.3f}")
     return results
@@ -233,4 +223,4 @@ def chosen_of(prepared, results):
     scores = AUTO_RULES[prepared.config.auto_rule](prepared, results)
     lowest = min(scores)
     best = next(k for k, value in enumerate(scores) if value <= lowest + 1e-12)
-    return replace(results[best], m_scan={float(r.m): float(s) for r, s in zip(results, scores)})
+    return replaced(results[best], m_scan={float(r.m): float(s) for r, s in zip(results, scores)})

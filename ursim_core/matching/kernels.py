@@ -8,7 +8,9 @@ the C module cannot be built. :func:`sweep_compiled` runs it over every m of a s
 refit's robust line fit (:file:`csrc/refit.c`, a port of :mod:`ursim_core.matching.refit`), and
 :func:`overlap_search_compiled` the orientation overlap's pattern search (:file:`csrc/overlap.c`, a
 port of :mod:`ursim_core.matching.alignment`'s, with OpenCV's nearest-neighbour warp done as OpenCV
-does it).
+does it), and :func:`correspondences_compiled` the vote's region correspondences
+(:file:`csrc/correspondences.c`, a port of
+:func:`~ursim_core.matching.resampling.region_correspondences`).
 
 :func:`match_compiled` takes the planar matcher's common case (no constraints, no alternatives
 kept, graphs whose alignments are sketch-sized) and gives the same pairs in the same order, the
@@ -48,6 +50,7 @@ __all__ = [
     "sweep_compiled",
     "fit_axes_compiled",
     "overlap_search_compiled",
+    "correspondences_compiled",
     "forget",
 ]
 
@@ -249,4 +252,25 @@ def overlap_search_compiled(sketch, target, target_area: int, numbers: dict, *, 
         tuple(map(float, first_steps)),
         float(smallest_step),
         int(max_rounds),
+    )
+
+
+#: Histograms of more (their region, our region) cells than this are counted by NumPy (whose
+#: bincount needs as many): the C kernel would hold them all at once, one per segmentation.
+LARGEST_HISTOGRAM = 1 << 22
+
+
+def correspondences_compiled(labels, others):
+    """:func:`~ursim_core.matching.resampling.region_correspondences` in one pass over the pixels
+    (:file:`csrc/correspondences.c`): the same dicts, or None without the C module, for arrays
+    that are not int32 of one size, or for histograms over :data:`LARGEST_HISTOGRAM` cells."""
+    module = kernel()
+    if module is None:
+        return None
+    labels = np.asarray(labels)
+    others = [np.asarray(other) for other in others]
+    if labels.dtype != np.int32 or any(other.dtype != np.int32 or other.shape != labels.shape for other in others):
+        return None
+    return module.region_correspondences(
+        np.ascontiguousarray(labels), [np.ascontiguousarray(other) for other in others], LARGEST_HISTOGRAM
     )

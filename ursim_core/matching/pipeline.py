@@ -47,7 +47,7 @@ from ursim_core.matching.oriented import (
 )
 from ursim_core.matching.refit import refit_from, refit_positions, signature_start
 from ursim_core.matching.resampling import voted_answer, with_resampled
-from ursim_core.matching.results import MatchResult, Prepared
+from ursim_core.matching.results import MatchResult, Prepared, replaced
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
 
 __all__ = [
@@ -240,7 +240,7 @@ def _prepare_one(
     return dataclasses.replace(
         prepared,
         orientation_scan=scan,
-        chosen=dataclasses.replace(result, orientation_scan=scan),
+        chosen=replaced(result, orientation_scan=scan),
         orientation_overlaps={candidates[index]: value for index, value in overlaps.items()},
     )
 
@@ -287,7 +287,7 @@ def _match_sparsely(prepared: Prepared) -> MatchResult:
     config = prepared.config
     if config.m == "auto" and len(config.m_grid) > 4 * _COARSE_STEP:
         sparse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: 2 * _COARSE_STEP]))
-        return dataclasses.replace(match_prepared(dataclasses.replace(prepared, config=sparse)), config=config)
+        return replaced(match_prepared(dataclasses.replace(prepared, config=sparse)), config=config)
     return _match_coarsely(prepared)
 
 
@@ -300,7 +300,7 @@ def _match_coarsely(prepared: Prepared) -> MatchResult:
     if config.m == "auto" and len(config.m_grid) > 2 * _COARSE_STEP:
         coarse = config.replace(m_grid=tuple(config.m_grid[_COARSE_STEP // 2 :: _COARSE_STEP]))
         answer = match_prepared(dataclasses.replace(prepared, config=coarse))
-        return dataclasses.replace(answer, config=config)  # the result records the caller's options
+        return replaced(answer, config=config)  # the result records the caller's options
     return match_prepared(prepared)
 
 

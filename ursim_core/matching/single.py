@@ -14,7 +14,7 @@ from ursim_core.matching.baselines import hungarian_match, vf2_match
 from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.kernels import sweep_compiled
 from ursim_core.matching.planar import hypothesis_cost, planar_match
-from ursim_core.matching.results import MatchResult, Prepared
+from ursim_core.matching.results import MatchResult, Prepared, new_result
 
 __all__ = [
     "seed_pairs",
@@ -300,28 +300,26 @@ def _notes_of(prepared: Prepared) -> list[str]:
 
 def _result(prepared: Prepared, m, index_pairs, cost, normalised, seeds_count, hypotheses, reasons) -> MatchResult:
     """The :class:`MatchResult` of index pairs found at m, in region ids, with the pair's anchors,
-    unique regions and signatures."""
-    descriptors = prepared.descriptors
-    signatures = None
-    if descriptors is not None and descriptors.sketch_signatures is not None:
-        signatures = (descriptors.sketch_signatures, descriptors.metric_signatures)
+    unique regions and signatures (``prepared.answer_fields``, made once per preparation)."""
     sketch_nodes, metric_nodes = prepared.sketch_planar.nodes, prepared.metric_planar.nodes
-    return MatchResult(
-        pairs=[(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs],
-        anchors=list(descriptors.anchors) if descriptors else [],
-        unique_sketch=list(descriptors.unique_sketch) if descriptors else [],
-        unique_metric=list(descriptors.unique_metric) if descriptors else [],
-        m=m,
-        cost=cost,
-        normalised_cost=normalised,
-        signatures=signatures,
-        c_matrix=prepared.c_matrix,
-        seeds_count=seeds_count,
-        hypotheses=hypotheses,
-        reason="; ".join(dict.fromkeys(reasons)),
-        config=prepared.config,
-        orientation=prepared.orientation,
-        orientation_scan=prepared.orientation_scan,
+    shared = prepared.answer_fields
+    # new_result skips the frozen dataclass's __init__: a turned KTH sketch makes about 600 of
+    # these (round 41). Each result gets lists and an m_scan of its own, as the constructor gave.
+    return new_result(
+        {
+            **shared,
+            "pairs": [(sketch_nodes[i], metric_nodes[j]) for i, j in index_pairs],
+            "anchors": list(shared["anchors"]),
+            "unique_sketch": list(shared["unique_sketch"]),
+            "unique_metric": list(shared["unique_metric"]),
+            "m": m,
+            "cost": cost,
+            "normalised_cost": normalised,
+            "seeds_count": seeds_count,
+            "hypotheses": hypotheses,
+            "reason": "; ".join(dict.fromkeys(reasons)),
+            "m_scan": {},
+        }
     )
 
 

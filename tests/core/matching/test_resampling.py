@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ursim_core.errors import ParameterError
-from ursim_core.matching import MatchConfig, MatchConstraints, match, match_prepared, prepare
+from ursim_core.matching import MatchConfig, MatchConstraints, kernels, match, match_prepared, prepare
 from ursim_core.matching.resampling import (
     lowest_scored_reading,
     mean_rank_values,
@@ -69,6 +69,33 @@ def test_the_correspondence_is_the_largest_overlap_pixel_by_pixel():
         assert region_correspondences(labels, others) == expected
         assert region_correspondence(labels, others[0]) == expected[0]
     assert region_correspondences(BASE, []) == []
+
+
+def test_the_c_kernel_counts_as_the_pixels_do(c_kernel, monkeypatch):
+    # The int32 label images of the vote go to csrc/correspondences.c: the same dicts (in the
+    # same key order) as counting by hand, on the random images above and long runs of one pair.
+    rng = np.random.default_rng(41)
+    for _ in range(300):
+        shape = tuple(rng.integers(0, 40, 2))
+        labels = np.repeat(rng.integers(-1, rng.integers(1, 9), (shape[0], max(1, shape[1] // 4))), 4, axis=1)
+        labels = labels[:, : shape[1]].astype(np.int32)
+        others = []
+        for _ in range(rng.integers(0, 7)):
+            other = rng.integers(-1, rng.integers(1, 9), labels.shape)
+            if rng.random() < 0.7:
+                other = np.where(rng.random(labels.shape) < 0.9, labels, other)
+            others.append(other.astype(np.int32))
+        expected = [_largest_overlaps_by_hand(labels, other) for other in others]
+        compiled = kernels.correspondences_compiled(labels, others)
+        assert compiled == expected
+        assert [sorted(found) for found in compiled] == [list(found) for found in compiled]
+    # What the kernel does not take, NumPy counts.
+    assert kernels.correspondences_compiled(BASE, [BASE]) is None  # int64
+    base = BASE.astype(np.int32)
+    assert kernels.correspondences_compiled(base, [base[:, :3].copy()]) is None
+    monkeypatch.setattr(kernels, "LARGEST_HISTOGRAM", 8)
+    assert kernels.correspondences_compiled(base, [base * 3]) is None
+    assert region_correspondences(base, [base * 3]) == [{3: 1, 6: 2, 9: 3}]
 
 
 def test_a_pair_needs_the_quorum():

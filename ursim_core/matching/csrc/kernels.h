@@ -79,5 +79,7 @@ KERNEL(planar_sweep);
 KERNEL(fit_axes);
 /* overlap.c */
 KERNEL(overlap_search);
+/* correspondences.c */
+KERNEL(region_correspondences);
 
 #endif

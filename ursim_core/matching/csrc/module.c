@@ -9,6 +9,7 @@ static PyMethodDef methods[] = {
     ENTRY(planar_sweep),
     ENTRY(fit_axes),
     ENTRY(overlap_search),
+    ENTRY(region_correspondences),
     {NULL, NULL, 0, NULL},
 };
 
@@ -16,7 +17,7 @@ static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_matching_kernels",
     "The matcher's loops in C (ursim_core/matching/csrc): the planar matcher's seed-and-expand loop, "
     "a port of planar.py, at one m or over a sweep of m; the refit's fit of a scale and shift per axis; "
-    "the orientation overlap's search.",
+    "the orientation overlap's search; the regions one segmentation's regions overlap most in others.",
     -1, methods,
 };
 
