@@ -97,9 +97,20 @@ def wall_angle(free: np.ndarray) -> float:
     if mask.size > _ANGLE_MAX_PIXELS:
         step = math.ceil(math.sqrt(mask.size / _ANGLE_MAX_PIXELS))
         mask = mask[::step, ::step]
+    # Traced in the box around the free space (a pixel of margin kept where the image has one,
+    # so that no free pixel comes to an edge it was not on): the same contours in the same
+    # order, shifted, and the vote reads only differences of their points, so the same angle
+    # bit for bit (a test), from a fraction of a turned sketch's padded image (round 41: 1.4
+    # against 1.7-2.4 ms per KTH label image).
+    import cv2
+
+    image = np.ascontiguousarray(mask, dtype=np.uint8)
+    left, top, width, height = cv2.boundingRect(image)
+    first_row, first_col = max(top - 1, 0), max(left - 1, 0)
+    image = image[first_row : top + height + 1, first_col : left + width + 1]
     # Remembered by content: a turned map's six segmentations each ask for the angle of the
     # same free space (and turned_back before them), and the vote below traces it eight times.
-    return _voted_angle(np.ascontiguousarray(mask, dtype=np.uint8).tobytes(), mask.shape)
+    return _voted_angle(image.tobytes(), image.shape)
 
 
 @functools.lru_cache(maxsize=8)

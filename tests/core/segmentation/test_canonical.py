@@ -19,6 +19,7 @@ from ursim_core.segmentation import (
 from ursim_core.segmentation.canonical import (
     RESAMPLING_OFFSETS,
     _turned,
+    _voted_angle,
     canonical_labels,
     canonical_pose,
     dihedral,
@@ -50,6 +51,27 @@ def test_wall_angle_is_exactly_the_same_for_every_quarter_turn_and_negated_for_a
     for quarter_turns in range(4):
         for mirrored in (False, True):
             assert wall_angle(dihedral(free, quarter_turns, mirrored)) == (-angle if mirrored else angle)
+
+
+def _angle_of_the_whole_image(free) -> float:
+    image = np.ascontiguousarray(np.asarray(free) != 0, dtype=np.uint8)
+    _voted_angle.cache_clear()
+    return _voted_angle(image.tobytes(), image.shape)
+
+
+def test_wall_angle_traced_in_the_free_space_box_is_the_whole_image_s():
+    # wall_angle traces the box around the free space (a pixel of margin where there is one):
+    # the same angle, bit for bit, as tracing the whole image, also for free space on the
+    # image's edges (which OpenCV reads as walls) and for the padded image of a turned map.
+    plan, sketch = make_pair(seed=3)
+    turned, _ = _turned(sketch.free, 33.0)
+    maps = [plan.free, sketch.free, turned, sketch.free[:250, 30:], np.pad(plan.free, ((7, 0), (0, 40)))]
+    rng = np.random.default_rng(41)
+    maps += [rng.random(tuple(rng.integers(1, 40, 2))) < rng.random() for _ in range(200)]
+    for free in maps:
+        expected = _angle_of_the_whole_image(free)
+        _voted_angle.cache_clear()
+        assert wall_angle(free) == expected
 
 
 def test_wall_angle_of_nothing_is_zero():
