@@ -130,8 +130,9 @@ def region_correspondences(labels: np.ndarray, others: Sequence[np.ndarray]) -> 
     # same ones).
     compiled = correspondences_compiled(labels, others)
     if compiled is not None:
-        # One pass over the pixels counting every histogram (round 41: 5.5 -> 0.x ms for the six
-        # segmentations of a turned KTH sketch); the same dicts, a test compares them.
+        # The histograms counted by runs over the stretches of region pixels, without NumPy's
+        # temporaries (round 41: 7.8 -> 2.4 ms a turned KTH pair); the same dicts, a test
+        # compares them.
         return compiled
     labels = np.asarray(labels).ravel()
     inside = np.flatnonzero(labels > 0)

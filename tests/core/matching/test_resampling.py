@@ -93,6 +93,8 @@ def test_the_c_kernel_counts_as_the_pixels_do(c_kernel, monkeypatch):
     assert kernels.correspondences_compiled(BASE, [BASE]) is None  # int64
     base = BASE.astype(np.int32)
     assert kernels.correspondences_compiled(base, [base[:, :3].copy()]) is None
+    huge = np.array([[1, np.iinfo(np.int32).max]], dtype=np.int32)
+    assert kernels.correspondences_compiled(huge, [huge]) is None  # ids past the histogram's bound
     monkeypatch.setattr(kernels, "LARGEST_HISTOGRAM", 8)
     assert kernels.correspondences_compiled(base, [base * 3]) is None
     assert region_correspondences(base, [base * 3]) == [{3: 1, 6: 2, 9: 3}]

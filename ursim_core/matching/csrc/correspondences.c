@@ -2,9 +2,10 @@
  * ``_matching_kernels``, see module.c): a port of resampling.region_correspondences.
  *
  * NumPy found the pixels inside a region once, then gathered them from each other segmentation
- * and made a joint histogram by a bincount: about 5.5 ms for the six segmentations of a turned
- * KTH sketch, most of it in the gathers and temporaries. Here one pass over the pixels counts
- * every histogram at once. */
+ * and made a joint histogram by a bincount, with temporaries the size of those pixels. Here one
+ * pass over the labels finds the stretches of pixels inside a region, and each other
+ * segmentation's histogram is counted over them by runs (round 41: 7.8 -> 2.4 ms for the
+ * segmentations of a turned KTH sketch). */
 #include "kernels.h"
 
 #include <stdlib.h>
@@ -72,7 +73,7 @@ KERNEL(region_correspondences)
     }
     /* The stretches of consecutive pixels inside a region of ours (about a fifth of a turned
      * sketch's image), found once for every other segmentation. */
-    int32_t stride = 1; /* our highest region + 1 */
+    int64_t stride = 1; /* our highest region + 1 (int64: a region id may be INT32_MAX) */
     Py_ssize_t n_spans = 0, room = 64;
     spans = malloc((size_t)room * 2 * sizeof(Py_ssize_t));
     if (spans == NULL) {
@@ -86,7 +87,7 @@ KERNEL(region_correspondences)
         }
         Py_ssize_t first = i;
         while (i < n && ours[i] > 0) {
-            stride = ours[i] >= stride ? ours[i] + 1 : stride;
+            stride = ours[i] >= stride ? (int64_t)ours[i] + 1 : stride;
             i += 1;
         }
         if (n_spans == room) {
@@ -110,7 +111,7 @@ KERNEL(region_correspondences)
             }
         }
         highest[k] = top;
-        if ((long long)(top + 1) * stride > largest) {
+        if (((int64_t)top + 1) * stride > largest) {
             Py_INCREF(Py_None);
             found = Py_None;
             goto done;
@@ -149,9 +150,9 @@ KERNEL(region_correspondences)
         PyList_SET_ITEM(found, k, carried);
         for (int32_t their = 1; their <= highest[k]; their++) {
             const int64_t *row = counts[k] + (int64_t)their * stride;
-            int32_t best = -1;
+            int64_t best = -1;
             int64_t most = 0;
-            for (int32_t our = 0; our < stride; our++) {
+            for (int64_t our = 0; our < stride; our++) {
                 if (row[our] > most) {
                     most = row[our];
                     best = our;
@@ -160,7 +161,7 @@ KERNEL(region_correspondences)
             if (best < 0) {
                 continue;
             }
-            PyObject *key = PyLong_FromLong(their), *value = PyLong_FromLong(best);
+            PyObject *key = PyLong_FromLong(their), *value = PyLong_FromLongLong(best);
             int failed = key == NULL || value == NULL || PyDict_SetItem(carried, key, value) < 0;
             Py_XDECREF(key);
             Py_XDECREF(value);
