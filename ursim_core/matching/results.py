@@ -15,7 +15,7 @@ from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, 
 from ursim_core.matching.descriptors import PairDescriptors
 from ursim_core.matching.planar import PlanarGraph
 
-__all__ = ["Prepared", "MatchResult", "replaced", "match_record", "next_reading_record"]
+__all__ = ["Prepared", "MatchResult", "replaced", "new_result", "match_record", "next_reading_record"]
 
 
 @dataclass(frozen=True, eq=False)
