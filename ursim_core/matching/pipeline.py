@@ -324,7 +324,8 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
     in the mirror readings of the orientation candidates) instead of the search; the answer then
     holds the fixed pairs and avoids the forbidden ones.
     """
-    from ursim_core.matching.overlay import constrained_pairs, fit_overlay, fit_to_pairs, overlay_pairs
+    from ursim_core.matching.alignment import Alignment
+    from ursim_core.matching.overlay import constrained_pairs, fit_to_pairs, overlay_pairs, ranked_overlays
 
     sketch_labels = getattr(sketch_seg, "labels", None)
     metric_labels = getattr(metric_seg, "labels", None)
@@ -333,13 +334,18 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
     candidates = orientations_to_try(config, sketch_seg, metric_seg)
     sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
     fit = None
+    scan: dict = {}
     if constraints is not None and len(constraints.fixed) >= 2:
         flags = [mirrored for _, mirrored in candidates]
         fit = fit_to_pairs(
             sketch_labels, metric_labels, constraints.fixed, sketch_graph, metric_graph, mirror_flags=flags
         )
     if fit is None:
-        fit = fit_overlay(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
+        ranked = ranked_overlays(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
+        fit = ranked[0][1] if ranked else Alignment.unfitted(*candidates[0])
+        # Rank values as the planar matcher's (lower is better): 1 - the correlation. The answer's
+        # runner-up reading (orientation.next_reading) then tells a person how close the call was.
+        scan = {(placed.degrees, placed.mirrored): 1.0 - score for score, placed in ranked}
     orientation = (fit.degrees, fit.mirrored)
     outlines = sketch_outlines(sketch_seg, sketch_graph, [orientation])
     base = prepare_oriented(sketch_graph, metric_graph, config, orientation, outlines)
@@ -365,8 +371,9 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
         reason="; ".join(dict.fromkeys(reasons)),
         config=config,
         orientation=orientation,
+        orientation_scan=scan,
     )
-    return dataclasses.replace(base, chosen=result, constraints=constraints)
+    return dataclasses.replace(base, chosen=result, constraints=constraints, orientation_scan=scan)
 
 
 def _share_of(progress, index: int, count: int):

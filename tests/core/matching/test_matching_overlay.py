@@ -9,7 +9,9 @@ import pytest
 from ursim_core.errors import ParameterError
 from ursim_core.evaluation import augment
 from ursim_core.matching import MatchConfig, match, match_prepared, prepare
-from ursim_core.matching.overlay import fit_overlay, overlay_pairs
+from ursim_core.matching.constraints import MatchConstraints
+from ursim_core.matching.overlay import fit_overlay, overlay_pairs, ranked_overlays
+from ursim_core.matching.results import next_reading_record
 from ursim_core.segmentation import segment, segment_canonical
 from ursim_core.synth import make_pair
 
@@ -102,6 +104,47 @@ def test_the_shift_of_a_crop_is_found_at_full_resolution(plan):
     np.testing.assert_allclose(fit.matrix[:, :2], np.eye(2), atol=0.06)
     # A coarse search: within a few coarse pixels (about 3 % of the map's side).
     assert np.abs(fit.matrix[:, 2] - [40, 60]).max() <= 0.03 * max(rows, cols)
+
+
+def test_every_orientation_is_ranked_and_the_first_is_fit_overlays(plan):
+    rows, cols = plan.free.shape
+    part = np.rot90(plan.free[rows // 6 : rows // 6 + int(rows * 0.7), : int(cols * 0.8)], 2)
+    quarter_turns = [(90.0 * k, False) for k in range(4)]
+    ranked = ranked_overlays(part, plan.free, orientations=quarter_turns, scale=1.0)
+    assert sorted(fit.degrees for _, fit in ranked) == [0.0, 90.0, 180.0, 270.0]
+    scores = [score for score, _ in ranked]
+    assert scores == sorted(scores, reverse=True) and scores[0] > scores[1]
+    best = fit_overlay(part, plan.free, orientations=quarter_turns, scale=1.0)
+    assert (ranked[0][1].degrees, ranked[0][1].overlap) == (best.degrees, best.overlap) == (180.0, best.overlap)
+    np.testing.assert_array_equal(ranked[0][1].matrix, best.matrix)
+    assert ranked_overlays(np.zeros_like(part), plan.free, orientations=quarter_turns) == []
+
+
+def test_the_overlay_answer_names_its_runner_up_reading(plan, plan_segmentation):
+    # A corridor lined with rooms correlates nearly as well turned by a half turn (Halmstad E5_05):
+    # the answer records every orientation's rank value, so `ursim match` and the app say how close
+    # the call was (the runner-up reading and how much worse it ranked).
+    rows, cols = plan.free.shape
+    part_seg = segment(np.rot90(plan.free[:, : int(cols * 0.8)], 1), preset="default")
+    result = match(part_seg, plan_segmentation, config=MatchConfig(input_kind="metric"))
+    scan = result.orientation_scan
+    assert len(scan) >= 2 and scan[result.orientation] == min(scan.values())
+    runner_up = next_reading_record(result)["next_reading"]
+    gap = (sorted(scan.values())[1] - scan[result.orientation]) / scan[result.orientation]
+    assert runner_up["ranked_worse_by"] == pytest.approx(gap) and runner_up["ranked_worse_by"] > 0
+    assert (runner_up["degrees"], runner_up["mirrored"]) != result.orientation
+    # Told the orientation, or laid by a person's pairs, there is no other reading to name.
+    told = match(
+        part_seg, plan_segmentation, config=MatchConfig(input_kind="metric", orientation=result.orientation[0])
+    )
+    assert next_reading_record(told) == {}
+    laid = match(
+        part_seg,
+        plan_segmentation,
+        config=MatchConfig(input_kind="metric"),
+        constraints=MatchConstraints(fixed=result.pairs[:2]),
+    )
+    assert laid.orientation_scan == {} and next_reading_record(laid) == {}
 
 
 def test_pairs_need_the_overlap_threshold():
