@@ -29,7 +29,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["KINDS", "InvarianceCase", "transformed_sketch", "run_case", "bench_invariance", "print_invariance"]
+__all__ = [
+    "KINDS",
+    "InvarianceCase",
+    "undoing_orientation",
+    "transformed_sketch",
+    "run_case",
+    "bench_invariance",
+    "print_invariance",
+]
 
 KINDS = ("upright", "turned", "mirrored", "cropped", "rescaled", "all")
 
@@ -46,6 +54,25 @@ class InvarianceCase:
     kept: float
     f1: float
     place_accuracy: float
+    #: Whether the matcher read the sketch in the orientation that undoes the transformation
+    #: (:func:`undoing_orientation`; the same mirror image, turned within
+    #: ``matching.orientation.SAME_READING`` degrees). A plan nearly symmetric under a turn can be
+    #: read otherwise and still score, so F1 stays the figure; this tells where a failure lies.
+    read_right: bool = True
+
+
+def undoing_orientation(degrees: float, mirrored: bool) -> tuple[float, bool]:
+    """The ``(degrees, mirrored)`` of :class:`~ursim_core.matching.MatchConfig` that brings a sketch
+    transformed by :func:`transformed_sketch` (mirrored first, then turned ``degrees``
+    counter-clockwise) back: a turn alone is undone by the opposite turn; a mirror image turned by d
+    is read by mirroring it and turning it by d (mirror, turn by -d equals turn by d, mirror).
+
+    Examples
+    --------
+    >>> undoing_orientation(30.0, False), undoing_orientation(30.0, True), undoing_orientation(0.0, False)
+    ((330.0, False), (30.0, True), (0.0, False))
+    """
+    return (float(degrees) % 360.0 if mirrored else (-float(degrees)) % 360.0, bool(mirrored))
 
 
 def _parameters(seed: int, kind: str) -> tuple[float, bool, float, float]:
@@ -116,6 +143,7 @@ def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None, plan_
     from ursim_core.correspondences import regions_at_points
     from ursim_core.evaluation.scoring import place_problem, score_matches, score_places
     from ursim_core.matching import MatchConfig, match
+    from ursim_core.matching.orientation import same_reading
     from ursim_core.segmentation import segment_canonical
     from ursim_core.synth import ground_truth_correspondences, make_pair
 
@@ -157,7 +185,8 @@ def run_case(seed: int, kind: str, *, config=None, plan_segmentation=None, plan_
     f1 = score_matches(result.pairs, regions).f1
     problem = place_problem(point_cliques, sketch_seg.labels, metric_seg.labels)
     place = score_places(result.pairs, problem, metric_seg.graph).accuracy
-    return InvarianceCase(seed, kind, degrees, mirrored, scale, kept, f1, place)
+    read_right = same_reading(result.orientation, undoing_orientation(degrees, mirrored))
+    return InvarianceCase(seed, kind, degrees, mirrored, scale, kept, f1, place, read_right)
 
 
 def bench_invariance(
@@ -179,8 +208,12 @@ def bench_invariance(
 
 
 def print_invariance(cases: list[InvarianceCase]) -> None:
-    """Per kind: mean F1 and place accuracy, the worst case; then the mean over the kinds."""
-    print(f"{'kind':10s} {'pairs':>5s} {'mean F1':>8s} {'place acc.':>10s} {'worst F1':>9s}  worst case")
+    """Per kind: mean F1 and place accuracy, how many were read in the right orientation and their
+    mean F1 against the others', the worst case; then the mean over the kinds."""
+    print(
+        f"{'kind':10s} {'pairs':>5s} {'mean F1':>8s} {'place acc.':>10s} {'read right':>10s} "
+        f"{'F1 right / wrong':>16s} {'worst F1':>9s}  worst case"
+    )
     means = []
     for kind in dict.fromkeys(case.kind for case in cases):
         group = [case for case in cases if case.kind == kind]
@@ -189,8 +222,14 @@ def print_invariance(cases: list[InvarianceCase]) -> None:
         places = [case.place_accuracy for case in group if not math.isnan(case.place_accuracy)]
         place = statistics.fmean(places) if places else math.nan
         means.append((f1, place))
+        right = [case.f1 for case in group if case.read_right]
+        wrong = [case.f1 for case in group if not case.read_right]
+        split = " / ".join(f"{statistics.fmean(part):.3f}" if part else "-" for part in (right, wrong))
         detail = f"seed {worst.seed}: {worst.degrees:.0f} deg{' mirrored' if worst.mirrored else ''}, scale {worst.scale:.2f}, kept {worst.kept:.2f}"
-        print(f"{kind:10s} {len(group):5d} {f1:8.3f} {place:10.3f} {worst.f1:9.3f}  {detail}")
+        print(
+            f"{kind:10s} {len(group):5d} {f1:8.3f} {place:10.3f} {f'{len(right)}/{len(group)}':>10s} "
+            f"{split:>16s} {worst.f1:9.3f}  {detail}"
+        )
     print(
         f"{'mean':10s} {len(cases):5d} {statistics.fmean(m[0] for m in means):8.3f} "
         f"{statistics.fmean(m[1] for m in means):10.3f}   (issue 11 bar: mean F1 >= 0.95)"

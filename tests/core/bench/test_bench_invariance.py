@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ursim_core.bench.invariance import KINDS, _parameters, run_case, transformed_sketch
+from ursim_core.bench.invariance import KINDS, _parameters, run_case, transformed_sketch, undoing_orientation
 from ursim_core.synth import make_pair
 
 
@@ -42,3 +42,24 @@ def test_parameters_are_reproducible_and_in_range():
 def test_an_upright_generated_pair_is_scored():
     case = run_case(1, "upright")
     assert case.f1 == pytest.approx(1.0) and case.place_accuracy == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("kind", ["turned", "mirrored"])
+def test_a_turned_or_mirrored_pair_is_read_in_the_orientation_that_undoes_it(kind):
+    case = run_case(1, kind)
+    assert case.read_right and case.f1 >= 0.9, case
+
+
+def test_the_undoing_orientation_brings_the_points_back():
+    from ursim_core.matching.alignment import orientation_matrix
+
+    free = np.zeros((40, 60), bool)
+    free[5:35, 5:55] = True
+    points = [(10, 10), (30, 50), (20, 12)]
+    for degrees, mirrored in [(30.0, False), (30.0, True), (250.0, True), (0.0, False)]:
+        _, moved = transformed_sketch(free, points, degrees=degrees, mirrored=mirrored)
+        # orientation_matrix maps (row, col) of the input to the metric frame, up to a shift.
+        matrix = orientation_matrix(**dict(zip(("degrees", "mirrored"), undoing_orientation(degrees, mirrored))))
+        back = np.asarray(moved, float) @ matrix.T
+        offsets = back - np.asarray(points, float)
+        np.testing.assert_allclose(offsets, offsets[:1].repeat(len(points), axis=0), atol=1.5)
