@@ -233,9 +233,24 @@ def fit_overlay(
 
 
 def ranked_overlays(
-    sketch_free, metric_free, *, orientations: Sequence[tuple[float, bool]], scale: float | None = None
+    sketch_free,
+    metric_free,
+    *,
+    orientations: Sequence[tuple[float, bool]],
+    scale: float | None = None,
+    angle_step: float = 0.0,
 ) -> list[tuple[float, Alignment]]:
     """Each orientation's best placement (:func:`fit_overlay`'s search), with its correlation.
+
+    Parameters
+    ----------
+    sketch_free, metric_free, orientations, scale
+        As for :func:`fit_overlay`.
+    angle_step : float, keyword-only
+        When above 0, each orientation is also tried turned by one and two such steps either way
+        (degrees), and keeps the turn whose placement correlates best: the candidates come from the
+        maps' wall angles, which a robot map's drift bends by a few degrees (Halmstad E5_05 against
+        E5_10: wall angles 174.5 and 354.5 degrees apart, the right placement at 350.5).
 
     Returns
     -------
@@ -244,8 +259,7 @@ def ranked_overlays(
         map's, and the placement; best first (ties: the earlier orientation), so the first is
         :func:`fit_overlay`'s. Empty when either map has no free space or the input is too small
         to place. The runner-up tells how close the call was: a corridor lined with rooms
-        correlates nearly as well turned by a half turn (Halmstad E5_05 against E5_10: 0.462 for
-        the half turn chosen, 0.440 for the right placement; docs/studies.md, round 42).
+        correlates nearly as well turned by a half turn (docs/studies.md, round 42).
 
     Examples
     --------
@@ -263,18 +277,21 @@ def ranked_overlays(
     sketch, metric = _Side(sketch_free), _Side(metric_free)
     if scale is None:
         scale = _estimated_scale(sketch, metric, orientations, SCALE_SEARCH)
+    # The candidate's own turn first: a tie keeps it.
+    turns = (0.0, -angle_step, angle_step, -2 * angle_step, 2 * angle_step) if angle_step > 0 else (0.0,)
     ranked = []
     for index, (degrees, mirrored) in enumerate(orientations):
-        turn = orientation_matrix(degrees=degrees, mirrored=mirrored)
-        best: tuple[float, float, np.ndarray] | None = None
-        for spread in SCALE_SPREAD:
-            linear = turn * (scale * spread * metric.factor)
-            placed = _best_placement(sketch, metric, linear)
-            if placed is not None and (best is None or placed[0] > best[0]):
-                matrix = np.hstack([linear / metric.factor, (placed[1] / metric.factor)[:, None]])
-                best = (placed[0], placed[2], matrix)
+        best: tuple[float, float, np.ndarray, float] | None = None
+        for turned in ((degrees + turn) % 360.0 if turn else degrees for turn in turns):
+            orientation = orientation_matrix(degrees=turned, mirrored=mirrored)
+            for spread in SCALE_SPREAD:
+                linear = orientation * (scale * spread * metric.factor)
+                placed = _best_placement(sketch, metric, linear)
+                if placed is not None and (best is None or placed[0] > best[0]):
+                    matrix = np.hstack([linear / metric.factor, (placed[1] / metric.factor)[:, None]])
+                    best = (placed[0], placed[2], matrix, turned)
         if best is not None:
-            fit = Alignment(min(best[1], 1.0), best[2], float(degrees), bool(mirrored))
+            fit = Alignment(min(best[1], 1.0), best[2], float(best[3]), bool(mirrored))
             ranked.append((-best[0], index, best[0], fit))
     return [(score, fit) for _, _, score, fit in sorted(ranked, key=lambda item: item[:2])]
 

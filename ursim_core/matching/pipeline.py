@@ -341,7 +341,11 @@ def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=No
             sketch_labels, metric_labels, constraints.fixed, sketch_graph, metric_graph, mirror_flags=flags
         )
     if fit is None:
-        ranked = ranked_overlays(sketch_labels, metric_labels, orientations=candidates, scale=config.scale)
+        # A told orientation is kept exactly; found ones are refined by a few degrees.
+        step = config.overlay_angle_step if config.orientation == "any" else 0.0
+        ranked = ranked_overlays(
+            sketch_labels, metric_labels, orientations=candidates, scale=config.scale, angle_step=step
+        )
         fit = ranked[0][1] if ranked else Alignment.unfitted(*candidates[0])
         # Rank values as the planar matcher's (lower is better): 1 - the correlation. The answer's
         # runner-up reading (orientation.next_reading) then tells a person how close the call was.

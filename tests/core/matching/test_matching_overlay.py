@@ -120,6 +120,27 @@ def test_every_orientation_is_ranked_and_the_first_is_fit_overlays(plan):
     assert ranked_overlays(np.zeros_like(part), plan.free, orientations=quarter_turns) == []
 
 
+def test_a_copy_turned_a_few_degrees_off_its_candidate_is_laid_by_the_angle_step(plan):
+    # A robot map's drift bends its walls: its wall angle can miss the turn between the maps by a
+    # few degrees. The candidate here says 0; the copy is turned by 4 degrees.
+    from ursim_core.bench.invariance import transformed_sketch
+
+    part, _ = transformed_sketch(plan.free, [], degrees=4.0)
+    ((plain, fixed),) = ranked_overlays(part, plan.free, orientations=[(0.0, False)], scale=1.0)
+    ((refined, fit),) = ranked_overlays(part, plan.free, orientations=[(0.0, False)], scale=1.0, angle_step=2.0)
+    assert fixed.degrees == 0.0 and fit.degrees == 356.0 and refined > plain
+    # With no better turn nearby the candidate's own is kept.
+    ((_, same),) = ranked_overlays(plan.free, plan.free, orientations=[(0.0, False)], scale=1.0, angle_step=2.0)
+    assert same.degrees == 0.0
+
+
+def test_a_told_orientation_is_kept_exactly_by_the_overlay(plan, plan_segmentation):
+    part_seg = segment(plan.free[:, : plan.free.shape[1] * 3 // 4], preset="default")
+    for told in (0.0, 3.0):
+        result = match(part_seg, plan_segmentation, config=MatchConfig(input_kind="metric", orientation=told))
+        assert result.orientation == (told, False)
+
+
 def test_the_overlay_answer_names_its_runner_up_reading(plan, plan_segmentation):
     # A corridor lined with rooms correlates nearly as well turned by a half turn (Halmstad E5_05):
     # the answer records every orientation's rank value, so `ursim match` and the app say how close
