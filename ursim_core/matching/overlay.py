@@ -20,7 +20,10 @@ shrunk nor a grown input is favoured. With no known scale it is estimated first
 Round 28 (docs/studies.md): the earlier score, the share of the input's free space and wall band
 that agrees, took the smallest scale allowed on the Halmstad E5 pairs it got wrong; with the
 correlation, E5 0.69 -> 0.79 mean F1 and cropped copies of generated plans (held-out seeds 32-63)
-0.80 -> 0.94 (0.97 with no wall band beyond a cut, :func:`_template`).
+0.80 -> 0.94 (0.97 with no wall band beyond a cut, :func:`_template`). With the orientation unknown
+the matcher also tries each candidate turned by a few degrees (:func:`ranked_overlays`'
+``angle_step``, ``MatchConfig.overlay_angle_step``), and its answer keeps every candidate's rank so
+that a close call is reported (round 42).
 
 Pairs a person gave (:mod:`ursim_core.matching.constraints`, two fixed pairs or more): the placement
 is the similarity (turn, scale, shift) that carries their regions' centroids onto their partners'
@@ -250,7 +253,7 @@ def ranked_overlays(
         When above 0, each orientation is also tried turned by one and two such steps either way
         (degrees), and keeps the turn whose placement correlates best: the candidates come from the
         maps' wall angles, which a robot map's drift bends by a few degrees (Halmstad E5_05 against
-        E5_10: wall angles 174.5 and 354.5 degrees apart, the right placement at 350.5).
+        E5_10: candidates at 174.5 and 354.5 degrees, the right placement at 350.5).
 
     Returns
     -------
