@@ -166,3 +166,21 @@ def test_the_summary_names_the_reading_ranked_next():
     # Told the orientation: nothing was read, so nothing ranked next.
     told = dataclasses.replace(result, config=dataclasses.replace(result.config, orientation=0.0))
     assert "next best" not in describe_result(told)
+
+
+def test_the_summary_names_the_overlays_runner_up_for_a_robot_map():
+    # Robot maps are overlaid, not matched by the planar matcher; their answer ranks every
+    # orientation too, so the panel says how close the call was (Halmstad E5_05's half turn).
+    import numpy as np
+
+    from ursim_core.matching import match
+    from ursim_core.segmentation import segment
+    from ursim_core.synth import make_pair
+    from ursim_gui.panels.matching_panel import describe_result
+
+    plan, _ = make_pair(seed=2)
+    part = segment(np.rot90(plan.free[:, : plan.free.shape[1] * 4 // 5], 1), preset="default")
+    result = match(part, segment(plan.free, preset="default"), config=MatchConfig(input_kind="metric"))
+    assert result.config.matcher == "overlay"
+    text = describe_result(result)
+    assert "next best: turned" in text and "% worse" in text, text
