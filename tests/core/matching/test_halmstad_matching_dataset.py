@@ -4,12 +4,13 @@ Each of the 11 sensor maps is matched against the model map of each annotator (M
 Vasiliki: E5_10; 20 pairs with ground truth). The maps carry no resolution and are not at one
 scale (the ground-truth clicks put the model-to-input distance ratio at 0.59-1.33). The layout
 holds robot maps, so the default matcher (``matcher="auto"``) is the overlay matcher, not
-mirrored, with the scale estimated (:func:`ursim_core.matching.overlay.estimate_scale`). The one
-value chosen on these maps is the overlay's IoU threshold, cross-validated leave-one-map-out over
-0.05, 0.15 and 0.3: measured held-out F1 0.69 and place accuracy 0.67 over the 20 runs (0.71 /
-0.69 as a mean over the 11 maps; 0.05 chosen in every fold; worst map E5_05, 0.13). The planar
-matcher, built for sketches, gives 0.26 here. The matching issue's bar: 0.65 with automatic
-settings (DAM, a metric alignment method: 0.78).
+mirrored, with the scale estimated (:func:`ursim_core.matching.overlay.estimate_scale`) and each
+candidate turn refined by 2 and 4 degrees (``MatchConfig.overlay_angle_step``, round 42). The
+overlay's IoU threshold is cross-validated here leave-one-map-out over 0.05, 0.15 and 0.3: measured
+held-out F1 0.83 and place accuracy 0.82 as a mean over the 11 maps in round 42 (0.80 / 0.78
+without the angle step; worst map E5_05, 0.55, was 0.15). The planar matcher, built for sketches,
+gives 0.26 here. The matching issue's bar: 0.65 with automatic settings (DAM, a metric alignment
+method: 0.78).
 """
 
 from __future__ import annotations
