@@ -25,6 +25,7 @@ __all__ = [
     "SIZE_WEIGHT_FLOOR",
     "VARIANTS",
     "ORIENTATIONS",
+    "ELASTIC_RULES",
     "MatchConfig",
 ]
 
@@ -37,6 +38,8 @@ DEFAULT_TIMES = tuple(round(0.2 * i, 10) for i in range(15))
 #: Added to ``z_size - min(z_size)`` so that no vertex gets weight 0 (see :mod:`.descriptors`).
 SIZE_WEIGHT_FLOOR = 0.1
 VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
+#: The values of ``MatchConfig.elastic`` (see :mod:`ursim_core.matching.elastic`).
+ELASTIC_RULES = ("off", "alone", "completed")
 #: The values of ``MatchConfig.orientation`` other than a number of degrees.
 ORIENTATIONS = ("any", "upright")
 
@@ -282,6 +285,12 @@ class MatchConfig:
         What the input map is: 'metric' (a robot map, a floor plan drawn to scale) makes
         ``matcher='auto'`` the overlay matcher; None (default) = unknown, taken as a sketch unless
         ``scale`` is known.
+    elastic : {'off', 'alone', 'completed'}
+        With 'alone' or 'completed' the planar matcher reads the sketch's orientation, and the
+        answer's pairs are those of the sketch laid on the metric map by its box and bent by an
+        optical flow between the two maps (:mod:`ursim_core.matching.elastic`), regions paired at
+        ``overlay_min_iou``; 'completed' adds the planar answer's pairs of regions left unpaired on
+        both sides. Planar matcher and label images only.
     """
 
     variant: str = "T4"
@@ -320,6 +329,7 @@ class MatchConfig:
     overlay_min_iou: float = 0.15
     overlay_angle_step: float = 2.0
     input_kind: str | None = None
+    elastic: str = "completed"
 
     def __post_init__(self):
         choices = {
@@ -333,6 +343,7 @@ class MatchConfig:
             "hypothesis_score": ("signature", "substitutions", "structure"),
             "vote_rule": VOTE_RULES,
             "vote_orientations": VOTE_ORIENTATIONS,
+            "elastic": ELASTIC_RULES,
         }
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
@@ -389,7 +400,13 @@ class MatchConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < smallest:
                 raise ParameterError(f"must be {wording}, not {value!r}", field=name)
-        for name in ("signature_refit", "keep_refit", "resampling_vote", "vote_by_reading", "vote_signature_refit"):
+        for name in (
+            "signature_refit",
+            "keep_refit",
+            "resampling_vote",
+            "vote_by_reading",
+            "vote_signature_refit",
+        ):
             if not isinstance(getattr(self, name), bool):
                 raise ParameterError(f"must be true or false, not {getattr(self, name)!r}", field=name)
         if not self.times:
@@ -424,6 +441,7 @@ class MatchConfig:
             reflections=False,
             position_weight=0.0,
             position_refits=0,
+            elastic="off",
             signature_refit=False,
             resampling_vote=False,
             hypothesis_score="structure",
@@ -459,6 +477,7 @@ class MatchConfig:
             reflections=False,
             position_weight=0.0,
             position_refits=0,
+            elastic="off",
             signature_refit=False,
             resampling_vote=False,
             hypothesis_score="substitutions",

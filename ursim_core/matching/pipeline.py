@@ -126,7 +126,12 @@ def prepare(
     (3, 3)
     """
     prepared = _prepare_one(sketch_seg, metric_seg, config, progress=progress, constraints=constraints)
-    return with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
+    prepared = with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
+    if prepared.config.elastic != "off" and prepared.config.matcher == "planar":
+        sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
+        if sketch_labels is not None and metric_labels is not None:
+            prepared = dataclasses.replace(prepared, sketch_labels=sketch_labels, metric_labels=metric_labels)
+    return prepared
 
 
 def _prepare_one(
@@ -407,8 +412,40 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
     [(0, 0), (1, 1), (2, 2), (3, 3)]
     """
     if prepared.resampled is not None:
-        return voted_answer(prepared, m, functools.partial(_match_one, progress=progress))
-    return _match_one(prepared, m, progress=progress)
+        result = voted_answer(prepared, m, functools.partial(_match_one, progress=progress))
+    else:
+        result = _match_one(prepared, m, progress=progress)
+    if prepared.sketch_labels is None:
+        return result
+    return _laid_elastically(prepared, result)
+
+
+def _laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
+    """``result`` with the pairs of the sketch laid elastically in its orientation
+    (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`), within the constraints."""
+    from ursim_core.matching.elastic import elastic_pairs
+    from ursim_core.matching.overlay import constrained_pairs
+
+    orientation = tuple(result.orientation)
+    if orientation not in prepared.elastic_answers:
+        degrees, mirrored = orientation
+        prepared.elastic_answers[orientation] = elastic_pairs(
+            prepared.sketch_labels,
+            prepared.metric_labels,
+            degrees=degrees,
+            mirrored=mirrored,
+            min_iou=prepared.config.overlay_min_iou,
+        )
+    pairs = prepared.elastic_answers[orientation]
+    if prepared.config.elastic == "completed":
+        # Regions the overlay leaves alone on both sides keep the graph answer's pairs: a small
+        # region the bent sketch misses still has its partner (a stub, a cut-off room).
+        sketch_paired, metric_paired = {a for a, _ in pairs}, {b for _, b in pairs}
+        pairs = sorted(
+            set(pairs) | {(a, b) for a, b in result.pairs if a not in sketch_paired and b not in metric_paired}
+        )
+    pairs = constrained_pairs(pairs, prepared.constraints)
+    return replaced(result, pairs=pairs)
 
 
 def _match_one(prepared: Prepared, m: float | None = None, *, progress=None) -> MatchResult:

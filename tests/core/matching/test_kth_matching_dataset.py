@@ -131,7 +131,9 @@ def test_a_turned_sketch_is_read_the_right_way_round_or_the_close_call_is_said(r
 
 def _cross_validated(root, option: str, values, *, augment: str = "dihedral"):
     """Leave-one-sketch-out cross-validation of ``option`` over ``values`` (planar T4, the sketches
-    turned as ``augment`` says)."""
+    turned as ``augment`` says). The graph matcher's own options are measured on its own answer
+    (``elastic='off'``): with the elastic answer they only choose the orientation."""
+    fixed = {} if option == "elastic" else {"elastic": "off"}
     results = {
         value: run_evaluation(
             root / "ursim_kth_sketches",
@@ -139,7 +141,7 @@ def _cross_validated(root, option: str, values, *, augment: str = "dihedral"):
             variants=["T4"],
             augment=augment,
             human=False,
-            config_overrides={option: value},
+            config_overrides={**fixed, option: value},
             segmentation_cache=_SEGMENTATIONS,
         )
         for value in values
@@ -178,6 +180,19 @@ def test_cross_validated_keep_refit_in_every_orientation(root):
 
 
 _SEGMENTATIONS: dict = {}
+
+
+def test_cross_validated_elastic_answer_meets_the_bar_in_every_orientation(root):
+    # Round 43: the sketch laid on the model by its box and bent by an optical flow
+    # (MatchConfig.elastic). Chosen in all 18 folds, held out 0.82 / 0.81 in every orientation,
+    # against 0.77 / 0.78 in sample without it; the issue's bar is 0.80 / 0.80.
+    cv = _cross_validated(root, "elastic", ("off", "alone", "completed"))
+    assert cv.f1 >= 0.80 and cv.place_accuracy >= 0.80, cv.table()
+    by_orientation = list(cv.by_orientation.values())
+    assert len(by_orientation) == 8, cv.table()
+    assert min(f1 for f1, _ in by_orientation) >= 0.80 and min(p for _, p in by_orientation) >= 0.80, cv.table()
+    # 'alone' pairs more but places worse: regions the bent sketch misses lose their partner.
+    assert cv.in_sample["alone"][1] < cv.in_sample["completed"][1], cv.table()
 
 
 def test_the_resampled_segmentations_vote_at_free_angles(root):

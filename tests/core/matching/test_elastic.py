@@ -1,0 +1,107 @@
+"""The sketch laid elastically (ursim_core.matching.elastic) and its place in the pipeline."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ursim_core.errors import ParameterError
+from ursim_core.matching import MatchConfig, match
+from ursim_core.matching.constraints import MatchConstraints
+from ursim_core.matching.elastic import elastic_flow, elastic_pairs, oriented_labels, signed_distance
+from ursim_core.matching.orientation import transform_points
+from ursim_core.segmentation.interface import Segmentation
+from ursim_core.segmentation.regions import region_table
+
+
+def _rooms(widths, height=60, wall=4, top=6):
+    """A row of rooms of the given widths: a label image, 0 on walls and outside."""
+    labels = np.zeros((height + 2 * top, sum(widths) + wall * (len(widths) + 1) + 8), np.int32)
+    left = 4 + wall
+    for index, width in enumerate(widths, start=1):
+        labels[top : top + height, left : left + width] = index
+        left += width + wall
+    return labels
+
+
+def _centroids(labels):
+    ids = np.unique(labels[labels > 0])
+    return ids, np.array([np.argwhere(labels == i).mean(axis=0) for i in ids])
+
+
+@pytest.mark.parametrize(
+    "degrees, mirrored", [(0, False), (90, False), (180, True), (270, True), (30, False), (135, True)]
+)
+def test_oriented_labels_move_regions_as_transform_points_moves_points(degrees, mirrored):
+    labels = _rooms([20, 30, 14, 40])
+    ids, before = _centroids(labels)
+    turned = oriented_labels(labels, degrees=degrees, mirrored=mirrored)
+    turned_ids, after = _centroids(turned)
+    assert turned_ids.tolist() == ids.tolist()
+    expected = transform_points(before, degrees=degrees, mirrored=mirrored)
+    # Equal up to a shift (the canvas), to a pixel or two of resampling at free angles.
+    offsets = after - expected
+    assert np.abs(offsets - offsets.mean(axis=0)).max() < 2.0
+
+
+def test_signed_distance_is_positive_inside_and_clipped():
+    free = np.zeros((40, 40), bool)
+    free[5:35, 5:35] = True
+    distance = signed_distance(free, clip=6)
+    assert distance[20, 20] == 6 and distance[0, 20] == -5 and distance[0, 0] == -6
+    assert distance[5, 20] > 0 > distance[4, 20]
+
+
+def test_flow_carries_a_shifted_room_back():
+    fixed = np.zeros((96, 96), bool)
+    fixed[20:70, 24:80] = True
+    moving = np.roll(fixed, (4, -5), axis=(0, 1))
+    flow = elastic_flow(fixed, moving, clip=10)
+    inside = flow[30:60, 34:70]
+    assert np.median(inside[..., 0]) == pytest.approx(-5, abs=1)
+    assert np.median(inside[..., 1]) == pytest.approx(4, abs=1)
+
+
+def test_a_sketch_out_of_proportion_pairs_room_by_room():
+    # The metric map's rooms are 20, 90, 30 and 60 px wide; the sketch draws them all alike.
+    metric = _rooms([20, 90, 30, 60], height=80)
+    sketch = _rooms([40, 40, 40, 40], height=50)
+    assert elastic_pairs(sketch, metric) == [(1, 1), (2, 2), (3, 3), (4, 4)]
+
+
+@pytest.mark.parametrize("degrees, mirrored", [(90, False), (180, False), (270, True), (0, True)])
+def test_a_turned_sketch_pairs_alike_once_its_orientation_is_given(degrees, mirrored):
+    metric = _rooms([30, 50, 24, 40], height=70)
+    # The sketch as drawn: the metric map's inverse transformation (mirror last).
+    undo = np.rot90(metric, -int(degrees // 90))
+    sketch = undo[:, ::-1] if mirrored else undo
+    assert elastic_pairs(sketch, metric, degrees=degrees, mirrored=mirrored) == [(i, i) for i in range(1, 5)]
+
+
+def test_nothing_to_lay_gives_no_pairs():
+    metric = _rooms([30, 30])
+    assert elastic_pairs(np.zeros((10, 10), np.int32), metric) == []
+    assert elastic_pairs(metric, np.zeros((10, 10), np.int32)) == []
+
+
+def _segmentation(labels):
+    return Segmentation(labels=labels, regions=region_table(labels))
+
+
+def test_the_pipeline_keeps_the_constraints_and_the_off_switch():
+    metric = _segmentation(_rooms([20, 90, 30, 60], height=80))
+    sketch = _segmentation(_rooms([40, 40, 40, 40], height=50))
+    told = MatchConfig(orientation="upright", mirrored=False)
+    laid = match(sketch, metric, config=told)
+    assert sorted(laid.pairs) == [(1, 1), (2, 2), (3, 3), (4, 4)]
+    constraints = MatchConstraints(fixed=((1, 2),), forbidden=((3, 3),))
+    constrained = match(sketch, metric, config=told, constraints=constraints)
+    assert (1, 2) in constrained.pairs and (3, 3) not in constrained.pairs
+    off = match(sketch, metric, config=told.replace(elastic="off"))
+    assert off.orientation == laid.orientation
+
+
+def test_elastic_must_be_a_rule():
+    with pytest.raises(ParameterError, match="elastic"):
+        MatchConfig(elastic="yes")
+    assert MatchConfig.paper().elastic == "off" and MatchConfig.released().elastic == "off"
