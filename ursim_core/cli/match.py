@@ -406,6 +406,7 @@ def match_pair(
         "reason": result.reason or "",
         "orientation": result.orientation,
         "resampling_votes": result.resampling_votes,
+        "laid": result.laid,
         **next_reading_record(result),
         "out": out,
     }
@@ -449,6 +450,7 @@ def run(args: argparse.Namespace) -> int:
         f"{record['n_metric_regions']} metric regions), m = {m_text}, sketch turned "
         f"{record['orientation'][0]:.1f} deg{' mirrored' if record['orientation'][1] else ''}"
         + (f", voted over {record['resampling_votes']} resamplings" if record["resampling_votes"] else "")
+        + (", pairs from the sketch laid and bent onto the map" if record["laid"] else "")
         + f", {record['match_ms']:.1f} ms"
         + (f"; {record['reason']}" if record["reason"] else "")
     )

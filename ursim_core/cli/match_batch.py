@@ -46,6 +46,7 @@ SUMMARY_COLUMNS = (
     "orientation_degrees",
     "orientation_mirrored",
     "resampling_votes",
+    "pairs_from",
     "next_reading_gap",
     "precision",
     "recall",
@@ -156,6 +157,8 @@ def run_pair(pair: dict[str, Any], out: Path, options: dict[str, Any]) -> dict[s
         orientation_degrees=float(degrees),
         orientation_mirrored=bool(mirrored),
         next_reading_gap=float(runner_up["ranked_worse_by"]) if runner_up else "",
+        # The laid sketch's pairs (MatchConfig.elastic) or the matcher's own.
+        pairs_from="laid sketch" if result.pop("laid", False) else "matcher",
     )
     return {**record, **result, "status": "ok", "error": ""}
 

@@ -445,7 +445,7 @@ def _laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
             set(pairs) | {(a, b) for a, b in result.pairs if a not in sketch_paired and b not in metric_paired}
         )
     pairs = constrained_pairs(pairs, prepared.constraints)
-    return replaced(result, pairs=pairs)
+    return replaced(result, pairs=pairs, laid=True)
 
 
 def _match_one(prepared: Prepared, m: float | None = None, *, progress=None) -> MatchResult:

@@ -72,6 +72,7 @@ class Prepared:
             "orientation": self.orientation,
             "orientation_scan": self.orientation_scan,
             "resampling_votes": 0,
+            "laid": False,
         }
 
     @property
@@ -121,6 +122,10 @@ class MatchResult:
         How many segmentations of a resampled sketch voted on ``pairs``
         (:mod:`ursim_core.matching.resampling`; the other fields are the first segmentation's
         answer's); 0 when there was no vote.
+    laid : bool
+        The pairs are those of the sketch laid on the metric map and bent onto it
+        (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`); ``m``, the cost and the
+        orientation are the planar matcher's, which read the orientation.
     """
 
     pairs: list
@@ -140,6 +145,7 @@ class MatchResult:
     orientation: tuple = (0.0, False)
     orientation_scan: dict = field(default_factory=dict)
     resampling_votes: int = 0
+    laid: bool = False
 
 
 _RESULT_FIELDS = frozenset(f.name for f in dataclasses.fields(MatchResult))
@@ -212,6 +218,8 @@ def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
         "reason": result.reason or "",
         # How the sketch was turned to match (chosen when config.orientation is 'any').
         "orientation": {"degrees": round(float(result.orientation[0]), 6), "mirrored": bool(result.orientation[1])},
+        # Whether the pairs are the laid sketch's (MatchConfig.elastic) or the matcher's own.
+        "pairs_from": "laid sketch" if result.laid else "matcher",
         **next_reading_record(result),
     }
 

@@ -28,7 +28,7 @@ from ursim_core.matching.orientation import describe_gap
 from ursim_gui.model.orientation import SketchOrientation
 from ursim_gui.model.pair_settings import MAX_SCALE
 
-__all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "INPUT_KINDS", "describe_result"]
+__all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "INPUT_KINDS", "PAIRS_FROM", "describe_result"]
 
 #: Descriptor variants (paper Table 1; T4 = URSIM) and matchers, as ``MatchConfig`` names them.
 VARIANTS = (
@@ -51,8 +51,16 @@ INPUT_KINDS = (
     ("sketch", "a sketch (drawn by hand)"),
     ("metric", "a robot map or a plan to scale"),
 )
-#: The matchers that use a known scale.
+#: Where a sketch's pairs come from (``MatchConfig.elastic``): the planar matcher reads the
+#: orientation either way.
+PAIRS_FROM = (
+    ("completed", "the sketch laid and bent onto the map, completed by the graph"),
+    ("alone", "the sketch laid and bent onto the map only"),
+    ("off", "the graph matcher's own answer"),
+)
+#: The matchers that use a known scale; those whose pairs may come from the laid sketch.
 _SCALED_MATCHERS = ("auto", "overlay")
+_ELASTIC_MATCHERS = ("auto", "planar")
 
 
 def orientation_read(result, *, automatic_cliques: int = 0, record=None):
@@ -86,6 +94,9 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
         if getattr(result, "resampling_votes", 0):
             # The pairs are a vote; m and the cost are the first segmentation's answer's.
             text += f"\nvoted over {result.resampling_votes} resamplings of the turned sketch"
+        if getattr(result, "laid", False):
+            # m and the cost are the planar matcher's, which read the orientation.
+            text += "\npairs from the sketch laid and bent onto the map"
     found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
         text += f"\nread the sketch {found.describe()}"
@@ -164,6 +175,18 @@ class MatchingPanel(QWidget):
             lambda _: self.input_kind.setEnabled(self.matcher.currentData() == "auto")
         )
         form.addRow("Input", self.input_kind)
+        self.pairs_from = _combo("match_pairs_from", PAIRS_FROM)
+        self.pairs_from.setToolTip(
+            "Where a sketch's pairs come from once the planar matcher has read its orientation: the "
+            "sketch laid on the map by its box and bent by an optical flow, regions paired where they "
+            "overlap (hand-drawn rooms out of proportion still land on theirs), or the graph matcher's "
+            "own answer"
+        )
+        self.pairs_from.setEnabled(self.matcher.currentData() in _ELASTIC_MATCHERS)
+        self.matcher.currentIndexChanged.connect(
+            lambda _: self.pairs_from.setEnabled(self.matcher.currentData() in _ELASTIC_MATCHERS)
+        )
+        form.addRow("Pairs", self.pairs_from)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
         self.turn_left.setObjectName("orient_left")
@@ -237,6 +260,7 @@ class MatchingPanel(QWidget):
             variant=self.variant.currentData(),
             matcher=matcher,
             m=m,
+            elastic=self.pairs_from.currentData(),
             **self.orientation.match_options(fields),
             **extra,
         )

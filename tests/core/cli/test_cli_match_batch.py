@@ -41,6 +41,8 @@ def test_batch_writes_each_pair_and_a_summary(maps, workers):
     assert rows[0]["orientation_mirrored"] == str(batch_record["orientation"]["mirrored"])
     assert float(rows[0]["next_reading_gap"]) == pytest.approx(batch_record["next_reading"]["ranked_worse_by"])
     assert rows[0]["resampling_votes"] == "0" and rows[2]["next_reading_gap"] == ""
+    # Where the pairs came from: the sketch laid and bent onto the map (MatchConfig.elastic).
+    assert batch_record["pairs_from"] == rows[0]["pairs_from"] == "laid sketch" and rows[2]["pairs_from"] == ""
     for name in ("a", "b"):
         assert {p.name for p in (out / name).iterdir()} == {
             "correspondences.json",

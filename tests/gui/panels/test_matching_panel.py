@@ -184,3 +184,23 @@ def test_the_summary_names_the_overlays_runner_up_for_a_robot_map():
     assert result.config.matcher == "overlay"
     text = describe_result(result)
     assert "next best: turned" in text and "% worse" in text, text
+
+
+def test_the_panel_says_where_a_sketchs_pairs_come_from(window, qtbot):
+    panel = window.matching_panel
+    assert panel.config().elastic == "completed" and panel.pairs_from.isEnabled()
+    panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
+    assert not panel.pairs_from.isEnabled()  # the Hungarian baseline gives its own pairs
+    panel.matcher.setCurrentIndex(panel.matcher.findData("auto"))
+    panel.pairs_from.setCurrentIndex(panel.pairs_from.findData("off"))
+    assert panel.config().elastic == "off"
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    assert not window.session.last_match.laid and "laid" not in panel.summary.text()
+    qtbot.waitUntil(lambda: panel.match_button.isEnabled())
+    panel.pairs_from.setCurrentIndex(panel.pairs_from.findData("completed"))
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    result = window.session.last_match
+    assert result.laid and result.config.elastic == "completed" and result.pairs
+    assert "pairs from the sketch laid and bent onto the map" in panel.summary.text()
