@@ -290,7 +290,7 @@ class MatchConfig:
         answer's pairs are those of the sketch laid on the metric map by its box and bent by an
         optical flow between the two maps (:mod:`ursim_core.matching.elastic`), regions paired at
         ``overlay_min_iou``; 'completed' adds the planar answer's pairs of regions left unpaired on
-        both sides. Planar matcher and label images only.
+        both sides. Planar matcher, label images and sketch-sized maps (at most 60 regions each) only.
     """
 
     variant: str = "T4"

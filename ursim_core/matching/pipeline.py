@@ -129,7 +129,10 @@ def prepare(
     prepared = with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
     if prepared.config.elastic != "off" and prepared.config.matcher == "planar":
         sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
-        if sketch_labels is not None and metric_labels is not None:
+        # Sketch-sized maps only: at the working size (512 px) a building's thousands of regions
+        # would be a few pixels wide, and its graph answer is not screened by orientation alike.
+        small = max(prepared.c_matrix.shape) <= _SCREEN_BY_ASSIGNMENT
+        if sketch_labels is not None and metric_labels is not None and small:
             prepared = dataclasses.replace(prepared, sketch_labels=sketch_labels, metric_labels=metric_labels)
     return prepared
 

@@ -105,3 +105,13 @@ def test_elastic_must_be_a_rule():
     with pytest.raises(ParameterError, match="elastic"):
         MatchConfig(elastic="yes")
     assert MatchConfig.paper().elastic == "off" and MatchConfig.released().elastic == "off"
+
+
+def test_building_sized_maps_keep_the_graph_answer():
+    # 70 rooms in a row: at the 512 px working size they would be a few pixels wide.
+    labels = _rooms([12] * 70, height=40, wall=2)
+    metric, sketch = _segmentation(labels), _segmentation(labels.copy())
+    told = MatchConfig(orientation="upright", mirrored=False)
+    result = match(sketch, metric, config=told)
+    assert not result.laid
+    assert sorted(result.pairs) == sorted(match(sketch, metric, config=told.replace(elastic="off")).pairs)
