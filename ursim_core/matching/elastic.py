@@ -23,7 +23,6 @@ same on maps of any resolution.
 
 from __future__ import annotations
 
-import math
 import weakref
 
 import numpy as np
@@ -62,13 +61,9 @@ def oriented_labels(labels: np.ndarray, *, degrees: float, mirrored: bool) -> np
     quarter = degrees / 90.0
     if abs(quarter - round(quarter)) < 1e-9:
         return np.ascontiguousarray(np.rot90(labels, int(round(quarter)) % 4))
-    rows, cols = labels.shape
-    theta = math.radians(degrees)
-    cos, sin = abs(math.cos(theta)), abs(math.sin(theta))
-    new_cols, new_rows = int(math.ceil(cols * cos + rows * sin)), int(math.ceil(cols * sin + rows * cos))
-    matrix = cv2.getRotationMatrix2D(((cols - 1) / 2.0, (rows - 1) / 2.0), degrees, 1.0)
-    matrix[0, 2] += (new_cols - cols) / 2.0
-    matrix[1, 2] += (new_rows - rows) / 2.0
+    from ursim_core.segmentation.canonical import turn_on_canvas
+
+    matrix, (new_rows, new_cols) = turn_on_canvas(labels.shape, degrees)
     # Nearest neighbour on float32 keeps the ids exactly (they are far below 2**24).
     turned = cv2.warpAffine(labels.astype(np.float32), matrix, (new_cols, new_rows), flags=cv2.INTER_NEAREST)
     return turned.astype(labels.dtype)

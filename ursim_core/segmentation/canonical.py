@@ -34,6 +34,7 @@ __all__ = [
     "dihedral",
     "turned_back",
     "smoothed_turn",
+    "turn_on_canvas",
     "RESAMPLING_OFFSETS",
     "TURN_SMOOTHING_DIVISOR",
 ]
@@ -262,17 +263,33 @@ def _renumber(labels: np.ndarray) -> np.ndarray:
     return (np.arange(ids.size, dtype=np.int32) + offset)[inverse].reshape(labels.shape)
 
 
-def _turned(free: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
-    """``free`` turned counter-clockwise by ``degrees`` on a canvas that holds it, and the affine map."""
+def turn_on_canvas(shape: tuple[int, int], degrees: float) -> tuple[np.ndarray, tuple[int, int]]:
+    """The OpenCV affine map that turns an image of ``shape`` counter-clockwise by ``degrees`` about
+    its centre onto a canvas that holds all of it, and that canvas's ``(rows, cols)``.
+
+    Examples
+    --------
+    >>> matrix, canvas = turn_on_canvas((10, 20), 90.0)
+    >>> canvas
+    (20, 10)
+    """
     import cv2
 
-    rows, cols = free.shape
+    rows, cols = shape
     theta = math.radians(degrees)
     c, s = abs(math.cos(theta)), abs(math.sin(theta))
     new_cols, new_rows = int(math.ceil(cols * c + rows * s)), int(math.ceil(cols * s + rows * c))
     matrix = cv2.getRotationMatrix2D(((cols - 1) / 2, (rows - 1) / 2), degrees, 1.0)
     matrix[0, 2] += (new_cols - cols) / 2
     matrix[1, 2] += (new_rows - rows) / 2
+    return matrix, (new_rows, new_cols)
+
+
+def _turned(free: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
+    """``free`` turned counter-clockwise by ``degrees`` on a canvas that holds it, and the affine map."""
+    import cv2
+
+    matrix, (new_rows, new_cols) = turn_on_canvas(free.shape, degrees)
     image = cv2.warpAffine(
         free.astype(np.uint8) * 255, matrix, (new_cols, new_rows), flags=cv2.INTER_LINEAR, borderValue=0
     )
