@@ -27,7 +27,15 @@ import weakref
 
 import numpy as np
 
-__all__ = ["WORKING_SIDE", "DISTANCE_CLIP", "oriented_labels", "signed_distance", "elastic_flow", "elastic_pairs"]
+__all__ = [
+    "WORKING_SIDE",
+    "DISTANCE_CLIP",
+    "oriented_labels",
+    "signed_distance",
+    "elastic_flow",
+    "elastic_pairs",
+    "laid_sketch",
+]
 
 #: The metric map's longer side (pixels) while the sketch is laid: the KTH model's own size.
 WORKING_SIDE = 512
@@ -181,15 +189,60 @@ def elastic_pairs(
     >>> elastic_pairs(sketch, metric)
     [(1, 1), (2, 2)]
     """
+    from ursim_core.matching.overlay import overlay_pairs
+
+    laid = _bent(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip)
+    if laid is None:
+        return []
+    bent, metric = laid
+    return overlay_pairs(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
+
+
+def laid_sketch(
+    sketch_labels: np.ndarray,
+    metric_labels: np.ndarray,
+    *,
+    degrees: float = 0.0,
+    mirrored: bool = False,
+    clip: float = DISTANCE_CLIP,
+) -> np.ndarray:
+    """The sketch's regions where :func:`elastic_pairs` lays them, on the metric map's pixels.
+
+    For a person to see why regions were paired: the bent sketch drawn over the metric map.
+
+    Returns
+    -------
+    ndarray of int32, shape of ``metric_labels``
+        Sketch region ids, 0 where no sketch region lands (resampled from the working size).
+
+    Examples
+    --------
+    >>> metric = np.zeros((60, 100), np.int32); metric[5:55, 5:45] = 1; metric[5:55, 50:95] = 2
+    >>> sketch = np.zeros((40, 40), np.int32); sketch[2:38, 2:14] = 1; sketch[2:38, 16:38] = 2
+    >>> laid = laid_sketch(sketch, metric)
+    >>> laid.shape, int(laid[30, 20]), int(laid[30, 80])
+    ((60, 100), 1, 2)
+    """
     import cv2
 
-    from ursim_core.matching.overlay import overlay_pairs
+    metric_labels = np.asarray(metric_labels)
+    laid = _bent(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip)
+    if laid is None:
+        return np.zeros(metric_labels.shape, np.int32)
+    bent = cv2.resize(laid[0].astype(np.float32), metric_labels.shape[::-1], interpolation=cv2.INTER_NEAREST)
+    return bent.astype(np.int32)
+
+
+def _bent(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip: float):
+    """``(bent sketch, metric map)`` label images at the working size, or None when either map
+    has no region."""
+    import cv2
 
     metric_labels = np.asarray(metric_labels)
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
     sketch_box, metric_box = _box(sketch > 0), _box(metric_labels > 0)
     if sketch_box is None or metric_box is None:
-        return []
+        return None
     metric, metric_image = _metric_at_working_size(metric_labels, clip)
     shape = metric.shape
     factor = WORKING_SIDE / max(metric_labels.shape)
@@ -203,4 +256,4 @@ def elastic_pairs(
     flow = dis.calc(metric_image, _flow_image(laid > 0, clip), None)
     rows, cols = np.indices(shape, dtype=np.float32)
     bent = cv2.remap(laid, cols + flow[..., 0], rows + flow[..., 1], cv2.INTER_NEAREST)
-    return overlay_pairs(bent.astype(np.int64), metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
+    return bent.astype(np.int64), metric

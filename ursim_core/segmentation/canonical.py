@@ -269,9 +269,9 @@ def turn_on_canvas(shape: tuple[int, int], degrees: float) -> tuple[np.ndarray, 
 
     Examples
     --------
-    >>> matrix, canvas = turn_on_canvas((10, 20), 90.0)
+    >>> matrix, canvas = turn_on_canvas((10, 20), 45.0)
     >>> canvas
-    (20, 10)
+    (22, 22)
     """
     import cv2
 

@@ -119,6 +119,13 @@ class MapView(QGraphicsView):
     def set_outlines_visible(self, visible: bool) -> None:
         self.layers.outlines.setVisible(bool(visible))
 
+    def set_laid_sketch(self, labels: np.ndarray | None, table: np.ndarray | None = None) -> None:
+        """Outline the sketch's regions where the matcher laid them on this map (None: hide)."""
+        self.layers.set_laid(labels, table)
+
+    def has_laid_sketch(self) -> bool:
+        return not self.layers.laid.image().isNull()
+
     def set_graph_visible(self, visible: bool) -> None:
         self.layers.graph_item.setVisible(bool(visible))
 

@@ -33,6 +33,8 @@ MIN_ID_REGION_PX = 28
 #: Up to this many recoloured regions are patched in place; more re-index the image.
 _MAX_PATCHED_REGIONS = 64
 _Z_OVERLAY, _Z_OUTLINE, _Z_GRAPH, _Z_MARKS, _Z_LABELS = 1, 2, 3, 4, 5
+#: The laid sketch's outlines sit over the map's own outlines, under the graph and the marks.
+_Z_LAID = 2.5
 #: kind -> (fill, outline colour, pen style, z offset above the marks base)
 MARK_STYLES = {
     "anchors": (QColor(0, 0, 0, 0), QColor(215, 0, 150), Qt.PenStyle.DashLine, 0.1),
@@ -56,6 +58,7 @@ class RegionLayers:
         self.overlay = self._image_layer(_Z_OVERLAY)
         self.overlay.setOpacity(0.45)
         self.outlines = self._image_layer(_Z_OUTLINE)
+        self.laid = self._image_layer(_Z_LAID)
         self.graph_item = QGraphicsPathItem()
         self.graph_item.setZValue(_Z_GRAPH)
         self.graph_item.setPen(cosmetic_pen(QColor(20, 60, 160, 200), 1.5))
@@ -93,6 +96,15 @@ class RegionLayers:
             self.outlines.set_image(*mask_qimage(outline_mask(labels), (30, 30, 40, 220)))
             self.graph_item.setPath(_graph_path(graph, labels.shape))
         self._rebuild_ids()
+
+    def set_laid(self, labels: np.ndarray | None, table: np.ndarray | None = None) -> None:
+        """Outline another map's regions laid on this one (``labels`` on this map's pixels),
+        coloured by ``table`` (RGBA rows by region id); None clears the layer."""
+        if labels is None or table is None:
+            self.laid.set_image(QImage())
+            return
+        edge = outline_mask(labels)
+        self.laid.set_image(*lut_qimage(np.where(edge, labels, 0), table))
 
     def set_colours(self, table: np.ndarray) -> None:
         """Colour the overlay with an RGBA table indexed by region id.

@@ -13,7 +13,7 @@ import functools
 import numpy as np
 from PySide6.QtGui import QColor
 
-from ursim_gui.model.view_state import eval_badges, first_regions, side_colour_table
+from ursim_gui.model.view_state import eval_badges, first_regions, laid_sketch_of, side_colour_table
 
 __all__ = ["ViewBinding", "SIDES"]
 
@@ -39,6 +39,10 @@ class ViewBinding:
         # clique and side on every edit.
         self._colour_of = functools.lru_cache(maxsize=4096)(session.color_of_clique)
         self._hovered: tuple[str, int] = ("sketch", 0)
+        # The laid sketch of the last match, made once per match and segmentations (about 15 ms).
+        self._laid_visible = False
+        self._laid_of: tuple = ()
+        self._laid: np.ndarray | None = None
         session.map_changed.connect(self._map_changed)
         session.segmentation_changed.connect(self._segmentation_changed)
         session.correspondences_changed.connect(self._correspondences_changed)
@@ -100,12 +104,14 @@ class ViewBinding:
         self._paint(side)
         self._badges_changed()
         self._update_links()
+        self._show_laid()
 
     def _correspondences_changed(self, *_args) -> None:
         for side in SIDES:
             self._paint(side)
         self._badges_changed()
         self._update_links()
+        self._show_laid()
         self.hover(*self._hovered)  # the hovered region's partners may have changed
 
     def _selection_changed(self, *_args) -> None:
@@ -133,6 +139,33 @@ class ViewBinding:
             index = SIDES.index(side)
             view.set_anchors({pair[index] for pair in self.session.anchors})
             view.set_selection(self.session.selection.get(side, ()))
+
+    def set_laid_visible(self, visible: bool) -> None:
+        """Show or hide the sketch laid on the metric map by the last match (View > Laid sketch)."""
+        self._laid_visible = bool(visible)
+        self._show_laid()
+
+    def _show_laid(self) -> None:
+        view = self.views["metric"]
+        sketch, metric = self.session.segmentation("sketch"), self.session.segmentation("metric")
+        result = self.session.last_match
+        if not self._laid_visible or sketch is None or metric is None or result is None:
+            view.set_laid_sketch(None)
+            return
+        made_of = (result, sketch.labels, metric.labels)
+        if len(self._laid_of) != 3 or any(a is not b for a, b in zip(self._laid_of, made_of)):
+            self._laid_of, self._laid = made_of, laid_sketch_of(result, sketch.labels, metric.labels)
+        if self._laid is None:
+            view.set_laid_sketch(None)
+            return
+        # In the sketch's clique colours, so each laid region shows whose partner it became.
+        max_label = max(sketch.graph.nodes, default=0)
+        table = side_colour_table(
+            self.session.correspondences, "sketch", sketch.labels, self._colour_of, max_label=max_label
+        ).copy()
+        # Darkened: over the metric map's own overlay in the same colours, plain ones would vanish.
+        table[:, :3] = table[:, :3] * 0.45
+        view.set_laid_sketch(self._laid, table)
 
     def _update_links(self) -> None:
         self.connectors.set_links(

@@ -73,13 +73,14 @@ _TOOLBAR = (
     "goal_tool",
     "route_tool",
 )
-_DISPLAY = ("outlines", "region_ids", "graph")
+_DISPLAY = ("outlines", "region_ids", "graph", "laid_sketch")
 #: Display toggles remembered between runs, with their first-run state.
 _TOGGLE_DEFAULTS = {
     "dark_theme": False,
     "outlines": True,
     "region_ids": False,
     "graph": False,
+    "laid_sketch": True,
     "connectors": False,
     "link_zoom": False,
 }
@@ -240,6 +241,7 @@ class MainWindow(QMainWindow):
         a["outlines"].toggled.connect(lambda on: [v.set_outlines_visible(on) for v in self.views.values()])
         a["region_ids"].toggled.connect(lambda on: [v.set_ids_visible(on) for v in self.views.values()])
         a["graph"].toggled.connect(lambda on: [v.set_graph_visible(on) for v in self.views.values()])
+        a["laid_sketch"].toggled.connect(self.binding.set_laid_visible)
         self.segmentation_panel.opacity_changed.connect(
             lambda value: [v.set_overlay_opacity(value) for v in self.views.values()]
         )

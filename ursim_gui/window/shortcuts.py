@@ -97,6 +97,14 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("dark_theme", "&Dark theme", (), "Dark window and map backgrounds (remembered)", "View", checkable=True),
     ActionSpec("graph", "Adjacency &graph", ("G",), "Show the region adjacency graph", "View", checkable=True),
     ActionSpec(
+        "laid_sketch",
+        "&Laid sketch",
+        ("Shift+L",),
+        "Outline the sketch's regions on the metric map where the matcher laid and bent them",
+        "View",
+        checkable=True,
+    ),
+    ActionSpec(
         "merge_regions", "&Merge regions", ("M",), "Merge the regions selected on one map (Ctrl+click them)", "Segment"
     ),
     ActionSpec(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 from conftest import three_room_labels
 
 from ursim_core.correspondences import Clique, Correspondences
@@ -40,3 +41,19 @@ def test_connector_ends_and_badges():
     marks = {1: "tp", 2: "fp"}
     assert eval_badges(corr, "sketch", marks.get) == {1: "TP", 2: "FP"}
     assert eval_badges(corr, "metric", marks.get) == {3: "TP", 2: "FP"}
+
+
+def test_the_laid_sketch_is_made_only_for_a_laid_answer():
+    from types import SimpleNamespace
+
+    from ursim_gui.model.view_state import laid_sketch_of
+
+    labels = three_room_labels()
+    laid = SimpleNamespace(laid=True, orientation=(0.0, False))
+    made = laid_sketch_of(laid, labels, labels)
+    assert made.shape == labels.shape and set(np.unique(made)) <= set(np.unique(labels))
+    # The same map laid on itself: each room lands on itself, but for its rim.
+    for region in (1, 2, 3):
+        assert np.count_nonzero((made == region) & (labels == region)) > 0.8 * np.count_nonzero(labels == region)
+    assert laid_sketch_of(SimpleNamespace(laid=False, orientation=(0.0, False)), labels, labels) is None
+    assert laid_sketch_of(laid, None, labels) is None and laid_sketch_of(None, labels, labels) is None

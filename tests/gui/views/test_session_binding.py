@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 from conftest import hover, region_point
 from PySide6.QtCore import Qt
 
@@ -37,3 +38,27 @@ def test_hover_highlights_partners_in_the_other_view(window, qtbot):
     assert sketch.marked_regions("highlight") == {1}
     window.session.unlink("sketch", 1)  # an edit updates the hovered highlight
     assert sketch.marked_regions("highlight") == set()
+
+
+def test_the_sketch_laid_by_the_last_match_is_outlined_on_the_metric_map(window, qtbot):
+    from ursim_core.matching import MatchConfig
+
+    metric = window.views["metric"]
+    action = window.actions["laid_sketch"]
+    assert action.isChecked() and not metric.has_laid_sketch()  # nothing matched yet
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        window.jobs.match(MatchConfig())
+    qtbot.waitUntil(lambda: window.matching_panel.match_button.isEnabled())
+    assert window.session.last_match.laid and metric.has_laid_sketch()
+    # Drawn in the sketch's clique colours: some outline pixel has a matched region's colour.
+    pixels = metric.layers.laid.pixels()
+    assert pixels is not None and np.count_nonzero(pixels) > 0
+    action.setChecked(False)
+    assert not metric.has_laid_sketch()
+    action.setChecked(True)
+    assert metric.has_laid_sketch()
+    # The graph matcher's own pairs were not laid: nothing to show.
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        window.jobs.match(MatchConfig(elastic="off"))
+    qtbot.waitUntil(lambda: window.matching_panel.match_button.isEnabled())
+    assert not window.session.last_match.laid and not metric.has_laid_sketch()
