@@ -59,6 +59,8 @@ class RegionLayers:
         self.overlay.setOpacity(0.45)
         self.outlines = self._image_layer(_Z_OUTLINE)
         self.laid = self._image_layer(_Z_LAID)
+        # (labels, their outline pixels' ids, colour table) last drawn on the laid layer.
+        self._laid_drawn: tuple = (None, None, None)
         self.graph_item = QGraphicsPathItem()
         self.graph_item.setZValue(_Z_GRAPH)
         self.graph_item.setPen(cosmetic_pen(QColor(20, 60, 160, 200), 1.5))
@@ -101,10 +103,16 @@ class RegionLayers:
         """Outline another map's regions laid on this one (``labels`` on this map's pixels),
         coloured by ``table`` (RGBA rows by region id); None clears the layer."""
         if labels is None or table is None:
+            self._laid_drawn = (None, None, None)
             self.laid.set_image(QImage())
             return
-        edge = outline_mask(labels)
-        self.laid.set_image(*lut_qimage(np.where(edge, labels, 0), table))
+        drawn_labels, edges, drawn_table = self._laid_drawn
+        if labels is not drawn_labels:
+            edges = np.where(outline_mask(labels), labels, 0)
+        elif drawn_table is not None and np.array_equal(table, drawn_table):
+            return  # an edit that recoloured no laid region: nothing to redraw
+        self._laid_drawn = (labels, edges, np.array(table, copy=True))
+        self.laid.set_image(*lut_qimage(edges, table))
 
     def set_colours(self, table: np.ndarray) -> None:
         """Colour the overlay with an RGBA table indexed by region id.
