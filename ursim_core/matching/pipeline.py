@@ -36,6 +36,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
+from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically
 from ursim_core.matching.oriented import (
     candidate_overlaps,
     carried_overlaps,
@@ -126,14 +127,19 @@ def prepare(
     (3, 3)
     """
     prepared = _prepare_one(sketch_seg, metric_seg, config, progress=progress, constraints=constraints)
+    labels = elastic_labels(prepared, sketch_seg, metric_seg, largest=_SCREEN_BY_ASSIGNMENT)
+    answers: dict = {}
+    if labels is not None and getattr(sketch_seg, "resampled", ()) and prepared.config.resampling_vote:
+        # The first segmentation's reading is nearly always the voted one: its sketch is laid on
+        # a thread (OpenCV's flow releases the GIL) while the other segmentations are prepared.
+        # A turned KTH pair 51.8-58.9 -> 42.1-45.7 ms (interleaved x3); with nothing to prepare
+        # meanwhile the thread would only add its start.
+        answers[prepared.orientation] = LaidAhead(prepared, *labels, prepared.orientation)
     prepared = with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
-    if prepared.config.elastic != "off" and prepared.config.matcher == "planar":
-        sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
-        # Sketch-sized maps only: at the working size (512 px) a building's thousands of regions
-        # would be a few pixels wide, and its graph answer is not screened by orientation alike.
-        small = max(prepared.c_matrix.shape) <= _SCREEN_BY_ASSIGNMENT
-        if sketch_labels is not None and metric_labels is not None and small:
-            prepared = dataclasses.replace(prepared, sketch_labels=sketch_labels, metric_labels=metric_labels)
+    if labels is not None:
+        prepared = dataclasses.replace(
+            prepared, sketch_labels=labels[0], metric_labels=labels[1], elastic_answers=answers
+        )
     return prepared
 
 
@@ -420,35 +426,7 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
         result = _match_one(prepared, m, progress=progress)
     if prepared.sketch_labels is None:
         return result
-    return _laid_elastically(prepared, result)
-
-
-def _laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
-    """``result`` with the pairs of the sketch laid elastically in its orientation
-    (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`), within the constraints."""
-    from ursim_core.matching.elastic import elastic_pairs
-    from ursim_core.matching.overlay import constrained_pairs
-
-    orientation = tuple(result.orientation)
-    if orientation not in prepared.elastic_answers:
-        degrees, mirrored = orientation
-        prepared.elastic_answers[orientation] = elastic_pairs(
-            prepared.sketch_labels,
-            prepared.metric_labels,
-            degrees=degrees,
-            mirrored=mirrored,
-            min_iou=prepared.config.overlay_min_iou,
-        )
-    pairs = prepared.elastic_answers[orientation]
-    if prepared.config.elastic == "completed":
-        # Regions the overlay leaves alone on both sides keep the graph answer's pairs: a small
-        # region the bent sketch misses still has its partner (a stub, a cut-off room).
-        sketch_paired, metric_paired = {a for a, _ in pairs}, {b for _, b in pairs}
-        pairs = sorted(
-            set(pairs) | {(a, b) for a, b in result.pairs if a not in sketch_paired and b not in metric_paired}
-        )
-    pairs = constrained_pairs(pairs, prepared.constraints)
-    return replaced(result, pairs=pairs, laid=True)
+    return laid_elastically(prepared, result)
 
 
 def _match_one(prepared: Prepared, m: float | None = None, *, progress=None) -> MatchResult:

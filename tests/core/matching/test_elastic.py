@@ -115,3 +115,31 @@ def test_building_sized_maps_keep_the_graph_answer():
     result = match(sketch, metric, config=told)
     assert not result.laid
     assert sorted(result.pairs) == sorted(match(sketch, metric, config=told.replace(elastic="off")).pairs)
+
+
+def test_a_resampled_sketch_is_laid_while_its_other_segmentations_are_prepared():
+    # The first segmentation's laying runs on a thread (matching.laid.LaidAhead): the answer holds
+    # the same laid pairs as a laying made afterwards, in the orientation voted.
+    from ursim_core.evaluation.augment import Orientation, transform_image
+    from ursim_core.matching import match_prepared, prepare
+    from ursim_core.segmentation import segment_canonical
+    from ursim_core.synth import make_pair
+
+    plan, sketch = make_pair(seed=3)
+    metric = segment_canonical(plan.free, preset="default")
+    turned = segment_canonical(transform_image(sketch.free, Orientation(30.0)), preset="default", resampled=True)
+    prepared = prepare(turned, metric)
+    assert prepared.resampled is not None and prepared.elastic_answers  # started ahead
+    result = match_prepared(prepared)
+    degrees, mirrored = result.orientation
+    alone = elastic_pairs(turned.labels, metric.labels, degrees=degrees, mirrored=mirrored)
+    assert result.laid and alone and set(alone) <= set(result.pairs)
+
+
+def test_a_failed_laying_ahead_is_raised_where_its_pairs_are_read():
+    from ursim_core.matching.laid import LaidAhead
+
+    prepared = type("P", (), {"config": MatchConfig()})()
+    ahead = LaidAhead(prepared, np.zeros((4, 4), np.int32), "not a label image", (0.0, False))
+    with pytest.raises(Exception):
+        ahead.pairs()
