@@ -158,10 +158,7 @@ class MatchingPanel(QWidget):
             "the automatic matcher then lays the maps on each other (overlay), and the input may cover "
             "any part of the metric map; leave it unknown for a sketch"
         )
-        self.scale.setEnabled(self.matcher.currentData() in _SCALED_MATCHERS)
-        self.matcher.currentIndexChanged.connect(
-            lambda _: self.scale.setEnabled(self.matcher.currentData() in _SCALED_MATCHERS)
-        )
+        self._enabled_for(self.scale, _SCALED_MATCHERS)
         form.addRow("Scale", self.scale)
         # What the input map is: a robot map makes the automatic matcher overlay the maps (a
         # campaign of robot maps says so for each pair).
@@ -170,10 +167,7 @@ class MatchingPanel(QWidget):
             "What the input (left) map is: a robot map or a plan drawn to scale makes the automatic "
             "matcher lay the maps on each other (overlay); a sketch is matched by its structure (planar)"
         )
-        self.input_kind.setEnabled(self.matcher.currentData() == "auto")
-        self.matcher.currentIndexChanged.connect(
-            lambda _: self.input_kind.setEnabled(self.matcher.currentData() == "auto")
-        )
+        self._enabled_for(self.input_kind, ("auto",))
         form.addRow("Input", self.input_kind)
         self.pairs_from = _combo("match_pairs_from", PAIRS_FROM)
         self.pairs_from.setToolTip(
@@ -182,10 +176,7 @@ class MatchingPanel(QWidget):
             "overlap (hand-drawn rooms out of proportion still land on theirs), or the graph matcher's "
             "own answer"
         )
-        self.pairs_from.setEnabled(self.matcher.currentData() in _ELASTIC_MATCHERS)
-        self.matcher.currentIndexChanged.connect(
-            lambda _: self.pairs_from.setEnabled(self.matcher.currentData() in _ELASTIC_MATCHERS)
-        )
+        self._enabled_for(self.pairs_from, _ELASTIC_MATCHERS)
         form.addRow("Pairs", self.pairs_from)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
@@ -243,6 +234,11 @@ class MatchingPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.addWidget(box)
         layout.addStretch(1)
+
+    def _enabled_for(self, widget: QWidget, matchers) -> None:
+        """Keep ``widget`` enabled only while the matcher chosen is one of ``matchers``."""
+        widget.setEnabled(self.matcher.currentData() in matchers)
+        self.matcher.currentIndexChanged.connect(lambda _: widget.setEnabled(self.matcher.currentData() in matchers))
 
     def config(self):
         """The ``MatchConfig`` the widgets describe."""
