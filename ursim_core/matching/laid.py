@@ -33,12 +33,12 @@ class LaidAhead:
     the start; :meth:`pairs` waits for it. The same pairs as a call made later (no shared state
     but the metric map's memo of its working image)."""
 
-    def __init__(self, prepared: Prepared, sketch_labels, metric_labels, orientation) -> None:
+    def __init__(self, sketch_labels, metric_labels, orientation, min_iou: float) -> None:
         import threading
 
         self._pairs: list | None = None
         self._error: BaseException | None = None
-        arguments = (sketch_labels, metric_labels, orientation, prepared.config.overlay_min_iou)
+        arguments = (sketch_labels, metric_labels, orientation, min_iou)
         self._thread = threading.Thread(target=self._run, args=arguments, daemon=True)
         self._thread.start()
 

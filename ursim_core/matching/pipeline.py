@@ -134,7 +134,7 @@ def prepare(
         # a thread (OpenCV's flow releases the GIL) while the other segmentations are prepared.
         # A turned KTH pair 51.8-58.9 -> 42.1-45.7 ms (interleaved x3); with nothing to prepare
         # meanwhile the thread would only add its start.
-        answers[prepared.orientation] = LaidAhead(prepared, *labels, prepared.orientation)
+        answers[prepared.orientation] = LaidAhead(*labels, prepared.orientation, prepared.config.overlay_min_iou)
     prepared = with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
     if labels is not None:
         prepared = dataclasses.replace(

@@ -139,7 +139,6 @@ def test_a_resampled_sketch_is_laid_while_its_other_segmentations_are_prepared()
 def test_a_failed_laying_ahead_is_raised_where_its_pairs_are_read():
     from ursim_core.matching.laid import LaidAhead
 
-    prepared = type("P", (), {"config": MatchConfig()})()
-    ahead = LaidAhead(prepared, np.zeros((4, 4), np.int32), "not a label image", (0.0, False))
+    ahead = LaidAhead(np.zeros((4, 4), np.int32), "not a label image", (0.0, False), 0.15)
     with pytest.raises(Exception):
         ahead.pairs()
