@@ -112,10 +112,14 @@ def elastic_flow(fixed_free: np.ndarray, moving_free: np.ndarray, *, clip: float
     >>> round(float(np.median(flow[20:44, 20:44, 0])))
     3
     """
+    return _dis_flow(_flow_image(fixed_free, clip), _flow_image(moving_free, clip))
+
+
+def _dis_flow(fixed_image: np.ndarray, moving_image: np.ndarray) -> np.ndarray:
+    """OpenCV's DIS flow, medium preset (the one setting cross-validated, round 43), of two 8-bit images."""
     import cv2
 
-    dis = cv2.DISOpticalFlow_create(cv2.DISOPTICAL_FLOW_PRESET_MEDIUM)
-    return dis.calc(_flow_image(fixed_free, clip), _flow_image(moving_free, clip), None)
+    return cv2.DISOpticalFlow_create(cv2.DISOPTICAL_FLOW_PRESET_MEDIUM).calc(fixed_image, moving_image, None)
 
 
 def _flow_image(free: np.ndarray, clip: float) -> np.ndarray:
@@ -125,7 +129,8 @@ def _flow_image(free: np.ndarray, clip: float) -> np.ndarray:
 
 #: The metric map at the working size and its flow image, for the last label image seen: an
 #: evaluation or a campaign matches many sketches against one map (a weak reference, so a new
-#: array at a freed address is never mistaken for it).
+#: array at a freed address is never mistaken for it). Label images are not changed in place: the
+#: app's edits and every segmenter make new arrays.
 _METRIC_MEMO: dict = {}
 
 
@@ -252,8 +257,7 @@ def _bent(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip:
     row_scale, col_scale = (m1 - m0) / (r1 - r0), (n1 - n0) / (c1 - c0)
     laying = np.array([[col_scale, 0.0, n0 - col_scale * c0], [0.0, row_scale, m0 - row_scale * r0]])
     laid = cv2.warpAffine(sketch.astype(np.float32), laying, shape[::-1], flags=cv2.INTER_NEAREST)
-    dis = cv2.DISOpticalFlow_create(cv2.DISOPTICAL_FLOW_PRESET_MEDIUM)
-    flow = dis.calc(metric_image, _flow_image(laid > 0, clip), None)
+    flow = _dis_flow(metric_image, _flow_image(laid > 0, clip))
     rows, cols = np.indices(shape, dtype=np.float32)
     bent = cv2.remap(laid, cols + flow[..., 0], rows + flow[..., 1], cv2.INTER_NEAREST)
     return bent.astype(np.int64), metric
