@@ -41,8 +41,10 @@ class ViewBinding:
         self._hovered: tuple[str, int] = ("sketch", 0)
         # The laid sketch of the last match, made once per match and segmentations (about 15 ms).
         self._laid_visible = False
-        self._laid_of: tuple = ()
+        self._laid_of: tuple = (None, None, None)
         self._laid: np.ndarray | None = None
+        # The sketch's colour table as last painted: the laid sketch is drawn in it too.
+        self._sketch_colours: np.ndarray | None = None
         session.map_changed.connect(self._map_changed)
         session.segmentation_changed.connect(self._segmentation_changed)
         session.correspondences_changed.connect(self._correspondences_changed)
@@ -136,6 +138,8 @@ class ViewBinding:
                 self.session.correspondences, side, segmentation.labels, self._colour_of, max_label=max_label
             )
             view.set_region_colours(table)
+            if side == "sketch":
+                self._sketch_colours = table
             index = SIDES.index(side)
             view.set_anchors({pair[index] for pair in self.session.anchors})
             view.set_selection(self.session.selection.get(side, ()))
@@ -153,17 +157,15 @@ class ViewBinding:
             view.set_laid_sketch(None)
             return
         made_of = (result, sketch.labels, metric.labels)
-        if len(self._laid_of) != 3 or any(a is not b for a, b in zip(self._laid_of, made_of)):
+        if any(a is not b for a, b in zip(self._laid_of, made_of)):
             self._laid_of, self._laid = made_of, laid_sketch_of(result, sketch.labels, metric.labels)
-        if self._laid is None:
+        if self._laid is None or self._sketch_colours is None:
             view.set_laid_sketch(None)
             return
-        # In the sketch's clique colours, so each laid region shows whose partner it became.
-        max_label = max(sketch.graph.nodes, default=0)
-        table = side_colour_table(
-            self.session.correspondences, "sketch", sketch.labels, self._colour_of, max_label=max_label
-        ).copy()
-        # Darkened: over the metric map's own overlay in the same colours, plain ones would vanish.
+        # In the sketch's clique colours as painted (each laid region shows whose partner it
+        # became), darkened: over the metric map's own overlay in the same colours, plain ones
+        # would vanish.
+        table = self._sketch_colours.copy()
         table[:, :3] = table[:, :3] * 0.45
         view.set_laid_sketch(self._laid, table)
 
