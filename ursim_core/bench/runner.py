@@ -28,6 +28,7 @@ def run_bench(
     csv: str | Path | None = None,
     seeds: int = 8,
     first_seed: int = 0,
+    told: bool = False,
 ) -> int:
     """Run the benchmarks named by ``what`` and print figures.
 
@@ -37,7 +38,8 @@ def run_bench(
     every preset on maoris_segmentation, :mod:`ursim_core.bench.quality`; ``csv``: also the rows)
     or 'invariance' (matching accuracy on ``seeds`` generated pairs turned, mirrored, cropped and
     rescaled, :mod:`ursim_core.bench.invariance`; ``first_seed``: the first of them, so that pairs not
-    looked at while tuning can be held out, e.g. seeds 8-15) or 'review' (edits of a simulated
+    looked at while tuning can be held out, e.g. seeds 8-15; ``told``: the matcher is also told each
+    case's orientation, a second table) or 'review' (edits of a simulated
     annotator on the KTH sketches, :mod:`ursim_core.bench.review`).
     ``sizes``: the building sides of 'scale' (default :data:`SCALE_SIZES`).
     Returns the exit code: 1 when the benchmark is not available.
@@ -96,6 +98,12 @@ def run_bench(
             "(issue 11 bar: mean F1 >= 0.95)"
         )
         print_invariance(bench_invariance(chosen))
+        if told:
+            print(
+                "== the same pairs, the matcher told each sketch's orientation (what a right reading of every "
+                "case would score; `--orientation` and `--mirrored` of `ursim match`)"
+            )
+            print_invariance(bench_invariance(chosen, told=True))
         from ursim_core.matching import MatchConfig
 
         print(

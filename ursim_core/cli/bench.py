@@ -11,6 +11,7 @@ EXAMPLES = """examples:
   ursim bench scale --sizes 1000 2000 4000
   ursim bench invariance --seeds 12
   ursim bench invariance --seeds 8 --first-seed 8
+  ursim bench invariance --seeds 8 --told
   ursim bench review
   ursim bench all --datasets ../shared/datasets"""
 
@@ -64,6 +65,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="invariance: the first pair's seed (default 0; 8 with --seeds 8 holds out seeds 8-15)",
     )
     parser.add_argument(
+        "--told",
+        action="store_true",
+        help="invariance: also match the same pairs told each sketch's orientation (the share of the gap "
+        "that is the orientation's)",
+    )
+    parser.add_argument(
         "--sizes",
         type=int,
         nargs="+",
@@ -83,4 +90,5 @@ def run(args: argparse.Namespace) -> int:
         csv=args.csv,
         seeds=args.seeds,
         first_seed=args.first_seed,
+        told=args.told,
     )

@@ -63,3 +63,30 @@ def test_the_undoing_orientation_brings_the_points_back():
         back = np.asarray(moved, float) @ matrix.T
         offsets = back - np.asarray(points, float)
         np.testing.assert_allclose(offsets, offsets[:1].repeat(len(points), axis=0), atol=1.5)
+
+
+@pytest.mark.parametrize("kind", ["cropped", "all"])
+def test_told_the_orientation_the_matcher_reads_the_sketch_so(kind):
+    # Seed 1 cropped is read as a mirror image when nothing is told (round 44); told, every case
+    # is read in the orientation that undoes its transformation, whatever the matcher would rank.
+    case = run_case(1, kind, told=True)
+    assert case.read_right, case
+
+
+def test_the_bench_prints_the_told_table_after_the_default_one(monkeypatch, capsys):
+    import ursim_core.bench.invariance as invariance
+    from ursim_core.bench.runner import run_bench
+
+    calls = []
+
+    def fake(seeds, kinds=KINDS, *, config=None, progress=None, plan_copy=False, told=False):
+        calls.append((tuple(seeds), told, plan_copy))
+        return [invariance.InvarianceCase(seeds[0], kind, 0.0, False, 1.0, 1.0, 1.0, 1.0) for kind in kinds]
+
+    monkeypatch.setattr(invariance, "bench_invariance", fake)
+    assert run_bench("invariance", seeds=2, first_seed=4, told=True) == 0
+    assert calls == [((4, 5), False, False), ((4, 5), True, False), ((4, 5), False, True)]
+    assert "told each sketch's orientation" in capsys.readouterr().out
+    calls.clear()
+    run_bench("invariance", seeds=2, first_seed=4)
+    assert [told for _, told, _ in calls] == [False, False]
