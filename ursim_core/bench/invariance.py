@@ -218,7 +218,7 @@ def bench_invariance(
             )
             cases.append(case)
             if progress is not None:
-                progress(cases[-1])
+                progress(case)
     return cases
 
 
