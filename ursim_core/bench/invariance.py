@@ -141,13 +141,22 @@ def transformed_sketch(free: np.ndarray, points, *, degrees=0.0, mirrored=False,
 
 
 def run_case(
-    seed: int, kind: str, *, config=None, plan_segmentation=None, plan_copy: bool = False, told: bool = False
+    seed: int,
+    kind: str,
+    *,
+    config=None,
+    plan_segmentation=None,
+    plan_copy: bool = False,
+    told: bool = False,
+    segmentations: dict | None = None,
 ) -> InvarianceCase:
     """Generate pair ``seed``, transform its sketch as ``kind`` says, match and score it.
 
     ``plan_copy``: transform a copy of the floor plan instead of the sketch (a robot-map-like
     input: exact walls, only part of the building when cropped). ``told``: the matcher is told the
-    orientation that undoes the transformation (``MatchConfig.orientation`` and ``mirrored``)."""
+    orientation that undoes the transformation (``MatchConfig.orientation`` and ``mirrored``).
+    ``segmentations``: a dict that keeps the transformed sketch's segmentation for a later call
+    on the same case (it does not depend on what the matcher is told)."""
     from ursim_core.correspondences import regions_at_points
     from ursim_core.evaluation.scoring import place_problem, score_matches, score_places
     from ursim_core.matching import MatchConfig, match
@@ -179,7 +188,12 @@ def run_case(
     # As ursim match: a sketch turned onto its wall axes is also segmented in its other
     # resamplings when the planar matcher will vote over them.
     resampled = config.resampling_vote and config.resolved().matcher == "planar"
-    sketch_seg = segment_canonical(image, preset="default", resampled=resampled)
+    key = (seed, kind, plan_copy, resampled)
+    sketch_seg = segmentations.get(key) if segmentations is not None else None
+    if sketch_seg is None:
+        sketch_seg = segment_canonical(image, preset="default", resampled=resampled)
+        if segmentations is not None:
+            segmentations[key] = sketch_seg
     metric_seg = plan_segmentation if plan_segmentation is not None else segment_canonical(plan.free, preset="default")
     result = match(sketch_seg, metric_seg, config=config)
     points = iter(moved)
@@ -201,20 +215,37 @@ def run_case(
 
 
 def bench_invariance(
-    seeds=range(8), kinds=KINDS, *, config=None, progress=None, plan_copy: bool = False, told: bool = False
+    seeds=range(8),
+    kinds=KINDS,
+    *,
+    config=None,
+    progress=None,
+    plan_copy: bool = False,
+    told: bool = False,
+    segmentations: dict | None = None,
 ) -> list[InvarianceCase]:
-    """Every kind for every seed (the plan of a seed segmented once); ``plan_copy`` and ``told``:
-    see :func:`run_case`."""
+    """Every kind for every seed (the plan of a seed segmented once); ``plan_copy``, ``told`` and
+    ``segmentations`` (the plans' segmentations kept there too): see :func:`run_case`."""
     from ursim_core.segmentation import segment_canonical
     from ursim_core.synth import make_pair
 
     cases = []
     for seed in seeds:
-        plan, _ = make_pair(seed=seed)
-        plan_segmentation = segment_canonical(plan.free, preset="default")
+        plan_segmentation = (segmentations or {}).get(("plan", seed))
+        if plan_segmentation is None:
+            plan, _ = make_pair(seed=seed)
+            plan_segmentation = segment_canonical(plan.free, preset="default")
+            if segmentations is not None:
+                segmentations["plan", seed] = plan_segmentation
         for kind in kinds:
             case = run_case(
-                seed, kind, config=config, plan_segmentation=plan_segmentation, plan_copy=plan_copy, told=told
+                seed,
+                kind,
+                config=config,
+                plan_segmentation=plan_segmentation,
+                plan_copy=plan_copy,
+                told=told,
+                segmentations=segmentations,
             )
             cases.append(case)
             if progress is not None:

@@ -79,14 +79,30 @@ def test_the_bench_prints_the_told_table_after_the_default_one(monkeypatch, caps
 
     calls = []
 
-    def fake(seeds, kinds=KINDS, *, config=None, progress=None, plan_copy=False, told=False):
+    shared = []
+
+    def fake(seeds, kinds=KINDS, *, config=None, progress=None, plan_copy=False, told=False, segmentations=None):
         calls.append((tuple(seeds), told, plan_copy))
+        shared.append(segmentations)
         return [invariance.InvarianceCase(seeds[0], kind, 0.0, False, 1.0, 1.0, 1.0, 1.0) for kind in kinds]
 
     monkeypatch.setattr(invariance, "bench_invariance", fake)
     assert run_bench("invariance", seeds=2, first_seed=4, told=True) == 0
     assert calls == [((4, 5), False, False), ((4, 5), True, False), ((4, 5), False, True)]
     assert "told each sketch's orientation" in capsys.readouterr().out
+    # The told table reuses the first table's segmentations; the robot-map copies are other images.
+    assert shared[0] is shared[1] and isinstance(shared[0], dict) and shared[2] is None
     calls.clear()
     run_bench("invariance", seeds=2, first_seed=4)
     assert [told for _, told, _ in calls] == [False, False]
+
+
+def test_a_case_matched_again_reuses_its_segmentation_and_scores_the_same():
+    kept = {}
+    first = run_case(2, "turned", segmentations=kept)
+    assert len(kept) == 1
+    (segmentation,) = kept.values()
+    again = run_case(2, "turned", segmentations=kept)
+    assert kept == {next(iter(kept)): segmentation} and again == first
+    told = run_case(2, "turned", told=True, segmentations=kept)
+    assert len(kept) == 1 and told.read_right
