@@ -264,6 +264,15 @@ class MatchConfig:
         and keeps 3), at free angles 4 in every fold, held out 0.74 / 0.74 (in sample 0.7366 /
         0.7411 -> 0.7380 / 0.7428). A fourth full sweep: 9 % more time per upright KTH pair,
         17 % per turned one (``ursim bench match``).
+    adjacency_penalty : float
+        With ``orientation='any'``, each finalist reading's rank value is multiplied by 1 + this
+        times the share of its answer's sketch adjacencies that the answer breaks
+        (:func:`~ursim_core.matching.orientation.broken_adjacencies`); 0 = not. A half turn or
+        mirror image of a partial sketch of rooms along a corridor can fit the room sizes better
+        than the right reading, but joins rooms that are not neighbours. Round 44: every KTH row
+        the same with 0.5-4 (8 orientations and 23 free angles), so the KTH sketches cannot choose
+        it; chosen on generated seeds 0-31 (``ursim bench invariance``: 0.918 -> 0.926 with 2 or 4,
+        0.5 and 1 less), held out seeds 32-63 0.874 -> 0.886 and 64-95 0.915 -> 0.923.
     scale : float or None
         Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
         resolution), for the overlay matcher: it then searches any placement, so either map may
@@ -325,6 +334,7 @@ class MatchConfig:
     mirrored: bool | None = None
     orientation_overlap: float = 1.0
     orientation_finalists: int = 4
+    adjacency_penalty: float = 2.0
     scale: float | None = None
     overlay_min_iou: float = 0.15
     overlay_angle_step: float = 2.0
@@ -367,6 +377,7 @@ class MatchConfig:
             "size_weight_floor",
             "vf2_timeout",
             "orientation_overlap",
+            "adjacency_penalty",
             "overlay_min_iou",
             "overlay_angle_step",
         ):
@@ -442,6 +453,7 @@ class MatchConfig:
             position_weight=0.0,
             position_refits=0,
             elastic="off",
+            adjacency_penalty=0.0,
             signature_refit=False,
             resampling_vote=False,
             hypothesis_score="structure",
@@ -478,6 +490,7 @@ class MatchConfig:
             position_weight=0.0,
             position_refits=0,
             elastic="off",
+            adjacency_penalty=0.0,
             signature_refit=False,
             resampling_vote=False,
             hypothesis_score="substitutions",

@@ -47,6 +47,7 @@ __all__ = [
     "next_reading",
     "CLOSE_READING",
     "describe_gap",
+    "broken_adjacencies",
 ]
 
 
@@ -118,6 +119,36 @@ def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[flo
     best = min(own)
     value, tried = min(others)
     return (float(tried[0]), bool(tried[1])), round((value - best) / best, 12)
+
+
+def broken_adjacencies(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) -> float:
+    """The share of an answer's sketch adjacencies that it breaks: of the edges of ``sketch_graph``
+    whose two regions are both paired, those neither of whose partners are the same metric region
+    or adjacent in ``metric_graph``. 0 when no such edge exists.
+
+    A reading of a sketch of rooms along a corridor turned by a half turn, or mirrored, lays the
+    room sizes of one row on the other. Its rooms can fit as well as the right reading's, but the
+    doors between neighbouring rooms then join rooms that are not neighbours on the map
+    (``MatchConfig.adjacency_penalty``, docs/studies.md, round 44).
+
+    Examples
+    --------
+    >>> sketch = nx.Graph([(1, 2), (2, 3)]); metric = nx.Graph([(7, 8), (8, 9)])
+    >>> broken_adjacencies([(1, 7), (2, 8), (3, 9)], sketch, metric)
+    0.0
+    >>> broken_adjacencies([(1, 7), (2, 9), (3, 8)], sketch, metric)
+    0.5
+    >>> broken_adjacencies([(1, 7), (2, 7), (3, 8)], sketch, metric), broken_adjacencies([], sketch, metric)
+    (0.0, 0.0)
+    """
+    partners: dict = {}
+    for sketch_region, metric_region in pairs:
+        partners.setdefault(sketch_region, set()).add(metric_region)
+    edges = [(u, v) for u, v in sketch_graph.edges() if u != v and u in partners and v in partners]
+    if not edges:
+        return 0.0
+    kept = sum(any(a == b or metric_graph.has_edge(a, b) for a in partners[u] for b in partners[v]) for u, v in edges)
+    return 1.0 - kept / len(edges)
 
 
 def describe_gap(gap: float) -> str:

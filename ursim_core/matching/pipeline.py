@@ -37,6 +37,7 @@ from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
 from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically
+from ursim_core.matching.orientation import broken_adjacencies
 from ursim_core.matching.oriented import (
     candidate_overlaps,
     carried_overlaps,
@@ -248,7 +249,12 @@ def _prepare_one(
         refitted, answer = _refitted(prepared, result, starts)
         # Ranked by the refitted answer's score either way; keep_refit=False keeps the first answer.
         kept = (refitted, answer) if config.keep_refit else (prepared, result)
-        trials.append((ranked(answer.normalised_cost, index), index, *kept))
+        cost = answer.normalised_cost
+        if config.adjacency_penalty:
+            # A reading that joins rooms that are not neighbours ranks worse (round 44).
+            broken = broken_adjacencies(answer.pairs, prepared.sketch_graph, prepared.metric_graph)
+            cost *= 1.0 + config.adjacency_penalty * broken
+        trials.append((ranked(cost, index), index, *kept))
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(

@@ -13,7 +13,13 @@ from ursim_core.errors import ParameterError
 from ursim_core.evaluation import augment
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match, prepare
-from ursim_core.matching.orientation import orientation_candidates, oriented_graph, region_outlines, transform_points
+from ursim_core.matching.orientation import (
+    broken_adjacencies,
+    orientation_candidates,
+    oriented_graph,
+    region_outlines,
+    transform_points,
+)
 from ursim_core.matching.positions import region_positions
 from ursim_core.segmentation import region_graph, segment_canonical
 from ursim_core.segmentation.canonical import _turned
@@ -163,6 +169,39 @@ def test_the_best_screened_orientations_get_the_full_sweep():
     assert [len(tried[k]) for k in (1, 3, 4, 8)] == [1, 3, 4, 8]
     assert set(tried[1]) < set(tried[3]) < set(tried[4]) < set(tried[8])
     assert MatchConfig().orientation_finalists == 4
+
+
+def test_config_validates_adjacency_penalty():
+    for bad in (-1, float("nan"), True, "2"):
+        with pytest.raises(ParameterError, match="adjacency_penalty"):
+            MatchConfig(adjacency_penalty=bad)
+    # The paper's method and the released code's options rank by their own score alone.
+    assert MatchConfig.paper().adjacency_penalty == 0 == MatchConfig.released().adjacency_penalty
+
+
+def test_broken_adjacencies_counts_edges_whose_partners_are_not_neighbours():
+    sketch = nx.Graph([(1, 2), (2, 3), (3, 4)])
+    metric = nx.Graph([(10, 11), (11, 12)])
+    # Region 4 is unpaired, so its edge does not count; one neighbouring partner of a region
+    # paired twice is enough.
+    assert broken_adjacencies([(1, 10), (2, 11), (2, 12), (3, 10)], sketch, metric) == 0.0
+    # (1, 2) lands on 10 and 12, which do not touch; (2, 3) on 12 and 11, which do.
+    assert broken_adjacencies([(1, 10), (2, 12), (3, 11)], sketch, metric) == pytest.approx(0.5)
+    assert broken_adjacencies([(1, 12), (2, 10), (3, 12), (4, 10)], sketch, metric) == pytest.approx(1.0)
+    assert broken_adjacencies([(1, 10)], sketch, metric) == 0.0
+
+
+def test_a_reading_that_breaks_adjacencies_ranks_worse_by_the_penalty():
+    sketch_seg, metric_seg = _generated_segmentations(1)
+    plain = prepare(sketch_seg, metric_seg, MatchConfig(adjacency_penalty=0.0)).orientation_scan
+    penalised = prepare(sketch_seg, metric_seg, MatchConfig(adjacency_penalty=2.0)).orientation_scan
+    assert set(penalised) == set(plain) and len(plain) > 1
+    # The answers do not depend on the penalty, only their rank values: 1 to 3 times as high.
+    for orientation, value in plain.items():
+        assert value - 1e-12 <= penalised[orientation] <= 3 * value + 1e-12, orientation
+    best = min(plain, key=plain.get)
+    assert penalised[best] == pytest.approx(plain[best])  # the right reading keeps every door
+    assert any(penalised[o] > plain[o] * 1.01 for o in plain)  # the others break some
 
 
 # --- invariance of the whole pipeline on generated pairs (ground truth transformed alike) ---
