@@ -270,7 +270,7 @@ class MatchConfig:
         (:func:`~ursim_core.matching.orientation.broken_adjacencies`); 0 = not. A half turn or
         mirror image of a partial sketch of rooms along a corridor can fit the room sizes better
         than the right reading, but joins rooms that are not neighbours. Round 44: every KTH row
-        the same with 0.5-4 (8 orientations and 23 free angles), so the KTH sketches cannot choose
+        the same with 0.5-4 (8 orientations; 2 at 23 free angles), so the KTH sketches cannot choose
         it; chosen on generated seeds 0-31 (``ursim bench invariance``: 0.918 -> 0.926 with 2 or 4,
         0.5 and 1 less), held out seeds 32-63 0.874 -> 0.886 and 64-95 0.915 -> 0.923.
     scale : float or None
