@@ -271,8 +271,8 @@ class MatchConfig:
         mirror image of a partial sketch of rooms along a corridor can fit the room sizes better
         than the right reading, but joins rooms that are not neighbours. Round 44: every KTH row
         the same with 0.5-4 (8 orientations; 2 at 23 free angles), so the KTH sketches cannot choose
-        it; chosen on generated seeds 0-31 (``ursim bench invariance``: 0.918 -> 0.926 with 2 or 4,
-        0.5 and 1 less), held out seeds 32-63 0.874 -> 0.886 and 64-95 0.915 -> 0.923.
+        it; chosen on generated seeds 0-31 (``ursim bench invariance``: 0.918 -> 0.926 with 2, 4 or 8,
+        0.921 with 0.5 or 1), held out seeds 32-63 0.874 -> 0.886 and 64-95 0.915 -> 0.923.
     scale : float or None
         Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
         resolution), for the overlay matcher: it then searches any placement, so either map may

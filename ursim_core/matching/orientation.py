@@ -123,8 +123,8 @@ def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[flo
 
 def broken_adjacencies(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) -> float:
     """The share of an answer's sketch adjacencies that it breaks: of the edges of ``sketch_graph``
-    whose two regions are both paired, those neither of whose partners are the same metric region
-    or adjacent in ``metric_graph``. 0 when no such edge exists.
+    whose two regions are both paired, those whose regions have no partners that are one and the
+    same metric region or adjacent in ``metric_graph``. 0 when no such edge exists.
 
     A reading of a sketch of rooms along a corridor turned by a half turn, or mirrored, lays the
     room sizes of one row on the other. Its rooms can fit as well as the right reading's, but the
