@@ -140,6 +140,16 @@ def transformed_sketch(free: np.ndarray, points, *, degrees=0.0, mirrored=False,
     return image >= 128, moved
 
 
+def _kept(segmentations: dict | None, key, make):
+    """``make()``, kept in ``segmentations`` under ``key`` and taken from there again (made every
+    time when ``segmentations`` is None)."""
+    if segmentations is None:
+        return make()
+    if key not in segmentations:
+        segmentations[key] = make()
+    return segmentations[key]
+
+
 def run_case(
     seed: int,
     kind: str,
@@ -184,16 +194,15 @@ def run_case(
     config = config or MatchConfig()
     if told:
         right_degrees, right_mirrored = undoing_orientation(degrees, mirrored)
-        config = dataclasses.replace(config, orientation=right_degrees, mirrored=right_mirrored)
+        config = config.replace(orientation=right_degrees, mirrored=right_mirrored)
     # As ursim match: a sketch turned onto its wall axes is also segmented in its other
     # resamplings when the planar matcher will vote over them.
     resampled = config.resampling_vote and config.resolved().matcher == "planar"
-    key = (seed, kind, plan_copy, resampled)
-    sketch_seg = segmentations.get(key) if segmentations is not None else None
-    if sketch_seg is None:
-        sketch_seg = segment_canonical(image, preset="default", resampled=resampled)
-        if segmentations is not None:
-            segmentations[key] = sketch_seg
+    sketch_seg = _kept(
+        segmentations,
+        (seed, kind, plan_copy, resampled),
+        lambda: segment_canonical(image, preset="default", resampled=resampled),
+    )
     metric_seg = plan_segmentation if plan_segmentation is not None else segment_canonical(plan.free, preset="default")
     result = match(sketch_seg, metric_seg, config=config)
     points = iter(moved)
@@ -231,12 +240,9 @@ def bench_invariance(
 
     cases = []
     for seed in seeds:
-        plan_segmentation = (segmentations or {}).get(("plan", seed))
-        if plan_segmentation is None:
-            plan, _ = make_pair(seed=seed)
-            plan_segmentation = segment_canonical(plan.free, preset="default")
-            if segmentations is not None:
-                segmentations["plan", seed] = plan_segmentation
+        plan_segmentation = _kept(
+            segmentations, ("plan", seed), lambda: segment_canonical(make_pair(seed=seed)[0].free, preset="default")
+        )
         for kind in kinds:
             case = run_case(
                 seed,
