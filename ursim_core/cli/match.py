@@ -407,6 +407,7 @@ def match_pair(
         "orientation": result.orientation,
         "resampling_votes": result.resampling_votes,
         "laid": result.laid,
+        "laid_by": result.laying.by if result.laid and result.laying is not None else "",
         **next_reading_record(result),
         "out": out,
     }
@@ -451,6 +452,7 @@ def run(args: argparse.Namespace) -> int:
         f"{record['orientation'][0]:.1f} deg{' mirrored' if record['orientation'][1] else ''}"
         + (f", voted over {record['resampling_votes']} resamplings" if record["resampling_votes"] else "")
         + (", pairs from the sketch laid and bent onto the map" if record["laid"] else "")
+        + (" where the graph answer puts it" if record["laid_by"] == "answer" else "")
         + f", {record['match_ms']:.1f} ms"
         + (f"; {record['reason']}" if record["reason"] else "")
     )

@@ -47,6 +47,7 @@ SUMMARY_COLUMNS = (
     "orientation_mirrored",
     "resampling_votes",
     "pairs_from",
+    "laid_by",
     "next_reading_gap",
     "precision",
     "recall",

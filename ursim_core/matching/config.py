@@ -26,6 +26,7 @@ __all__ = [
     "VARIANTS",
     "ORIENTATIONS",
     "ELASTIC_RULES",
+    "ELASTIC_LAYINGS",
     "MatchConfig",
 ]
 
@@ -40,6 +41,8 @@ SIZE_WEIGHT_FLOOR = 0.1
 VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
 #: The values of ``MatchConfig.elastic`` (see :mod:`ursim_core.matching.elastic`).
 ELASTIC_RULES = ("off", "alone", "completed")
+#: The values of ``MatchConfig.elastic_laying`` (see :mod:`ursim_core.matching.elastic`).
+ELASTIC_LAYINGS = ("boxes", "boxes_or_answer")
 #: The values of ``MatchConfig.orientation`` other than a number of degrees.
 ORIENTATIONS = ("any", "upright")
 
@@ -300,6 +303,15 @@ class MatchConfig:
         optical flow between the two maps (:mod:`ursim_core.matching.elastic`), regions paired at
         ``overlay_min_iou``; 'completed' adds the planar answer's pairs of regions left unpaired on
         both sides. Planar matcher, label images and sketch-sized maps (at most 60 regions each) only.
+    elastic_laying : {'boxes', 'boxes_or_answer'}
+        Where the sketch is laid before it is bent: 'boxes' (default), box onto box;
+        'boxes_or_answer', also by a scale and a shift per axis fitted to the planar answer's pairs
+        (:func:`~ursim_core.matching.elastic.answer_laying`), and the laying whose bent sketch
+        lands more on the metric map's free space gives the pairs: a partial sketch laid box onto
+        box is stretched over the whole map. Round 45 (docs/studies.md): generated pairs 0.926 ->
+        0.931 and 0.886 -> 0.896 (seeds 0-31, 32-63), KTH held out the same (0.8229 / 0.8146 in 8
+        orientations); not the default because its second flow takes a turned KTH pair from
+        41-43 to 56-63 ms, over the 50 ms budget.
     """
 
     variant: str = "T4"
@@ -340,6 +352,7 @@ class MatchConfig:
     overlay_angle_step: float = 2.0
     input_kind: str | None = None
     elastic: str = "completed"
+    elastic_laying: str = "boxes"
 
     def __post_init__(self):
         choices = {
@@ -354,6 +367,7 @@ class MatchConfig:
             "vote_rule": VOTE_RULES,
             "vote_orientations": VOTE_ORIENTATIONS,
             "elastic": ELASTIC_RULES,
+            "elastic_laying": ELASTIC_LAYINGS,
         }
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:

@@ -7,12 +7,15 @@ Once the planar matcher has read the sketch's orientation, :func:`elastic_pairs`
 
 1. turns the sketch's label image into that orientation (:func:`oriented_labels`);
 2. lays it on the metric map by the bounding boxes of both maps' regions (a scale and a shift
-   per axis);
+   per axis), and, given the planar answer's pairs, also by a scale and a shift per axis fitted to
+   their regions' centroids (:func:`answer_laying`): a partial sketch laid box onto box is
+   stretched over the whole map;
 3. bends it by a dense optical flow between the two maps' signed distance images
    (:func:`elastic_flow`: OpenCV's DIS, Kroeger et al., ECCV 2016), which moves each wall of the
    sketch towards the nearest wall of the metric map it resembles;
-4. pairs every region with the region it overlaps most on the other side, both ways, when their
-   intersection over union is at least ``min_iou``
+4. keeps the laying whose bent sketch lands more on the metric map's free space (the share of its
+   free space that does; the boxes on a tie), and pairs every region with the region it overlaps most on the
+   other side, both ways, when their intersection over union is at least ``min_iou``
    (:func:`~ursim_core.matching.overlay.overlay_pairs`, as the overlay matcher does for robot
    maps).
 
@@ -24,15 +27,21 @@ same on maps of any resolution.
 from __future__ import annotations
 
 import weakref
+from typing import NamedTuple
 
 import numpy as np
 
 __all__ = [
     "WORKING_SIDE",
     "DISTANCE_CLIP",
+    "Laying",
+    "LaidSketch",
     "oriented_labels",
     "signed_distance",
     "elastic_flow",
+    "box_laying",
+    "answer_laying",
+    "lay_sketch",
     "elastic_pairs",
     "laid_sketch",
 ]
@@ -44,6 +53,40 @@ WORKING_SIDE = 512
 #: do not flatten the gradient. Round 43, the 18 KTH sketches upright in the planar matcher's
 #: orientation (in sample; a study script): mean F1 0.74 / 0.80 / 0.82 at 10 / 30 / 60 px.
 DISTANCE_CLIP = 60.0
+
+
+class Laying(NamedTuple):
+    """A scale and a shift per axis that carry the oriented sketch's pixels onto the metric map's:
+    ``row' = row_scale * row + row_shift``, ``col' = col_scale * col + col_shift``. ``by`` says
+    what it was fitted to: ``"boxes"`` (box onto box) or ``"answer"`` (the answer's pairs)."""
+
+    by: str
+    row_scale: float
+    row_shift: float
+    col_scale: float
+    col_shift: float
+
+    def scaled(self, factor: float) -> Laying:
+        """The same laying onto the metric map resized by ``factor``."""
+        return self._replace(
+            row_scale=self.row_scale * factor,
+            row_shift=self.row_shift * factor,
+            col_scale=self.col_scale * factor,
+            col_shift=self.col_shift * factor,
+        )
+
+    def matrix(self) -> np.ndarray:
+        """OpenCV's 2 x 3 affine matrix of the laying, in (x, y) = (col, row)."""
+        return np.array([[self.col_scale, 0.0, self.col_shift], [0.0, self.row_scale, self.row_shift]])
+
+
+class LaidSketch(NamedTuple):
+    """What :func:`lay_sketch` found: the region pairs, the laying used, and the share of the bent
+    sketch's free space that landed on the metric map's free space (at the working size)."""
+
+    pairs: list
+    laying: Laying
+    landed: float
 
 
 def oriented_labels(labels: np.ndarray, *, degrees: float, mirrored: bool) -> np.ndarray:
@@ -137,20 +180,42 @@ _METRIC_MEMO: dict = {}
 def _metric_at_working_size(metric_labels: np.ndarray, clip: float) -> tuple[np.ndarray, np.ndarray]:
     import cv2
 
-    key = (id(metric_labels), metric_labels.shape, clip)
-    held = _METRIC_MEMO.get("last")
+    def make() -> tuple[np.ndarray, np.ndarray]:
+        factor = WORKING_SIDE / max(metric_labels.shape)
+        shape = (max(1, round(metric_labels.shape[0] * factor)), max(1, round(metric_labels.shape[1] * factor)))
+        metric = cv2.resize(metric_labels.astype(np.float32), shape[::-1], interpolation=cv2.INTER_NEAREST)
+        metric = metric.astype(np.int64)
+        return metric, _flow_image(metric > 0, clip)
+
+    return _memoised("working", metric_labels, clip, make)
+
+
+def _memoised(name: str, metric_labels: np.ndarray, extra, make):
+    """``make()`` of the metric map, kept in :data:`_METRIC_MEMO` under ``name`` for the last map seen."""
+    key = (id(metric_labels), metric_labels.shape, extra)
+    held = _METRIC_MEMO.get(name)
     if held is not None and held[0] == key and held[1]() is metric_labels:
-        return held[2], held[3]
-    factor = WORKING_SIDE / max(metric_labels.shape)
-    shape = (max(1, round(metric_labels.shape[0] * factor)), max(1, round(metric_labels.shape[1] * factor)))
-    metric = cv2.resize(metric_labels.astype(np.float32), shape[::-1], interpolation=cv2.INTER_NEAREST)
-    metric = metric.astype(np.int64)
-    image = _flow_image(metric > 0, clip)
+        return held[2]
+    value = make()
     try:
-        _METRIC_MEMO["last"] = (key, weakref.ref(metric_labels), metric, image)
+        _METRIC_MEMO[name] = (key, weakref.ref(metric_labels), value)
     except TypeError:  # an array-like without weak references: not kept
         pass
-    return metric, image
+    return value
+
+
+def _centroids(labels: np.ndarray) -> dict:
+    """``{region: (row, col)}``: the mean pixel of every region of a label image (0 = none)."""
+    labels = np.asarray(labels)
+    flat = labels.ravel().astype(np.intp, copy=False)
+    if not flat.size or flat.max() <= 0:
+        return {}
+    rows, cols = labels.shape
+    count = np.bincount(flat)
+    row_sum = np.bincount(flat, weights=np.repeat(np.arange(rows, dtype=np.float64), cols))
+    col_sum = np.bincount(flat, weights=np.tile(np.arange(cols, dtype=np.float64), rows))
+    present = np.flatnonzero(count)
+    return {int(r): (row_sum[r] / count[r], col_sum[r] / count[r]) for r in present if r > 0}
 
 
 def _box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
@@ -160,16 +225,100 @@ def _box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
 
 
-def elastic_pairs(
+def box_laying(sketch_labels: np.ndarray, metric_labels: np.ndarray, *, degrees: float = 0.0, mirrored: bool = False):
+    """The :class:`Laying` that carries the box around the oriented sketch's regions onto the box
+    around the metric map's; None when either map has no region.
+
+    Examples
+    --------
+    >>> metric = np.zeros((60, 100), np.int32); metric[10:50, 20:80] = 1
+    >>> sketch = np.zeros((30, 40), np.int32); sketch[5:25, 10:40] = 1
+    >>> box_laying(sketch, metric)
+    Laying(by='boxes', row_scale=2.0, row_shift=0.0, col_scale=2.0, col_shift=0.0)
+    """
+    return _box_laying(oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored), metric_labels)
+
+
+def _box_laying(sketch: np.ndarray, metric_labels: np.ndarray) -> Laying | None:
+    sketch_box, metric_box = _box(sketch > 0), _box(np.asarray(metric_labels) > 0)
+    if sketch_box is None or metric_box is None:
+        return None
+    (r0, r1, c0, c1), (m0, m1, n0, n1) = sketch_box, metric_box
+    row_scale, col_scale = (m1 - m0) / (r1 - r0), (n1 - n0) / (c1 - c0)
+    return Laying("boxes", row_scale, m0 - row_scale * r0, col_scale, n0 - col_scale * c0)
+
+
+def answer_laying(
+    sketch_labels: np.ndarray, metric_labels: np.ndarray, pairs, *, degrees: float = 0.0, mirrored: bool = False
+):
+    """The :class:`Laying` fitted to an answer: per axis, the least-squares scale and shift that
+    carry the centroids of the oriented sketch's paired regions onto their partners' centroids.
+
+    No assumption that the sketch covers the metric map's extent, as laying box onto box makes.
+    Paired regions in one row (or column) take the other axis' scale across it. None when fewer
+    than three pairs have both regions in the label images, when the paired sketch regions spread
+    along neither axis, or when a fitted scale is not positive (an answer that lays the sketch
+    mirrored or folded is not a laying of it in this orientation).
+
+    Examples
+    --------
+    >>> metric = np.zeros((60, 100), np.int32)
+    >>> metric[10:20, 10:20], metric[10:20, 30:40], metric[30:40, 10:20] = 1, 2, 3
+    >>> sketch = metric[5:45, 5:45] * 1
+    >>> laying = answer_laying(sketch, metric, [(1, 1), (2, 2), (3, 3)])
+    >>> laying.by, [round(value, 6) for value in laying[1:]]
+    ('answer', [1.0, 5.0, 1.0, 5.0])
+    >>> answer_laying(sketch, metric, [(1, 1), (2, 2)]) is None
+    True
+    """
+    sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
+    metric_labels = np.asarray(metric_labels)
+    return _answer_laying(
+        sketch, metric_labels, _memoised("centroids", metric_labels, None, lambda: _centroids(metric_labels)), pairs
+    )
+
+
+def _answer_laying(sketch: np.ndarray, metric_labels: np.ndarray, metric_centroids: dict, pairs) -> Laying | None:
+    sketch_centroids = _centroids(sketch)
+    matched = [
+        (sketch_centroids[a], metric_centroids[b]) for a, b in pairs if a in sketch_centroids and b in metric_centroids
+    ]
+    if len(matched) < 3:
+        return None
+    source, target = (np.array([points[side] for points in matched], dtype=np.float64) for side in (0, 1))
+    spread = [np.ptp(source[:, axis]) >= 1.0 for axis in (0, 1)]
+    if not any(spread):
+        return None
+    fitted = {}
+    for axis in (0, 1):
+        if spread[axis]:
+            design = np.stack([source[:, axis], np.ones(len(source))], axis=1)
+            (scale, shift), *_ = np.linalg.lstsq(design, target[:, axis], rcond=None)
+            if not (np.isfinite(scale) and np.isfinite(shift) and scale > 0):
+                return None
+            fitted[axis] = (float(scale), float(shift))
+    for axis in (0, 1):
+        if not spread[axis]:
+            # Regions in one row (or column) fix no scale across it: the other axis' scale, and
+            # the shift that carries their mean onto their partners'.
+            scale = fitted[1 - axis][0]
+            fitted[axis] = (scale, float(target[:, axis].mean() - scale * source[:, axis].mean()))
+    fitted = [*fitted[0], *fitted[1]]
+    return Laying("answer", *fitted)
+
+
+def lay_sketch(
     sketch_labels: np.ndarray,
     metric_labels: np.ndarray,
     *,
     degrees: float = 0.0,
     mirrored: bool = False,
+    answer=None,
+    laying: Laying | None = None,
     min_iou: float = 0.15,
     clip: float = DISTANCE_CLIP,
-) -> list[tuple[int, int]]:
-    """Region pairs of a sketch laid on a metric map by its boxes, then bent by :func:`elastic_flow`.
+) -> LaidSketch | None:
+    """The sketch laid on the metric map, bent by :func:`elastic_flow`, and its regions paired.
 
     Parameters
     ----------
@@ -177,10 +326,55 @@ def elastic_pairs(
         0 = no region.
     degrees, mirrored : keyword-only
         The sketch's orientation (:func:`oriented_labels`), as the planar matcher read it.
+    answer : list of (sketch region, metric region), keyword-only
+        An answer's pairs: the sketch is also laid by :func:`answer_laying`, and the laying whose
+        bent sketch lands more on the metric map's free space is kept (the boxes on a tie). Not
+        the intersection over union: a partial sketch stretched box onto box over the whole map
+        covers more of it, but less of it lands on free space.
+    laying : Laying, keyword-only
+        Lay the sketch so and no other way (``answer`` is then not read).
     min_iou : float, keyword-only
         Regions are paired when their intersection over union is at least this.
     clip : float, keyword-only
         :data:`DISTANCE_CLIP`.
+
+    Returns
+    -------
+    LaidSketch or None
+        None when either map has no region.
+
+    Examples
+    --------
+    >>> metric = np.zeros((60, 100), np.int32); metric[5:55, 5:45] = 1; metric[5:55, 50:95] = 2
+    >>> sketch = np.zeros((40, 40), np.int32); sketch[2:38, 2:14] = 1; sketch[2:38, 16:38] = 2
+    >>> laid = lay_sketch(sketch, metric)
+    >>> laid.pairs, laid.laying.by, round(laid.landed, 2)
+    ([(1, 1), (2, 2)], 'boxes', 1.0)
+    """
+    from ursim_core.matching.overlay import overlay_pairs
+
+    found = _laid(
+        sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip, answer=answer, laying=laying
+    )
+    if found is None:
+        return None
+    bent, metric, chosen, overlap = found
+    pairs = overlay_pairs(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
+    return LaidSketch(pairs, chosen, overlap)
+
+
+def elastic_pairs(
+    sketch_labels: np.ndarray,
+    metric_labels: np.ndarray,
+    *,
+    degrees: float = 0.0,
+    mirrored: bool = False,
+    answer=None,
+    min_iou: float = 0.15,
+    clip: float = DISTANCE_CLIP,
+) -> list[tuple[int, int]]:
+    """Region pairs of a sketch laid on a metric map and bent by :func:`elastic_flow`
+    (:func:`lay_sketch`'s pairs; [] when either map has no region).
 
     Returns
     -------
@@ -194,13 +388,10 @@ def elastic_pairs(
     >>> elastic_pairs(sketch, metric)
     [(1, 1), (2, 2)]
     """
-    from ursim_core.matching.overlay import overlay_pairs
-
-    laid = _bent(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip)
-    if laid is None:
-        return []
-    bent, metric = laid
-    return overlay_pairs(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
+    laid = lay_sketch(
+        sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, answer=answer, min_iou=min_iou, clip=clip
+    )
+    return [] if laid is None else laid.pairs
 
 
 def laid_sketch(
@@ -209,11 +400,13 @@ def laid_sketch(
     *,
     degrees: float = 0.0,
     mirrored: bool = False,
+    laying: Laying | None = None,
     clip: float = DISTANCE_CLIP,
 ) -> np.ndarray:
-    """The sketch's regions where :func:`elastic_pairs` lays them, on the metric map's pixels.
+    """The sketch's regions where :func:`lay_sketch` lays them, on the metric map's pixels.
 
     For a person to see why regions were paired: the bent sketch drawn over the metric map.
+    ``laying``: the one a match used (``MatchResult.laying``); box onto box when None.
 
     Returns
     -------
@@ -231,33 +424,50 @@ def laid_sketch(
     import cv2
 
     metric_labels = np.asarray(metric_labels)
-    laid = _bent(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip)
-    if laid is None:
+    found = _laid(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip, laying=laying)
+    if found is None:
         return np.zeros(metric_labels.shape, np.int32)
-    bent = cv2.resize(laid[0].astype(np.float32), metric_labels.shape[::-1], interpolation=cv2.INTER_NEAREST)
+    bent = cv2.resize(found[0].astype(np.float32), metric_labels.shape[::-1], interpolation=cv2.INTER_NEAREST)
     return bent.astype(np.int32)
 
 
-def _bent(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip: float):
-    """``(bent sketch, metric map)`` label images at the working size, or None when either map
+def _laid(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip: float, answer=None, laying=None):
+    """``(bent sketch, metric map, laying, landed)``, the images at the working size, of the
+    laying given, or else of the better of box onto box and the answer's; None when either map
     has no region."""
-    import cv2
-
     metric_labels = np.asarray(metric_labels)
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-    sketch_box, metric_box = _box(sketch > 0), _box(metric_labels > 0)
-    if sketch_box is None or metric_box is None:
+    if not (sketch > 0).any() or not (metric_labels > 0).any():
         return None
+    if laying is None:
+        layings = [_box_laying(sketch, metric_labels)]
+        if answer:
+            centroids = _memoised("centroids", metric_labels, None, lambda: _centroids(metric_labels))
+            fitted = _answer_laying(sketch, metric_labels, centroids, answer)
+            if fitted is not None:
+                layings.append(fitted)
+    else:
+        layings = [laying]
     metric, metric_image = _metric_at_working_size(metric_labels, clip)
-    shape = metric.shape
     factor = WORKING_SIDE / max(metric_labels.shape)
-    r0, r1, c0, c1 = sketch_box
-    m0, m1, n0, n1 = (value * factor for value in metric_box)
-    # Box onto box, then the flow: the laid sketch at the working size, read through the flow.
-    row_scale, col_scale = (m1 - m0) / (r1 - r0), (n1 - n0) / (c1 - c0)
-    laying = np.array([[col_scale, 0.0, n0 - col_scale * c0], [0.0, row_scale, m0 - row_scale * r0]])
-    laid = cv2.warpAffine(sketch.astype(np.float32), laying, shape[::-1], flags=cv2.INTER_NEAREST)
+    best = None
+    for tried in layings:
+        bent, landed = _bent(sketch, metric, metric_image, tried.scaled(factor), clip)
+        if best is None or landed > best[3]:
+            best = (bent, metric, tried, landed)
+    return best
+
+
+def _bent(sketch: np.ndarray, metric: np.ndarray, metric_image: np.ndarray, laying: Laying, clip: float):
+    """The oriented sketch laid at the working size and read through the flow onto the metric
+    map, and the share of its free space that lands on the metric map's free space."""
+    import cv2
+
+    shape = metric.shape
+    laid = cv2.warpAffine(sketch.astype(np.float32), laying.matrix(), shape[::-1], flags=cv2.INTER_NEAREST)
     flow = _dis_flow(metric_image, _flow_image(laid > 0, clip))
     rows, cols = np.indices(shape, dtype=np.float32)
-    bent = cv2.remap(laid, cols + flow[..., 0], rows + flow[..., 1], cv2.INTER_NEAREST)
-    return bent.astype(np.int64), metric
+    bent = cv2.remap(laid, cols + flow[..., 0], rows + flow[..., 1], cv2.INTER_NEAREST).astype(np.int64)
+    sketch_free = bent > 0
+    laid_area = np.count_nonzero(sketch_free)
+    return bent, float(np.count_nonzero(sketch_free & (metric > 0)) / laid_area) if laid_area else 0.0

@@ -2,17 +2,19 @@
 
 The planar matcher reads the sketch's orientation and votes over its segmentations; the answer's
 pairs are then those of the sketch laid and bent onto the metric map in that orientation
-(:mod:`ursim_core.matching.elastic`), completed by the planar answer's pairs of regions left
-unpaired on both sides ('completed'), within a person's constraints. :func:`prepare
-<ursim_core.matching.prepare>` starts the first segmentation's laying on a thread
-(:class:`LaidAhead`) while the other segmentations are prepared.
+(:mod:`ursim_core.matching.elastic`), laid box onto box or by the planar answer's own pairs,
+whichever lands more on the metric map's free space once bent (``MatchConfig.elastic_laying``), completed by
+the planar answer's pairs of regions left unpaired on both sides ('completed'), within a person's
+constraints. :func:`prepare
+<ursim_core.matching.prepare>` starts the first segmentation's laying on a thread (:class:`LaidAhead`) while the
+other segmentations are prepared.
 """
 
 from __future__ import annotations
 
 from ursim_core.matching.results import MatchResult, Prepared, replaced
 
-__all__ = ["elastic_labels", "LaidAhead", "laid_elastically"]
+__all__ = ["elastic_labels", "LaidAhead", "laying_answer", "laid_elastically"]
 
 
 def elastic_labels(prepared: Prepared, sketch_seg, metric_seg, *, largest: int) -> tuple | None:
@@ -29,53 +31,75 @@ def elastic_labels(prepared: Prepared, sketch_seg, metric_seg, *, largest: int) 
 
 
 class LaidAhead:
-    """:func:`~ursim_core.matching.elastic.elastic_pairs` of one orientation, run on a thread from
-    the start; :meth:`pairs` waits for it. The same pairs as a call made later (no shared state
-    but the metric map's memo of its working image)."""
+    """:func:`~ursim_core.matching.elastic.lay_sketch` of one orientation (given the answer to fit
+    a laying to, as :func:`laying_answer` gives it), run on a thread from the start; :meth:`laid`
+    waits for it. The same result as a call made later (no shared state but the metric map's
+    memos of its working image and centroids)."""
 
-    def __init__(self, sketch_labels, metric_labels, orientation, min_iou: float) -> None:
+    def __init__(self, sketch_labels, metric_labels, orientation, min_iou: float, answer=None) -> None:
         import threading
 
-        self._pairs: list | None = None
+        self._laid = None
         self._error: BaseException | None = None
-        arguments = (sketch_labels, metric_labels, orientation, min_iou)
+        arguments = (sketch_labels, metric_labels, orientation, min_iou, answer)
         self._thread = threading.Thread(target=self._run, args=arguments, daemon=True)
         self._thread.start()
 
-    def _run(self, sketch_labels, metric_labels, orientation, min_iou) -> None:
+    def _run(self, sketch_labels, metric_labels, orientation, min_iou, answer) -> None:
         try:
-            self._pairs = _elastic_pairs_of(sketch_labels, metric_labels, orientation, min_iou)
-        except BaseException as error:  # re-raised where the pairs are read
+            self._laid = _lay(sketch_labels, metric_labels, orientation, min_iou, answer)
+        except BaseException as error:  # re-raised where the result is read
             self._error = error
 
-    def pairs(self) -> list:
+    def laid(self):
         self._thread.join()
         if self._error is not None:
             raise self._error
-        return self._pairs
+        return self._laid
 
 
-def _elastic_pairs_of(sketch_labels, metric_labels, orientation, min_iou: float) -> list:
-    from ursim_core.matching.elastic import elastic_pairs
+def laying_answer(prepared: Prepared, orientation: tuple, result: MatchResult | None = None):
+    """The pairs the sketch is also laid by in ``orientation`` (``MatchConfig.elastic_laying``):
+    the answer found while the orientation was chosen (``Prepared.chosen``, at the automatic m)
+    when it reads the sketch so, else ``result``'s; None for box onto box only. One laying per
+    orientation, whatever m: an answer at a small m pairs too few regions to lay the sketch, and
+    a flow per m would cost an evaluation's sweep a flow per m."""
+    if prepared.config.elastic_laying != "boxes_or_answer":
+        return None
+    chosen = prepared.chosen
+    if chosen is not None and tuple(chosen.orientation) == tuple(orientation) and chosen.pairs:
+        return list(chosen.pairs)
+    return list(result.pairs) if result is not None and result.pairs else None
+
+
+def _lay(sketch_labels, metric_labels, orientation, min_iou: float, answer=None):
+    from ursim_core.matching.elastic import lay_sketch
 
     degrees, mirrored = orientation
-    return elastic_pairs(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, min_iou=min_iou)
+    return lay_sketch(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, answer=answer, min_iou=min_iou)
 
 
 def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
     """``result`` with the pairs of the sketch laid elastically in its orientation
-    (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`), within the constraints."""
+    (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`), within the constraints; with
+    ``MatchConfig.elastic_laying='boxes_or_answer'`` laid box onto box or by the planar answer's
+    pairs (:func:`laying_answer`), whichever lands more on the metric map's free space once bent."""
     from ursim_core.matching.overlay import constrained_pairs
 
     orientation = tuple(result.orientation)
     answers = prepared.elastic_answers
     if isinstance(answers.get(orientation), LaidAhead):
-        answers[orientation] = answers[orientation].pairs()
+        answers[orientation] = answers[orientation].laid()
     if orientation not in answers:
-        answers[orientation] = _elastic_pairs_of(
-            prepared.sketch_labels, prepared.metric_labels, orientation, prepared.config.overlay_min_iou
+        answers[orientation] = _lay(
+            prepared.sketch_labels,
+            prepared.metric_labels,
+            orientation,
+            prepared.config.overlay_min_iou,
+            laying_answer(prepared, orientation, result),
         )
-    pairs = answers[orientation]
+    laid = answers[orientation]
+    pairs = [] if laid is None else laid.pairs
     if prepared.config.elastic == "completed":
         # Regions the overlay leaves alone on both sides keep the graph answer's pairs: a small
         # region the bent sketch misses still has its partner (a stub, a cut-off room).
@@ -84,4 +108,4 @@ def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
             set(pairs) | {(a, b) for a, b in result.pairs if a not in sketch_paired and b not in metric_paired}
         )
     pairs = constrained_pairs(pairs, prepared.constraints)
-    return replaced(result, pairs=pairs, laid=True)
+    return replaced(result, pairs=pairs, laid=True, laying=None if laid is None else laid.laying)

@@ -36,7 +36,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
-from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically
+from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically, laying_answer
 from ursim_core.matching.orientation import broken_adjacencies
 from ursim_core.matching.oriented import (
     candidate_overlaps,
@@ -135,7 +135,10 @@ def prepare(
         # a thread (OpenCV's flow releases the GIL) while the other segmentations are prepared.
         # A turned KTH pair 51.8-58.9 -> 42.1-45.7 ms (interleaved x3); with nothing to prepare
         # meanwhile the thread would only add its start.
-        answers[prepared.orientation] = LaidAhead(*labels, prepared.orientation, prepared.config.overlay_min_iou)
+        answer = laying_answer(prepared, prepared.orientation)
+        answers[prepared.orientation] = LaidAhead(
+            *labels, prepared.orientation, prepared.config.overlay_min_iou, answer
+        )
     prepared = with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
     if labels is not None:
         prepared = dataclasses.replace(

@@ -73,6 +73,7 @@ class Prepared:
             "orientation_scan": self.orientation_scan,
             "resampling_votes": 0,
             "laid": False,
+            "laying": None,
         }
 
     @property
@@ -126,6 +127,10 @@ class MatchResult:
         The pairs are those of the sketch laid on the metric map and bent onto it
         (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`); ``m``, the cost and the
         orientation are the planar matcher's, which read the orientation.
+    laying : Laying or None
+        With ``laid``: how the sketch was laid on the metric map before it was bent
+        (:class:`~ursim_core.matching.elastic.Laying`: box onto box, or fitted to the planar
+        answer's pairs; ``MatchConfig.elastic_laying``), to draw it again; None otherwise.
     """
 
     pairs: list
@@ -146,6 +151,7 @@ class MatchResult:
     orientation_scan: dict = field(default_factory=dict)
     resampling_votes: int = 0
     laid: bool = False
+    laying: Any = None
 
 
 _RESULT_FIELDS = frozenset(f.name for f in dataclasses.fields(MatchResult))
@@ -220,6 +226,8 @@ def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
         "orientation": {"degrees": round(float(result.orientation[0]), 6), "mirrored": bool(result.orientation[1])},
         # Whether the pairs are the laid sketch's (MatchConfig.elastic) or the matcher's own.
         "pairs_from": "laid sketch" if result.laid else "matcher",
+        # How the sketch was laid before it was bent: box onto box, or by the planar answer's pairs.
+        **({"laid_by": result.laying.by} if result.laid and result.laying is not None else {}),
         **next_reading_record(result),
     }
 

@@ -79,11 +79,13 @@ def eval_badges(
 
 def laid_sketch_of(result, sketch_labels, metric_labels) -> np.ndarray | None:
     """The sketch's regions where a match laid them on the metric map, on the metric map's pixels
-    (:func:`ursim_core.matching.elastic.laid_sketch`); None when the result's pairs are not the
-    laid sketch's (``MatchResult.laid``) or a map has no segmentation."""
+    (:func:`ursim_core.matching.elastic.laid_sketch`, laid as the match laid it:
+    ``MatchResult.laying``); None when the result's pairs are not the laid sketch's
+    (``MatchResult.laid``) or a map has no segmentation."""
     if result is None or not getattr(result, "laid", False) or sketch_labels is None or metric_labels is None:
         return None
     from ursim_core.matching.elastic import laid_sketch
 
     degrees, mirrored = result.orientation
-    return laid_sketch(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored)
+    laying = getattr(result, "laying", None)
+    return laid_sketch(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, laying=laying)

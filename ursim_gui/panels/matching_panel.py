@@ -58,6 +58,11 @@ PAIRS_FROM = (
     ("alone", "the sketch laid and bent onto the map only"),
     ("off", "the graph matcher's own answer"),
 )
+#: Where the sketch is laid before it is bent (``MatchConfig.elastic_laying``).
+LAYINGS = (
+    ("boxes", "box onto box (a sketch of the whole map)"),
+    ("boxes_or_answer", "box onto box or where the graph answer puts it (a partial sketch; slower)"),
+)
 #: The matchers that use a known scale; those whose pairs may come from the laid sketch.
 _SCALED_MATCHERS = ("auto", "overlay")
 _ELASTIC_MATCHERS = ("auto", "planar")
@@ -97,6 +102,8 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
         if getattr(result, "laid", False):
             # m and the cost are the planar matcher's, which read the orientation.
             text += "\npairs from the sketch laid and bent onto the map"
+            if getattr(getattr(result, "laying", None), "by", "") == "answer":
+                text += ", laid where the graph answer puts it"
     found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
         text += f"\nread the sketch {found.describe()}"
@@ -178,6 +185,14 @@ class MatchingPanel(QWidget):
         )
         self._enabled_for(self.pairs_from, _ELASTIC_MATCHERS)
         form.addRow("Pairs", self.pairs_from)
+        self.laying = _combo("match_laying", LAYINGS)
+        self.laying.setToolTip(
+            "Where the sketch is laid before it is bent: box onto box stretches a sketch of part of the "
+            "map over all of it; the graph answer's pairs lay it where they put it, and the laying whose "
+            "bent sketch lands more on the map's free space is kept (a second optical flow per match)"
+        )
+        self._enabled_for(self.laying, _ELASTIC_MATCHERS)
+        form.addRow("Laying", self.laying)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
         self.turn_left.setObjectName("orient_left")
@@ -257,6 +272,7 @@ class MatchingPanel(QWidget):
             matcher=matcher,
             m=m,
             elastic=self.pairs_from.currentData(),
+            elastic_laying=self.laying.currentData(),
             **self.orientation.match_options(fields),
             **extra,
         )

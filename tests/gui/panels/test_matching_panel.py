@@ -204,3 +204,24 @@ def test_the_panel_says_where_a_sketchs_pairs_come_from(window, qtbot):
     result = window.session.last_match
     assert result.laid and result.config.elastic == "completed" and result.pairs
     assert "pairs from the sketch laid and bent onto the map" in panel.summary.text()
+
+
+def test_the_panel_lays_a_partial_sketch_where_its_answer_puts_it(window, qtbot):
+    from ursim_core.matching.elastic import Laying
+    from ursim_gui.panels.matching_panel import describe_result
+
+    panel = window.matching_panel
+    assert panel.config().elastic_laying == "boxes" and panel.laying.isEnabled()
+    panel.laying.setCurrentIndex(panel.laying.findData("boxes_or_answer"))
+    assert panel.config().elastic_laying == "boxes_or_answer"
+    panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
+    assert not panel.laying.isEnabled()  # the Hungarian baseline lays nothing
+    panel.matcher.setCurrentIndex(panel.matcher.findData("auto"))
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    result = window.session.last_match
+    assert result.laid and result.config.elastic_laying == "boxes_or_answer"
+    assert result.laying.by in ("boxes", "answer")
+    by_answer = dataclasses.replace(result, laying=Laying("answer", 1.0, 0.0, 1.0, 0.0))
+    assert "laid where the graph answer puts it" in describe_result(by_answer)
+    assert "graph answer" not in describe_result(dataclasses.replace(result, laying=None))
