@@ -309,9 +309,10 @@ class MatchConfig:
         (:func:`~ursim_core.matching.elastic.answer_laying`), and the laying whose bent sketch
         lands more on the metric map's free space gives the pairs: a partial sketch laid box onto
         box is stretched over the whole map. Round 45 (docs/studies.md): generated pairs 0.926 ->
-        0.931 and 0.886 -> 0.896 (seeds 0-31, 32-63), KTH held out the same (0.8229 / 0.8146 in 8
-        orientations); not the default because its second flow takes a turned KTH pair from
-        41-43 to 56-63 ms, over the 50 ms budget.
+        0.931 and 0.886 -> 0.896 (seeds 0-31, 32-63), KTH held out the same in 8 orientations
+        (0.8229 / 0.8146) and a little worse at free angles (0.8026 / 0.7940 -> 0.7983 / 0.7893);
+        not the default: its second flow takes a turned KTH pair from 41-43 to 56-63 ms, over
+        the 50 ms budget.
     """
 
     variant: str = "T4"
