@@ -358,9 +358,9 @@ def lay_sketch(
     )
     if found is None:
         return None
-    bent, metric, chosen, overlap = found
+    bent, metric, chosen, landed = found
     pairs = overlay_pairs(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
-    return LaidSketch(pairs, chosen, overlap)
+    return LaidSketch(pairs, chosen, landed)
 
 
 def elastic_pairs(
