@@ -310,7 +310,7 @@ def match_pair(
 
     from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
     from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review, sweep_helper
-    from ursim_core.matching.results import match_record, next_reading_record
+    from ursim_core.matching.results import laid_by, match_record, next_reading_record
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -407,7 +407,7 @@ def match_pair(
         "orientation": result.orientation,
         "resampling_votes": result.resampling_votes,
         "laid": result.laid,
-        "laid_by": result.laying.by if result.laid and result.laying is not None else "",
+        "laid_by": laid_by(result),
         **next_reading_record(result),
         "out": out,
     }

@@ -2,12 +2,11 @@
 
 The planar matcher reads the sketch's orientation and votes over its segmentations; the answer's
 pairs are then those of the sketch laid and bent onto the metric map in that orientation
-(:mod:`ursim_core.matching.elastic`), laid box onto box or by the planar answer's own pairs,
-whichever lands more on the metric map's free space once bent (``MatchConfig.elastic_laying``), completed by
-the planar answer's pairs of regions left unpaired on both sides ('completed'), within a person's
-constraints. :func:`prepare
-<ursim_core.matching.prepare>` starts the first segmentation's laying on a thread (:class:`LaidAhead`) while the
-other segmentations are prepared.
+(:mod:`ursim_core.matching.elastic`), laid box onto box or, with ``MatchConfig.elastic_laying``,
+also by the planar answer's own pairs, whichever lands more on the metric map's free space once
+bent; completed by the planar answer's pairs of regions left unpaired on both sides ('completed'),
+within a person's constraints. :func:`prepare <ursim_core.matching.prepare>` starts the first
+segmentation's laying on a thread (:class:`LaidAhead`) while the other segmentations are prepared.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, 
 from ursim_core.matching.descriptors import PairDescriptors
 from ursim_core.matching.planar import PlanarGraph
 
-__all__ = ["Prepared", "MatchResult", "replaced", "new_result", "match_record", "next_reading_record"]
+__all__ = ["Prepared", "MatchResult", "replaced", "new_result", "match_record", "next_reading_record", "laid_by"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -227,9 +227,17 @@ def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
         # Whether the pairs are the laid sketch's (MatchConfig.elastic) or the matcher's own.
         "pairs_from": "laid sketch" if result.laid else "matcher",
         # How the sketch was laid before it was bent: box onto box, or by the planar answer's pairs.
-        **({"laid_by": result.laying.by} if result.laid and result.laying is not None else {}),
+        **({"laid_by": laid_by(result)} if laid_by(result) else {}),
         **next_reading_record(result),
     }
+
+
+def laid_by(result: MatchResult) -> str:
+    """How a laid answer's sketch was laid before it was bent: ``"boxes"`` (box onto box) or
+    ``"answer"`` (by the planar answer's pairs, ``MatchConfig.elastic_laying``); ``""`` when the
+    pairs are not the laid sketch's."""
+    laying = getattr(result, "laying", None)
+    return laying.by if getattr(result, "laid", False) and laying is not None else ""
 
 
 def next_reading_record(result: MatchResult) -> dict[str, Any]:

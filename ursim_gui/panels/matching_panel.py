@@ -102,7 +102,9 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
         if getattr(result, "laid", False):
             # m and the cost are the planar matcher's, which read the orientation.
             text += "\npairs from the sketch laid and bent onto the map"
-            if getattr(getattr(result, "laying", None), "by", "") == "answer":
+            from ursim_core.matching.results import laid_by
+
+            if laid_by(result) == "answer":
                 text += ", laid where the graph answer puts it"
     found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
