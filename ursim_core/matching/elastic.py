@@ -204,6 +204,11 @@ def _memoised(name: str, metric_labels: np.ndarray, extra, make):
     return value
 
 
+def _metric_centroids(metric_labels: np.ndarray) -> dict:
+    """:func:`_centroids` of the metric map, kept for the last map seen (many sketches, one map)."""
+    return _memoised("centroids", metric_labels, None, lambda: _centroids(metric_labels))
+
+
 def _centroids(labels: np.ndarray) -> dict:
     """``{region: (row, col)}``: the mean pixel of every region of a label image (0 = none)."""
     labels = np.asarray(labels)
@@ -273,9 +278,7 @@ def answer_laying(
     """
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
     metric_labels = np.asarray(metric_labels)
-    return _answer_laying(
-        sketch, metric_labels, _memoised("centroids", metric_labels, None, lambda: _centroids(metric_labels)), pairs
-    )
+    return _answer_laying(sketch, metric_labels, _metric_centroids(metric_labels), pairs)
 
 
 def _answer_laying(sketch: np.ndarray, metric_labels: np.ndarray, metric_centroids: dict, pairs) -> Laying | None:
@@ -442,7 +445,7 @@ def _laid(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip:
     if laying is None:
         layings = [_box_laying(sketch, metric_labels)]
         if answer:
-            centroids = _memoised("centroids", metric_labels, None, lambda: _centroids(metric_labels))
+            centroids = _metric_centroids(metric_labels)
             fitted = _answer_laying(sketch, metric_labels, centroids, answer)
             if fitted is not None:
                 layings.append(fitted)
