@@ -440,17 +440,14 @@ def _laid(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip:
     has no region."""
     metric_labels = np.asarray(metric_labels)
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-    if not (sketch > 0).any() or not (metric_labels > 0).any():
+    boxes = _box_laying(sketch, metric_labels)  # None when either map has no region
+    if boxes is None:
         return None
-    if laying is None:
-        layings = [_box_laying(sketch, metric_labels)]
-        if answer:
-            centroids = _metric_centroids(metric_labels)
-            fitted = _answer_laying(sketch, metric_labels, centroids, answer)
-            if fitted is not None:
-                layings.append(fitted)
-    else:
-        layings = [laying]
+    layings = [boxes if laying is None else laying]
+    if laying is None and answer:
+        fitted = _answer_laying(sketch, metric_labels, _metric_centroids(metric_labels), answer)
+        if fitted is not None:
+            layings.append(fitted)
     metric, metric_image = _metric_at_working_size(metric_labels, clip)
     factor = WORKING_SIDE / max(metric_labels.shape)
     best = None
