@@ -14,8 +14,8 @@ Once the planar matcher has read the sketch's orientation, :func:`elastic_pairs`
    (:func:`elastic_flow`: OpenCV's DIS, Kroeger et al., ECCV 2016), which moves each wall of the
    sketch towards the nearest wall of the metric map it resembles;
 4. keeps the laying whose bent sketch lands more on the metric map's free space (the share of its
-   free space that does; the boxes on a tie), and pairs every region with the region it overlaps most on the
-   other side, both ways, when their intersection over union is at least ``min_iou``
+   free space that does; the boxes on a tie), and pairs every region with the region it overlaps
+   most on the other side, both ways, when their intersection over union is at least ``min_iou``
    (:func:`~ursim_core.matching.overlay.overlay_pairs`, as the overlay matcher does for robot
    maps).
 
@@ -278,10 +278,10 @@ def answer_laying(
     """
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
     metric_labels = np.asarray(metric_labels)
-    return _answer_laying(sketch, metric_labels, _metric_centroids(metric_labels), pairs)
+    return _answer_laying(sketch, _metric_centroids(metric_labels), pairs)
 
 
-def _answer_laying(sketch: np.ndarray, metric_labels: np.ndarray, metric_centroids: dict, pairs) -> Laying | None:
+def _answer_laying(sketch: np.ndarray, metric_centroids: dict, pairs) -> Laying | None:
     sketch_centroids = _centroids(sketch)
     matched = [
         (sketch_centroids[a], metric_centroids[b]) for a, b in pairs if a in sketch_centroids and b in metric_centroids
@@ -445,7 +445,7 @@ def _laid(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip:
         return None
     layings = [boxes if laying is None else laying]
     if laying is None and answer:
-        fitted = _answer_laying(sketch, metric_labels, _metric_centroids(metric_labels), answer)
+        fitted = _answer_laying(sketch, _metric_centroids(metric_labels), answer)
         if fitted is not None:
             layings.append(fitted)
     metric, metric_image = _metric_at_working_size(metric_labels, clip)
