@@ -49,15 +49,7 @@ ORIENTATIONS = ("any", "upright")
 #: Rules of ``m='auto'`` (implemented in :mod:`ursim_core.matching.auto_m`).
 AUTO_RULE_NAMES = ("score", "structure")
 
-#: MAORIS preset used for both maps when matching. Measured on the 18 KTH sketches (planar T4,
-#: automatic m, mean F1 malcolm/vasiliki): default/default .627/.692, icra/icra .598/.662,
-#: sketch/default .571/.607, default/robot .509/.551, sketch/robot .458/.499. The annotators'
-#: ground truth was also clicked on this preset (original_code.md §2.9). Re-checked with the
-#: cross-validated ``sketch`` preset of issue 16 (chosen on maoris_segmentation, not on KTH):
-#: ``ursim evaluate ursim_kth_sketches --matchers planar --variants T4 --augment dihedral
-#: --preset sketch`` gives F1 .30/.32 and place accuracy .32/.33 (malcolm/vasiliki, 144 runs
-#: each) against .66/.65 and .66/.65 with ``--preset default``: its finer regions (doors kept
-#: apart) match far worse, so the default stays.
+#: MAORIS preset used for both maps when matching (the evidence: docs/options.md).
 MATCH_PRESETS = {"sketch": "default", "metric": "default"}
 
 
@@ -132,103 +124,47 @@ class MatchConfig:
         structure alone), lay the sketch on the metric map by that answer's pairs, match again
         and keep that answer when its hypothesis score is lower than the refitted one's
         (:func:`ursim_core.matching.refit.signature_start`). A start that does not depend on the
-        sketch covering the metric map in proportion. On by default since round 20: held-out
-        generated pairs (``ursim bench invariance --first-seed 8``) 0.863 -> 0.892 mean F1, seeds
-        0-7 unchanged, the 18 KTH sketches unchanged in the 8 orientations and at 15-degree steps
-        one of 432 sketch orientations worse (01 at 195 degrees). Costs a sweep of every fourth m
-        per mirror flag and one of every second m per finalist orientation: 32.6 -> 37.6 ms median
-        prepare per KTH pair on a quiet machine, 35.8 -> 41.2 ms on a loaded one (interleaved;
-        budget 50 ms).
+        sketch covering the metric map in proportion. Evidence: docs/options.md.
     keep_refit : bool
         With position refits: True (default) keeps an orientation's refitted answer when its
         hypothesis score is lower (as above); False lets the refit only rank the orientations
         (each still ranked by its refitted answer's score) and keeps the chosen orientation's
         answer from before the refit, so with one orientation (given, or one candidate) there
-        is no refit at all. The refit's placement tells the orientation of a nearly symmetric
-        sketch more reliably than it changes the pairs: on the 18 KTH sketches (round 30,
-        in sample) False 0.754 mean F1 against 0.762 (sketch 01 0.83 against 1.00, 03 0.43
-        against 0.57, 15 0.72 against 0.56) and 0.717 with no refit (01 read mirrored: 0.17).
+        is no refit at all. Evidence: docs/options.md.
     resampling_vote : bool
         The planar matcher on a sketch that was resampled onto its wall axes and segmented in
         several resamplings (``segment_canonical(..., resampled=True)``, which ``ursim match``,
         ``ursim evaluate`` and the app use): match each segmentation and keep the pairs most of the
         answers hold (:mod:`ursim_core.matching.resampling`). Not with constraints (their region
-        ids are the first segmentation's). Round 30: the 18 KTH sketches turned by 15, 30, ...,
-        345 degrees 0.69 / 0.71 -> 0.73 / 0.73 mean F1 / place accuracy (``ursim evaluate ...
-        --augment angles=... --cross-validate resampling_vote=true,false``: true in every fold;
-        its quorum was chosen on these sketches); the upright and quarter-turned sketches are not
-        resampled, so nothing changes there. Six matches of a turned sketch instead of one.
+        ids are the first segmentation's). Six matches of a turned sketch instead of one.
+        Evidence: docs/options.md.
     vote_by_reading : bool
         With ``resampling_vote``: True (default) lets only the answers that read the sketch the way
         most of them do (the same mirror image, turned within a few degrees) vote on pairs, half
         of them needed; an answer in another orientation pairs regions of another reading, not
-        votes for or against this one's. False: every answer votes, half of all needed (rounds
-        30-31). On the 18 KTH sketches turned by 15, 30, ..., 345 degrees, in sample: mean F1 /
-        place accuracy 0.7253 / 0.7287 -> 0.7297 / 0.7361 (round 32).
+        votes for or against this one's. False: every answer votes, half of all needed.
+        Evidence: docs/options.md.
     vote_rule : {'score', 'count'}
         With ``resampling_vote`` and ``vote_by_reading``: which reading the voters share. Every
         segmentation has ranked the same finalist orientations (the hypothesis score over the
         free-space overlap, ``orientation_scan``); 'score' (default) takes the reading whose mean
         rank value over all the segmentations is lowest, 'count' the reading most of their own
-        choices fall in (ties: the earliest answer's; rounds 32-36). A segmentation's choice drops
-        how close the runner-up was: of ten, four read KTH sketch 01 turned by 75 degrees mirrored
-        and four the right way, and the tie went the wrong way. Round 37, the 18 KTH sketches
-        turned by 15, 30, ..., 345 degrees (``ursim evaluate ... --cross-validate
-        vote_rule=count,score``): 'score' in every fold, held out 0.7455 / 0.7504 mean F1 / place
-        accuracy against 0.7380 / 0.7428 (01 0.70 -> 0.77, 04 0.61 -> 0.70, 07 0.54 -> 0.48). Five
-        other rules were measured on the same runs (docs/studies.md, round 37); chosen among all
-        seven leave-one-sketch-out, the figure is 0.7348 / 0.7391. Generated pairs (``ursim bench
-        invariance``): seeds 0-31 0.912 -> 0.917, held-out seeds 32-63 0.872 -> 0.867 and 64-95
-        0.897 -> 0.898: neutral there. Upright and quarter-turned sketches are not resampled:
-        nothing changes there.
+        choices fall in (ties: the earliest answer's). Evidence: docs/options.md.
     vote_segmentations : int
         With ``resampling_vote``: how many of a turned sketch's segmentations vote (at most the
         six ``segment_canonical(..., resampled=True)`` makes), the first and then its resamplings:
-        not turned back, then in the order of ``segmentation.canonical.RESAMPLING_OFFSETS`` (turned
-        back 2 and 1 degrees less and more; until round 38 also 1.5 and 0.5 degrees less, the
-        seventh and eighth in the figures below). Round 33, the 18 KTH
-        sketches turned by 15, 30, ..., 345 degrees (``ursim evaluate ... --cross-validate
-        vote_segmentations=6,10``, with 0.5 and 1.5 degrees more as the ninth and tenth): 10
-        chosen in every fold, held out 0.74 / 0.74 mean F1 / place accuracy (in sample 0.7307 /
-        0.7384 with 6, 0.7366 / 0.7411 with 10). Round 37, with ``vote_rule='score'``
-        (``--cross-validate vote_segmentations=6,8,10``): 8 chosen in every fold, held out 0.7495
-        / 0.7558 (in sample 0.7445 / 0.7524 with 6, 0.7455 / 0.7504 with 10; 82 of 864 runs
-        changed from 10: 01 0.77 -> 0.82, 04 0.70 -> 0.72, 07 0.48 -> 0.50, 08 0.85 -> 0.83).
-        The rule was chosen on the same sketches. Generated pairs (``ursim bench invariance``, 8
-        against 10): seeds 0-31 0.914 / 0.919 against 0.917 / 0.923, 32-63 0.867 / 0.872 both,
-        64-95 0.902 / 0.900 against 0.898 / 0.895. A KTH pair turned by 30 degrees 177 -> 153 ms
-        (``bench_kth_turned``, interleaved x2), and seven resamplings to segment instead of nine,
-        so the last two of round 33 are no longer made. Round 38, the resampled sketches smoothed
-        and the wall angle exact (``--cross-validate vote_segmentations=6,8``): 6 chosen in every
-        fold, held out 0.7702 / 0.7717, against 0.7670 / 0.7669 with 8. Round 39: 6 is the
-        default, as that held-out choice says; on generated pairs (``ursim bench invariance
-        --seeds 32 --first-seed 0|32|64``) 6 against 8 gave 0.913 / 0.918 against 0.914 / 0.919,
-        0.866 / 0.872 both, and 0.916 / 0.914 against 0.913 / 0.911. The two last resamplings
-        (-1.5 and -0.5 degrees) are no longer made.
+        not turned back, then in the order of ``segmentation.canonical.RESAMPLING_OFFSETS``.
+        Evidence: docs/options.md.
     vote_signature_refit : bool
         With ``resampling_vote`` and ``signature_refit``: whether the other segmentations of a
         turned sketch refit from the signatures too (True, the default) or only the first does
-        (each still refits by its own pairs). False skips a sweep and a refit per mirror flag in
-        nine of the ten segmentations: a KTH pair turned by 30 degrees 215-218 -> 180-192 ms (a
-        study script, interleaved x2). Round 35: on the 18 KTH sketches turned by 15, 30, ...,
-        345 degrees (``ursim evaluate ... --cross-validate vote_signature_refit=true,false``)
-        12 of 864 runs changed, all of sketch 10, and false was chosen in 17 folds: held out 0.74
-        / 0.74 either way (in sample 0.7366 / 0.7411 -> 0.7385 / 0.7434). But on generated pairs
-        not used in any design (``ursim bench invariance --seeds 32 --first-seed 32``) False lost:
-        turned 0.956 -> 0.932, all 0.719 -> 0.691, mean 0.862 -> 0.854 (seeds 0-31 unchanged,
-        0.912). So the default keeps the start in every segmentation.
+        (each still refits by its own pairs). Evidence: docs/options.md.
     vote_orientations : {'own', 'first'}
         With ``resampling_vote``: the orientations the other segmentations of a turned sketch are
         matched in. 'own' (the default): their own candidates (from their label image's wall
         angle) nearest to the first segmentation's finalists, a fraction of a degree from them.
         'first': the first one's finalists as they are, so no other label image has its wall
-        angle measured (its eight outline tracings, about 1.9 ms each on a turned KTH sketch).
-        Round 39: a KTH pair turned by 30 degrees 56-57 -> 47 ms (``bench_kth_turned``, three
-        runs), for 14 of the 864 runs at free angles changed (in sample 0.7702 / 0.7717
-        -> 0.7686 / 0.7689: 07 0.49 -> 0.46, 12 0.47 -> 0.47, 04 0.84 -> 0.84) and generated
-        pairs seeds 0-63 unchanged, 64-95 0.916 / 0.914 -> 0.911 / 0.909 (``ursim bench
-        invariance``). Round 40, with the sweeps and the overlap search in C: 42.5-44.1 -> 34.0-34.5
-        ms. The faster choice, not the default.
+        angle measured: faster, not the default. Evidence: docs/options.md.
     hypothesis_score : {'signature', 'substitutions', 'structure'}
         Planar hypothesis score: 'structure' = the released code's structural cost;
         'substitutions' = plus ``score_weight`` per matched pair with ``c > m`` (the
@@ -257,25 +193,13 @@ class MatchConfig:
     orientation_finalists : int
         With ``orientation='any'`` and the automatic m: the candidate orientations are screened
         on every second m of the grid, and this many of the best get the full sweep and the
-        refit, which decide. Round 36: the right reading of KTH sketch 12 (drawn upright) is
-        screened out with 3 and wins with 4 (F1 0.50 -> 0.58, both annotators, in every
-        quarter turn and mirror image). Also: held-out generated pairs (``ursim bench invariance
-        --seeds 32 --first-seed 32``) 0.862 -> 0.872 (cropped 0.638 -> 0.665, all 0.719 ->
-        0.746); seeds 0-31 and the robot-map copies unchanged; 5 and 8 finalists lose sketch
-        04 (0.545 -> 0.509). ``ursim evaluate ... --cross-validate orientation_finalists=3,4``:
-        in the 8 quarter turns and mirror images held out 0.76 / 0.78 (sketch 12's own fold ties
-        and keeps 3), at free angles 4 in every fold, held out 0.74 / 0.74 (in sample 0.7366 /
-        0.7411 -> 0.7380 / 0.7428). A fourth full sweep: 9 % more time per upright KTH pair,
-        17 % per turned one (``ursim bench match``).
+        refit, which decide. Evidence: docs/options.md.
     adjacency_penalty : float
         With ``orientation='any'``, each finalist reading's rank value is multiplied by 1 + this
         times the share of its answer's sketch adjacencies that the answer breaks
         (:func:`~ursim_core.matching.orientation.broken_adjacencies`); 0 = not. A half turn or
         mirror image of a partial sketch of rooms along a corridor can fit the room sizes better
-        than the right reading, but joins rooms that are not neighbours. Round 44: every KTH row
-        the same with 0.5-4 (8 orientations; 2 at 23 free angles), so the KTH sketches cannot choose
-        it; chosen on generated seeds 0-31 (``ursim bench invariance``: 0.918 -> 0.926 with 2, 4 or 8,
-        0.921 with 0.5 or 1), held out seeds 32-63 0.874 -> 0.886 and 64-95 0.915 -> 0.923.
+        than the right reading, but joins rooms that are not neighbours. Evidence: docs/options.md.
     scale : float or None
         Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
         resolution), for the overlay matcher: it then searches any placement, so either map may
@@ -285,14 +209,7 @@ class MatchConfig:
     overlay_angle_step : float
         With ``orientation='any'``, the overlay matcher also tries each candidate orientation turned
         by one and two such steps (degrees) either way, keeping the best correlation; 0 = the
-        wall angles' quarter turns only. Round 42 (docs/studies.md), Halmstad E5 (``ursim evaluate
-        .../E5 --matchers auto --variants T4 --cross-validate overlay_angle_step=0,1,2,3``): 2 in
-        10 of 11 folds, held out 0.82 / 0.80 (in sample 0.78 / 0.76 with 0, 0.82 / 0.79-0.80 with
-        1-3); with ``--cross-validate overlay_min_iou=0.05,0.15,0.3`` 0.80 / 0.78 -> 0.83 / 0.82
-        (E5_05 0.15 -> 0.55, E5_01 0.77 -> 0.79, E5_03 0.88 -> 0.80). E5's robot maps matched
-        against each other (ground truth derived through the annotators' models, a study script):
-        placed right 66 -> 69 of 80, the placement's error smaller on 32 and larger on 6. The
-        robot-map-like copies of ``ursim bench invariance`` unchanged.
+        wall angles' quarter turns only. Evidence: docs/options.md.
     input_kind : {'sketch', 'metric'} or None
         What the input map is: 'metric' (a robot map, a floor plan drawn to scale) makes
         ``matcher='auto'`` the overlay matcher; None (default) = unknown, taken as a sketch unless
@@ -308,11 +225,8 @@ class MatchConfig:
         'boxes_or_answer', also by a scale and a shift per axis fitted to the planar answer's pairs
         (:func:`~ursim_core.matching.elastic.answer_laying`), and the laying whose bent sketch
         lands more on the metric map's free space gives the pairs: a partial sketch laid box onto
-        box is stretched over the whole map. Round 45 (docs/studies.md): generated pairs 0.926 ->
-        0.931 and 0.886 -> 0.896 (seeds 0-31, 32-63), KTH held out the same in 8 orientations
-        (0.8229 / 0.8146) and a little worse at free angles (0.8026 / 0.7940 -> 0.7983 / 0.7893);
-        not the default: its second flow takes a turned KTH pair from 41-43 to 56-63 ms, over
-        the 50 ms budget.
+        box is stretched over the whole map. Not the default: its second optical flow takes a
+        turned KTH pair over the 50 ms budget. Evidence: docs/options.md.
     """
 
     variant: str = "T4"
