@@ -162,39 +162,47 @@ class MatchingPanel(QWidget):
         self.scale.setSingleStep(0.05)
         self.scale.setSpecialValueText("unknown (estimated)")
         self.scale.setValue(0.0)
-        self.scale.setToolTip(
+        self._add_option(
+            form,
+            "Scale",
+            self.scale,
+            _SCALED_MATCHERS,
             "Metric-map pixels per input-map pixel when known (1 for two robot maps of one resolution): "
             "the automatic matcher then lays the maps on each other (overlay), and the input may cover "
-            "any part of the metric map; leave it unknown for a sketch"
+            "any part of the metric map; leave it unknown for a sketch",
         )
-        self._enabled_for(self.scale, _SCALED_MATCHERS)
-        form.addRow("Scale", self.scale)
         # What the input map is: a robot map makes the automatic matcher overlay the maps (a
         # campaign of robot maps says so for each pair).
         self.input_kind = _combo("match_input_kind", INPUT_KINDS)
-        self.input_kind.setToolTip(
+        self._add_option(
+            form,
+            "Input",
+            self.input_kind,
+            ("auto",),
             "What the input (left) map is: a robot map or a plan drawn to scale makes the automatic "
-            "matcher lay the maps on each other (overlay); a sketch is matched by its structure (planar)"
+            "matcher lay the maps on each other (overlay); a sketch is matched by its structure (planar)",
         )
-        self._enabled_for(self.input_kind, ("auto",))
-        form.addRow("Input", self.input_kind)
         self.pairs_from = _combo("match_pairs_from", PAIRS_FROM)
-        self.pairs_from.setToolTip(
+        self._add_option(
+            form,
+            "Pairs",
+            self.pairs_from,
+            _ELASTIC_MATCHERS,
             "Where a sketch's pairs come from once the planar matcher has read its orientation: the "
             "sketch laid on the map by its box and bent by an optical flow, regions paired where they "
             "overlap (hand-drawn rooms out of proportion still land on theirs), or the graph matcher's "
-            "own answer"
+            "own answer",
         )
-        self._enabled_for(self.pairs_from, _ELASTIC_MATCHERS)
-        form.addRow("Pairs", self.pairs_from)
         self.laying = _combo("match_laying", LAYINGS)
-        self.laying.setToolTip(
+        self._add_option(
+            form,
+            "Laying",
+            self.laying,
+            _ELASTIC_MATCHERS,
             "Where the sketch is laid before it is bent: box onto box stretches a sketch of part of the "
             "map over all of it; the graph answer's pairs lay it where they put it, and the laying whose "
-            "bent sketch lands more on the map's free space is kept (a second optical flow per match)"
+            "bent sketch lands more on the map's free space is kept (a second optical flow per match)",
         )
-        self._enabled_for(self.laying, _ELASTIC_MATCHERS)
-        form.addRow("Laying", self.laying)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
         self.turn_left.setObjectName("orient_left")
@@ -252,8 +260,11 @@ class MatchingPanel(QWidget):
         layout.addWidget(box)
         layout.addStretch(1)
 
-    def _enabled_for(self, widget: QWidget, matchers) -> None:
-        """Keep ``widget`` enabled only while the matcher chosen is one of ``matchers``."""
+    def _add_option(self, form: QFormLayout, label: str, widget: QWidget, matchers, tooltip: str) -> None:
+        """Add a row of ``form`` for an option that applies only to some matchers: ``widget`` is
+        enabled only while the matcher chosen is one of ``matchers``."""
+        widget.setToolTip(tooltip)
+        form.addRow(label, widget)
         widget.setEnabled(self.matcher.currentData() in matchers)
         self.matcher.currentIndexChanged.connect(lambda _: widget.setEnabled(self.matcher.currentData() in matchers))
 
