@@ -200,6 +200,13 @@ class MatchConfig:
         (:func:`~ursim_core.matching.orientation.broken_adjacencies`); 0 = not. A half turn or
         mirror image of a partial sketch of rooms along a corridor can fit the room sizes better
         than the right reading, but joins rooms that are not neighbours. Evidence: docs/options.md.
+    door_penalty : float
+        With ``orientation='any'``, each finalist reading's rank value is also multiplied by 1 +
+        this times how far its answer's regions touch their neighbours from where their partners
+        touch theirs (:func:`~ursim_core.matching.orientation.misplaced_doors`), when some
+        finalist's is below ``orientation.DOOR_EVIDENCE`` (the doors were drawn where they are);
+        0 = not. The same half turn or mirror image puts each room's door at the other end of its
+        wall. Evidence: docs/options.md.
     scale : float or None
         Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
         resolution), for the overlay matcher: it then searches any placement, so either map may
@@ -262,6 +269,7 @@ class MatchConfig:
     orientation_overlap: float = 1.0
     orientation_finalists: int = 4
     adjacency_penalty: float = 2.0
+    door_penalty: float = 1.0
     scale: float | None = None
     overlay_min_iou: float = 0.15
     overlay_angle_step: float = 2.0
@@ -307,6 +315,7 @@ class MatchConfig:
             "vf2_timeout",
             "orientation_overlap",
             "adjacency_penalty",
+            "door_penalty",
             "overlay_min_iou",
             "overlay_angle_step",
         ):
@@ -383,6 +392,7 @@ class MatchConfig:
             position_refits=0,
             elastic="off",
             adjacency_penalty=0.0,
+            door_penalty=0.0,
             signature_refit=False,
             resampling_vote=False,
             hypothesis_score="structure",
@@ -420,6 +430,7 @@ class MatchConfig:
             position_refits=0,
             elastic="off",
             adjacency_penalty=0.0,
+            door_penalty=0.0,
             signature_refit=False,
             resampling_vote=False,
             hypothesis_score="substitutions",

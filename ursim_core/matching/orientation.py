@@ -48,6 +48,9 @@ __all__ = [
     "CLOSE_READING",
     "describe_gap",
     "broken_adjacencies",
+    "misplaced_doors",
+    "UNRELATED_DOOR",
+    "DOOR_EVIDENCE",
 ]
 
 
@@ -149,6 +152,85 @@ def broken_adjacencies(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) ->
         return 0.0
     kept = sum(any(a == b or metric_graph.has_edge(a, b) for a in partners[u] for b in partners[v]) for u, v in edges)
     return 1.0 - kept / len(edges)
+
+
+def _door_offsets(graph: nx.Graph) -> dict:
+    """Where each region touches each neighbour, from its centroid, in halves of its box's height
+    and width: ``{(region, neighbour): (rows, cols)}``, both ways round, for the edges with a
+    ``contact`` and the regions with a ``bbox``."""
+    offsets = {}
+    for a, b, contact in graph.edges(data="contact"):
+        if contact is None:
+            continue
+        for region, neighbour in ((a, b), (b, a)):
+            node = graph.nodes[region]
+            box = node.get("bbox")
+            if box is None:
+                continue
+            half_rows, half_cols = max(0.5, (box[2] - box[0]) / 2.0), max(0.5, (box[3] - box[1]) / 2.0)
+            centre = node["centroid"]
+            offsets[region, neighbour] = ((contact[0] - centre[0]) / half_rows, (contact[1] - centre[1]) / half_cols)
+    return offsets
+
+
+#: What :func:`misplaced_doors` counts for a contact of the sketch that the answer does not carry to
+#: the map: about the distance between two doors placed at random on a wall (the offsets run from
+#: -1 to 1 along it), not fitted.
+UNRELATED_DOOR = 1.0
+
+
+#: A reading whose :func:`misplaced_doors` is below this puts the sketch's doors about where the map
+#: has them; when no reading does, the doors do not rank the readings (``MatchConfig.door_penalty``).
+DOOR_EVIDENCE = 0.5
+
+
+def misplaced_doors(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) -> float:
+    """How far an answer's regions touch their neighbours from where their partners touch theirs.
+
+    For each region of ``sketch_graph`` and each neighbour: the place where the two touch (the
+    edge's ``contact``, a door for two rooms split at it), from the region's centroid in halves of
+    its box's height and width, against the same for their partners when the answer pairs both
+    and the partners are neighbours in ``metric_graph`` (the closest partners, for a region paired
+    more than once), else :data:`UNRELATED_DOOR`; the mean over them. 0 when the sketch graph has
+    no contacts.
+
+    The graphs must be in one frame (the sketch's turned to the reading, :func:`oriented_graph`).
+    A half turn or mirror image of a sketch of rooms along a corridor can fit the rooms' sizes
+    and neighbours as well as the right reading, but puts each room's door at the other end of
+    its wall (``MatchConfig.door_penalty``, docs/studies.md, round 46).
+
+    Examples
+    --------
+    >>> sketch = nx.Graph(); metric = nx.Graph()
+    >>> for graph in (sketch, metric):
+    ...     graph.add_node(1, centroid=(5.0, 5.0), bbox=(0, 0, 10, 10))
+    ...     graph.add_node(2, centroid=(15.0, 5.0), bbox=(10, 0, 20, 10))
+    >>> sketch.add_edge(1, 2, contact=(10.0, 2.0)); metric.add_edge(1, 2, contact=(10.0, 2.0))
+    >>> misplaced_doors([(1, 1), (2, 2)], sketch, metric)
+    0.0
+    >>> metric.edges[1, 2]["contact"] = (10.0, 8.0)  # the door at the other end of the wall
+    >>> round(misplaced_doors([(1, 1), (2, 2)], sketch, metric), 6)
+    1.2
+    """
+    partners: dict = {}
+    for sketch_region, metric_region in pairs:
+        partners.setdefault(sketch_region, []).append(metric_region)
+    sketch_offsets = _door_offsets(sketch_graph)
+    if not sketch_offsets:
+        return 0.0
+    metric_offsets = _door_offsets(metric_graph)
+    distances = []
+    for (region, neighbour), offset in sketch_offsets.items():
+        found = [
+            math.dist(offset, metric_offsets[a, b])
+            for a in partners.get(region, ())
+            for b in partners.get(neighbour, ())
+            if (a, b) in metric_offsets
+        ]
+        # A contact the answer does not carry to the map counts as an unrelated door: otherwise
+        # an answer that pairs fewer regions would be judged on fewer doors, and fare better.
+        distances.append(min(found) if found else UNRELATED_DOOR)
+    return float(np.mean(distances))
 
 
 def describe_gap(gap: float) -> str:
@@ -281,7 +363,7 @@ def region_outlines(graph: nx.Graph, labels: np.ndarray) -> dict:
 
 
 def oriented_graph(graph: nx.Graph, *, degrees: float, mirrored: bool, outlines: dict | None = None) -> nx.Graph:
-    """A copy of a region graph whose ``centroid`` and ``bbox`` are turned to a candidate.
+    """A copy of a region graph whose ``centroid``, ``bbox`` and edges' ``contact`` are turned to a candidate.
 
     The bounding box of a turned region is the box around its turned corners. Other attributes
     (size, shape, interior point) are kept as they are; the identity returns the graph itself.
@@ -328,4 +410,9 @@ def oriented_graph(graph: nx.Graph, *, degrees: float, mirrored: bool, outlines:
             out.nodes[node]["bbox"] = (float(low[i, 0]), float(low[i, 1]), float(high[i, 0]), float(high[i, 1]))
     for i, node in enumerate(nodes):
         out.nodes[node]["centroid"] = (float(moved[i, 0]), float(moved[i, 1]))
+    touching = [(a, b) for a, b, contact in out.edges(data="contact") if contact is not None]
+    if touching:
+        contacts = np.array([out.edges[edge]["contact"] for edge in touching], dtype=np.float64).reshape(-1, 2)
+        for edge, point in zip(touching, transform_points(contacts, degrees=degrees, mirrored=mirrored)):
+            out.edges[edge]["contact"] = (float(point[0]), float(point[1]))
     return out

@@ -37,7 +37,7 @@ from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
 from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically, laying_answer
-from ursim_core.matching.orientation import broken_adjacencies
+from ursim_core.matching.orientation import DOOR_EVIDENCE, broken_adjacencies, misplaced_doors
 from ursim_core.matching.oriented import (
     candidate_overlaps,
     carried_overlaps,
@@ -240,6 +240,7 @@ def _prepare_one(
             screened.append((ranked(chosen_of(coarse_prepared, results).normalised_cost, index), index))
         finalists = sorted(index for _, index in sorted(screened)[: config.orientation_finalists])
     trials = []
+    doors: list[float] = []  # per trial, with a door penalty: misplaced_doors of its answer
     starts: dict = {}  # the signature starts of the refit, by mirror flag (see _refitted)
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
@@ -257,7 +258,15 @@ def _prepare_one(
             # A reading that joins rooms that are not neighbours ranks worse (round 44).
             broken = broken_adjacencies(answer.pairs, prepared.sketch_graph, prepared.metric_graph)
             cost *= 1.0 + config.adjacency_penalty * broken
-        trials.append((ranked(cost, index), index, *kept))
+        trials.append([ranked(cost, index), index, *kept])
+        if config.door_penalty:
+            doors.append(misplaced_doors(answer.pairs, prepared.sketch_graph, prepared.metric_graph))
+    if doors and min(doors) < DOOR_EVIDENCE:
+        # A reading whose rooms touch their neighbours elsewhere than on the map ranks worse too
+        # (round 46), when some reading puts the sketch's doors where the map has them: where none
+        # does, the doors were not drawn where they are, and say nothing of the reading.
+        for trial, misplaced in zip(trials, doors):
+            trial[0] *= 1.0 + config.door_penalty * misplaced
     _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(

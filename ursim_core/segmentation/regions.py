@@ -9,6 +9,7 @@ makes the same as a ``networkx.Graph``; a command that only writes a segmentatio
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -39,10 +40,14 @@ class RegionTable:
         Region id -> ``{"size", "centroid", "interior", "bbox", "pca_shape"}``, ids ascending.
     edges : dict
         ``(a, b)`` with ``a < b`` -> ``boundary``, the number of 4-adjacent pixel pairs.
+    contacts : dict
+        ``(a, b)`` as in ``edges`` -> ``contact``, the mean (row, col) of the midpoints of those
+        pixel pairs: where the two regions touch (a door, for two rooms split at it).
     """
 
     nodes: dict[int, dict]
     edges: dict[tuple[int, int], int]
+    contacts: dict[tuple[int, int], tuple[float, float]] = dataclasses.field(default_factory=dict)
 
     def __contains__(self, region: object) -> bool:
         return region in self.nodes
@@ -72,13 +77,21 @@ class RegionTable:
         graph = nx.Graph()
         graph.add_nodes_from((region, dict(data)) for region, data in self.nodes.items())
         graph.add_edges_from((a, b, {"boundary": count}) for (a, b), count in self.edges.items())
+        for (a, b), contact in self.contacts.items():
+            graph.edges[a, b]["contact"] = contact
         return graph
 
     @classmethod
     def from_graph(cls, graph: nx.Graph) -> RegionTable:
         """The table of a region graph (given in place of a label image's)."""
-        edges = {(min(a, b), max(a, b)): data.get("boundary", 0) for a, b, data in graph.edges(data=True)}
-        return cls(nodes={region: dict(data) for region, data in graph.nodes(data=True)}, edges=edges)
+        edges, contacts = {}, {}
+        for a, b, data in graph.edges(data=True):
+            edges[min(a, b), max(a, b)] = data.get("boundary", 0)
+            if "contact" in data:
+                contacts[min(a, b), max(a, b)] = data["contact"]
+        return cls(
+            nodes={region: dict(data) for region, data in graph.nodes(data=True)}, edges=edges, contacts=contacts
+        )
 
 
 def adjacent_pairs(labels: np.ndarray) -> dict[tuple[int, int], int]:
@@ -100,30 +113,48 @@ def adjacent_pairs(labels: np.ndarray) -> dict[tuple[int, int], int]:
     >>> adjacent_pairs(labels)
     {(1, 2): 1}
     """
+    return _adjacency(labels)[0]
+
+
+def _adjacency(labels: np.ndarray) -> tuple[dict, dict]:
+    """:func:`adjacent_pairs`' counts, and the mean (row, col) of each pair's pixel-pair midpoints
+    (``RegionTable.contacts``)."""
     labels = np.asarray(labels)
-    firsts, seconds = [], []
+    firsts, seconds, rows_at, cols_at = [], [], [], []
     # In bands of rows (each with the next band's first row, for the pairs across): the masks
     # of a band stay small, where full-size ones were several images of fresh memory (64 MB
     # each at 8000 x 8000 px). The pairs are counted, so their order does not matter.
     for rows in row_bands(labels):
         band = labels[rows.start : rows.stop + 1]
         height = rows.stop - rows.start
-        for a, b in ((band[:height, :-1], band[:height, 1:]), (band[:-1, :], band[1:, :])):
+        # Side by side (the midpoint half a column right), then one above the other (half a row down).
+        for (a, b), (down, right) in (
+            ((band[:height, :-1], band[:height, 1:]), (0.0, 0.5)),
+            ((band[:-1, :], band[1:, :]), (0.5, 0.0)),
+        ):
             touching = a != b
             touching &= a != 0
             touching &= b != 0
             firsts.append(a[touching])
             seconds.append(b[touching])
+            found_rows, found_cols = np.divmod(np.flatnonzero(touching), touching.shape[1])
+            rows_at.append(found_rows + (rows.start + down))
+            cols_at.append(found_cols + right)
     if not firsts:
-        return {}
+        return {}, {}
     first = np.concatenate(firsts).astype(np.int64)
     second = np.concatenate(seconds).astype(np.int64)
     low, high = np.minimum(first, second), np.maximum(first, second)
     if low.size == 0:
-        return {}
+        return {}, {}
     base = int(high.max()) + 1
-    keys, counts = np.unique(low * base + high, return_counts=True)
-    return {(int(k // base), int(k % base)): int(n) for k, n in zip(keys, counts)}
+    keys, inverse, counts = np.unique(low * base + high, return_inverse=True, return_counts=True)
+    row_means = np.bincount(inverse, weights=np.concatenate(rows_at)) / counts
+    col_means = np.bincount(inverse, weights=np.concatenate(cols_at)) / counts
+    pairs = [(int(k // base), int(k % base)) for k in keys.tolist()]
+    edges = {pair: int(n) for pair, n in zip(pairs, counts.tolist())}
+    contacts = {pair: (float(r), float(c)) for pair, r, c in zip(pairs, row_means.tolist(), col_means.tolist())}
+    return edges, contacts
 
 
 #: Pixels per band of :func:`row_bands`: the masks of a band then fit a core's 2 MB cache
@@ -253,7 +284,7 @@ def region_table(labels: np.ndarray) -> RegionTable:
         pixel farthest from the region's border, a point safely inside even for non-convex
         regions), ``bbox`` (min_row, min_col, max_row, max_col; max exclusive) and
         ``pca_shape`` (see :func:`contour_pca_shape`); per pair of regions with 4-adjacent
-        pixels, the number of such pixel pairs.
+        pixels, the number of such pixel pairs (``edges``) and where they touch (``contacts``).
 
     Examples
     --------
@@ -299,4 +330,5 @@ def region_table(labels: np.ndarray) -> RegionTable:
             "bbox": (row_start, col_start, row_stop, col_stop),
             "pca_shape": _pca_shape_of_padded(padded),
         }
-    return RegionTable(nodes=nodes, edges=adjacent_pairs(labels))
+    edges, contacts = _adjacency(labels)
+    return RegionTable(nodes=nodes, edges=edges, contacts=contacts)

@@ -117,3 +117,18 @@ def test_a_partial_sketch_read_as_its_mirror_image_is_read_right_once_broken_doo
     default = run_case(1, "cropped")
     assert not without.read_right and without.f1 < 0.2
     assert default.read_right and default.f1 >= 0.7
+
+
+def test_a_plan_symmetric_but_for_its_doors_is_read_right_once_the_doors_count():
+    # Seed 37: the two rows of rooms are within a few pixels of each other, and the sketch leaves
+    # out the corridor that told them apart. Its mirror image fits sizes and neighbours as well,
+    # but puts every door at the other end of its wall (MatchConfig.door_penalty, round 46).
+    from ursim_core.matching import MatchConfig
+
+    without = run_case(37, "upright", config=MatchConfig(door_penalty=0.0))
+    default = run_case(37, "upright")
+    assert not without.read_right and without.f1 < 0.2
+    assert default.read_right and default.f1 >= 0.9
+    # A partial sketch too: seed 15 cropped, read as its half turn without the doors.
+    assert not run_case(15, "cropped", config=MatchConfig(door_penalty=0.0)).read_right
+    assert run_case(15, "cropped").read_right

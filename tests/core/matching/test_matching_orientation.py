@@ -14,7 +14,9 @@ from ursim_core.evaluation import augment
 from ursim_core.evaluation.scoring import score_matches
 from ursim_core.matching import MatchConfig, match, prepare
 from ursim_core.matching.orientation import (
+    UNRELATED_DOOR,
     broken_adjacencies,
+    misplaced_doors,
     orientation_candidates,
     oriented_graph,
     region_outlines,
@@ -189,6 +191,51 @@ def test_broken_adjacencies_counts_edges_whose_partners_are_not_neighbours():
     assert broken_adjacencies([(1, 10), (2, 12), (3, 11)], sketch, metric) == pytest.approx(0.5)
     assert broken_adjacencies([(1, 12), (2, 10), (3, 12), (4, 10)], sketch, metric) == pytest.approx(1.0)
     assert broken_adjacencies([(1, 10)], sketch, metric) == 0.0
+
+
+def test_config_validates_door_penalty():
+    for bad in (-0.5, float("inf"), False, "1"):
+        with pytest.raises(ParameterError, match="door_penalty"):
+            MatchConfig(door_penalty=bad)
+    assert MatchConfig.paper().door_penalty == 0 == MatchConfig.released().door_penalty
+
+
+def _comb(doors_at: list[float]) -> nx.Graph:
+    """A corridor (region 1, rows 10-20, columns 0-40) with rooms 2, 3, 4 above it (rows 0-10, ten
+    columns each), each touching it at the column ``doors_at`` gives."""
+    graph = nx.Graph()
+    graph.add_node(1, centroid=(15.0, 20.0), bbox=(10, 0, 20, 40))
+    for room, door in zip((2, 3, 4), doors_at):
+        left = 10.0 * (room - 2)
+        graph.add_node(room, centroid=(5.0, left + 5.0), bbox=(0, left, 10, left + 10))
+        graph.add_edge(1, room, contact=(10.0, left + door))
+    return graph
+
+
+def test_misplaced_doors_measures_where_paired_regions_touch():
+    metric = _comb([2.0, 2.0, 8.0])
+    assert misplaced_doors([(1, 1), (2, 2), (3, 3), (4, 4)], _comb([2.0, 2.0, 8.0]), metric) == 0.0
+    # The same rooms with room 2's door at the other end of its wall: 1.2 box halves off, seen
+    # from the room and (1.2 x 5 px) / 20 px from the corridor; the mean over the six contacts.
+    moved = misplaced_doors([(1, 1), (2, 2), (3, 3), (4, 4)], _comb([8.0, 2.0, 8.0]), metric)
+    assert moved == pytest.approx((1.2 + 0.3) / 6)
+    # A contact the answer does not carry to the map counts as an unrelated door.
+    unpaired = misplaced_doors([(1, 1), (2, 2), (3, 3)], _comb([2.0, 2.0, 8.0]), metric)
+    assert unpaired == pytest.approx(2 * UNRELATED_DOOR / 6)
+    # No contacts at all (a graph from elsewhere): nothing to say.
+    assert misplaced_doors([(1, 1)], nx.Graph([(1, 2)]), metric) == 0.0
+
+
+def test_turned_graphs_carry_their_contacts_along():
+    graph = _comb([2.0, 2.0, 8.0])
+    turned = oriented_graph(graph, degrees=180, mirrored=False)
+    assert turned.edges[1, 2]["contact"] == pytest.approx((-10.0, -2.0))
+    # Turned alike, the doors are where they were from every region.
+    assert misplaced_doors([(n, n) for n in graph], turned, oriented_graph(graph, degrees=180, mirrored=False)) == 0
+    mirrored = oriented_graph(graph, degrees=0, mirrored=True)
+    assert mirrored.edges[1, 4]["contact"] == pytest.approx((10.0, -28.0))
+    # The mirror image read against the map puts every door at the other end of its wall.
+    assert misplaced_doors([(n, n) for n in graph], mirrored, graph) > 0
 
 
 def test_a_reading_that_breaks_adjacencies_ranks_worse_by_the_penalty():

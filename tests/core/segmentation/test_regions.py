@@ -36,6 +36,22 @@ def test_the_table_is_the_graph_in_the_same_order():
     assert (3 in table) == (3 in graph) and 0 not in table
 
 
+def test_contacts_are_where_two_regions_touch_and_travel_with_the_graph():
+    labels = np.zeros((6, 9), np.int32)
+    labels[:, :4], labels[:, 5:] = 1, 2
+    labels[4, 4] = 2  # a door at row 4: 1 and 2 touch there only
+    labels[:2, 5:] = 3  # 3 above 2, along their whole width
+    table = region_table(labels)
+    assert table.contacts[1, 2] == (4.0, 3.5)  # between column 3 and the door pixel, at row 4
+    assert table.contacts[2, 3] == (1.5, 6.5)  # between rows 1 and 2, over columns 5-8
+    graph = table.to_graph()
+    assert graph.edges[1, 2]["contact"] == (4.0, 3.5) and graph.edges[2, 3]["boundary"] == 4
+    assert RegionTable.from_graph(graph).contacts == table.contacts
+    # A graph made elsewhere, without contacts, gives a table without them.
+    graph.edges[1, 2].pop("contact")
+    assert (1, 2) not in RegionTable.from_graph(graph).contacts
+
+
 def test_negative_labels_are_refused_by_name():
     from ursim_core.errors import ParameterError
 
@@ -134,12 +150,20 @@ def _direct_table(labels):
             "pca_shape": contour_pca_shape(crop),
         }
     edges: dict = {}
-    for a, b in ((labels[:, :-1], labels[:, 1:]), (labels[:-1], labels[1:])):
-        for x, y in zip(a.ravel().tolist(), b.ravel().tolist()):
+    sums: dict = {}
+    rows, cols = np.indices(labels.shape)
+    # Side by side, the midpoint half a column right of the left pixel; one above the other, half a row down.
+    for (a, b), (down, right), (r, c) in (
+        ((labels[:, :-1], labels[:, 1:]), (0.0, 0.5), (rows[:, :-1], cols[:, :-1])),
+        ((labels[:-1], labels[1:]), (0.5, 0.0), (rows[:-1], cols[:-1])),
+    ):
+        for x, y, row, col in zip(a.ravel().tolist(), b.ravel().tolist(), r.ravel().tolist(), c.ravel().tolist()):
             if x != y and x and y:
                 key = (min(x, y), max(x, y))
                 edges[key] = edges.get(key, 0) + 1
-    return nodes, dict(sorted(edges.items()))
+                sums[key] = (sums.get(key, (0.0, 0.0))[0] + row + down, sums.get(key, (0.0, 0.0))[1] + col + right)
+    contacts = {key: (sums[key][0] / edges[key], sums[key][1] / edges[key]) for key in sorted(edges)}
+    return nodes, dict(sorted(edges.items())), contacts
 
 
 @pytest.mark.parametrize("shape", [(700, 1100), (1300, 240), (3, 90000), (9, 9)])
@@ -154,8 +178,11 @@ def test_the_table_follows_the_definitions_across_bands_of_rows(shape):
     labels[specks] = rng.integers(0, 9, int(specks.sum()))  # holes, and specks touching on every row
     labels[labels == 4] = 0  # an id with no pixels
     table = region_table(labels)
-    nodes, edges = _direct_table(labels)
+    nodes, edges, contacts = _direct_table(labels)
     assert table.nodes == nodes and table.edges == edges
+    assert table.contacts.keys() == contacts.keys()
+    for pair, (row, col) in contacts.items():
+        assert table.contacts[pair] == pytest.approx((row, col), abs=1e-9), pair
     assert all(
         type(v) is int for node in table.nodes.values() for v in (*node["interior"], *node["bbox"], node["size"])
     )
