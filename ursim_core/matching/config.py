@@ -63,6 +63,11 @@ VOTE_RULES = ("score", "count")
 VOTE_ORIENTATIONS = ("own", "first")
 
 
+def _is_number(value) -> bool:
+    """Whether ``value`` is a finite int or float (a bool is not a number here)."""
+    return not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+
+
 @dataclass(frozen=True, kw_only=True)
 class MatchConfig:
     """Options of the matcher; the defaults are the recommended configuration.
@@ -295,14 +300,8 @@ class MatchConfig:
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise ParameterError(f"must be one of {allowed}, not {getattr(self, name)!r}", field=name)
-        if self.m != "auto":
-            if (
-                isinstance(self.m, bool)
-                or not isinstance(self.m, (int, float))
-                or not math.isfinite(self.m)
-                or self.m < 0
-            ):
-                raise ParameterError(f"must be 'auto' or a non-negative number, not {self.m!r}", field="m")
+        if self.m != "auto" and not (_is_number(self.m) and self.m >= 0):
+            raise ParameterError(f"must be 'auto' or a non-negative number, not {self.m!r}", field="m")
         if self.max_seeds not in ("auto", None) and (not isinstance(self.max_seeds, int) or self.max_seeds < 1):
             raise ParameterError(
                 f"must be 'auto', None or a positive integer, not {self.max_seeds!r}", field="max_seeds"
@@ -320,22 +319,13 @@ class MatchConfig:
             "overlay_angle_step",
         ):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+            if not (_is_number(value) and value >= 0):
                 raise ParameterError(f"must be a non-negative number, not {value!r}", field=name)
-        if self.orientation not in ORIENTATIONS and (
-            isinstance(self.orientation, bool)
-            or not isinstance(self.orientation, (int, float))
-            or not math.isfinite(self.orientation)
-        ):
+        if self.orientation not in ORIENTATIONS and not _is_number(self.orientation):
             raise ParameterError(
                 f"must be 'any', 'upright' or a number of degrees, not {self.orientation!r}", field="orientation"
             )
-        if self.scale is not None and (
-            isinstance(self.scale, bool)
-            or not isinstance(self.scale, (int, float))
-            or not math.isfinite(self.scale)
-            or self.scale <= 0
-        ):
+        if self.scale is not None and not (_is_number(self.scale) and self.scale > 0):
             raise ParameterError(f"must be a positive number or null, not {self.scale!r}", field="scale")
         if self.input_kind not in (None, "sketch", "metric"):
             raise ParameterError(f"must be 'sketch', 'metric' or null, not {self.input_kind!r}", field="input_kind")
