@@ -453,6 +453,7 @@ def run(args: argparse.Namespace) -> int:
         + (f", voted over {record['resampling_votes']} resamplings" if record["resampling_votes"] else "")
         + (", pairs from the sketch laid and bent onto the map" if record["laid"] else "")
         + (" where the graph answer puts it" if record["laid_by"] == "answer" else "")
+        + (" on the part of the map it resembles most" if record["laid_by"] == "window" else "")
         + f", {record['match_ms']:.1f} ms"
         + (f"; {record['reason']}" if record["reason"] else "")
     )

@@ -42,7 +42,7 @@ VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
 #: The values of ``MatchConfig.elastic`` (see :mod:`ursim_core.matching.elastic`).
 ELASTIC_RULES = ("off", "alone", "completed")
 #: The values of ``MatchConfig.elastic_laying`` (see :mod:`ursim_core.matching.elastic`).
-ELASTIC_LAYINGS = ("boxes", "boxes_or_answer")
+ELASTIC_LAYINGS = ("boxes", "boxes_or_answer", "window", "window_or_answer")
 #: The values of ``MatchConfig.orientation`` other than a number of degrees.
 ORIENTATIONS = ("any", "upright")
 
@@ -232,13 +232,15 @@ class MatchConfig:
         optical flow between the two maps (:mod:`ursim_core.matching.elastic`), regions paired at
         ``overlay_min_iou``; 'completed' adds the planar answer's pairs of regions left unpaired on
         both sides. Planar matcher, label images and sketch-sized maps (at most 60 regions each) only.
-    elastic_laying : {'boxes', 'boxes_or_answer'}
+    elastic_laying : {'boxes', 'boxes_or_answer', 'window', 'window_or_answer'}
         Where the sketch is laid before it is bent: 'boxes' (default), box onto box;
         'boxes_or_answer', also by a scale and a shift per axis fitted to the planar answer's pairs
         (:func:`~ursim_core.matching.elastic.answer_laying`), and the laying whose bent sketch
         lands more on the metric map's free space gives the pairs: a partial sketch laid box onto
-        box is stretched over the whole map. Not the default: its second optical flow takes a
-        turned KTH pair over the 50 ms budget. Evidence: docs/options.md.
+        box is stretched over the whole map. 'window' lays it instead in the window of the map
+        where it correlates clearly better than over the whole box
+        (:func:`~ursim_core.matching.elastic.window_laying`); 'window_or_answer', that or the
+        answer's laying. Not the default: see docs/options.md.
     """
 
     variant: str = "T4"

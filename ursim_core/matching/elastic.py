@@ -41,6 +41,7 @@ __all__ = [
     "elastic_flow",
     "box_laying",
     "answer_laying",
+    "window_laying",
     "lay_sketch",
     "elastic_pairs",
     "laid_sketch",
@@ -318,6 +319,7 @@ def lay_sketch(
     mirrored: bool = False,
     answer=None,
     laying: Laying | None = None,
+    window: bool = False,
     min_iou: float = 0.15,
     clip: float = DISTANCE_CLIP,
 ) -> LaidSketch | None:
@@ -335,7 +337,11 @@ def lay_sketch(
         the intersection over union: a partial sketch stretched box onto box over the whole map
         covers more of it, but less of it lands on free space.
     laying : Laying, keyword-only
-        Lay the sketch so and no other way (``answer`` is then not read).
+        Lay the sketch so and no other way (``answer`` and ``window`` are then not read).
+    window : bool, keyword-only
+        Lay the sketch in the window of the metric map where it correlates clearly better than
+        over the map's whole box (:func:`window_laying`), instead of box onto box: a sketch of
+        part of a building.
     min_iou : float, keyword-only
         Regions are paired when their intersection over union is at least this.
     clip : float, keyword-only
@@ -357,7 +363,14 @@ def lay_sketch(
     from ursim_core.matching.overlay import overlay_pairs
 
     found = _laid(
-        sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, clip=clip, answer=answer, laying=laying
+        sketch_labels,
+        metric_labels,
+        degrees=degrees,
+        mirrored=mirrored,
+        clip=clip,
+        answer=answer,
+        laying=laying,
+        window=window,
     )
     if found is None:
         return None
@@ -434,15 +447,54 @@ def laid_sketch(
     return bent.astype(np.int32)
 
 
-def _laid(sketch_labels, metric_labels, *, degrees: float, mirrored: bool, clip: float, answer=None, laying=None):
+def window_laying(sketch: np.ndarray, metric_labels: np.ndarray, *, gain: float | None = None) -> Laying | None:
+    """The :class:`Laying` that carries the box around the oriented sketch's regions onto the
+    window of the metric map where it correlates best (:func:`~ursim_core.matching.template.best_window`),
+    when that window correlates better than the map's whole box by at least ``gain``; else None.
+
+    Examples
+    --------
+    >>> plan = np.zeros((300, 600), np.int32)
+    >>> plan[20:130, 20:150], plan[20:130, 160:400], plan[20:130, 410:580] = 1, 2, 3
+    >>> plan[140:170, 20:580], plan[180:280, 20:260], plan[180:280, 270:580] = 4, 5, 6
+    >>> laying = window_laying(plan[:, :320], plan)
+    >>> laying.by, 0.9 < laying.col_scale < 1.1
+    ('window', True)
+    >>> window_laying(plan, plan) is None
+    True
+    """
+    from ursim_core.matching.template import WINDOW_GAIN, best_window
+
+    sketch_free, metric_free = np.asarray(sketch) > 0, np.asarray(metric_labels) > 0
+    window = best_window(sketch_free, metric_free)
+    if window is None or window.gain < (WINDOW_GAIN if gain is None else gain):
+        return None
+    r0, r1, c0, c1 = _box(sketch_free)
+    row_scale, col_scale = window.height / (r1 - r0), window.width / (c1 - c0)
+    return Laying("window", row_scale, window.top - row_scale * r0, col_scale, window.left - col_scale * c0)
+
+
+def _laid(
+    sketch_labels,
+    metric_labels,
+    *,
+    degrees: float,
+    mirrored: bool,
+    clip: float,
+    answer=None,
+    laying=None,
+    window: bool = False,
+):
     """``(bent sketch, metric map, laying, landed)``, the images at the working size, of the
-    laying given, or else of the better of box onto box and the answer's; None when either map
-    has no region."""
+    laying given, or else of the better of box onto box (or the window, with ``window``, when it
+    is clearly better) and the answer's; None when either map has no region."""
     metric_labels = np.asarray(metric_labels)
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
     boxes = _box_laying(sketch, metric_labels)  # None when either map has no region
     if boxes is None:
         return None
+    if laying is None and window:
+        boxes = window_laying(sketch, metric_labels) or boxes
     layings = [boxes if laying is None else laying]
     if laying is None and answer:
         fitted = _answer_laying(sketch, _metric_centroids(metric_labels), answer)

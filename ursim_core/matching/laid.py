@@ -35,18 +35,20 @@ class LaidAhead:
     waits for it. The same result as a call made later (no shared state but the metric map's
     memos of its working image and centroids)."""
 
-    def __init__(self, sketch_labels, metric_labels, orientation, min_iou: float, answer=None) -> None:
+    def __init__(
+        self, sketch_labels, metric_labels, orientation, min_iou: float, answer=None, *, window: bool = False
+    ) -> None:
         import threading
 
         self._laid = None
         self._error: BaseException | None = None
-        arguments = (sketch_labels, metric_labels, orientation, min_iou, answer)
+        arguments = (sketch_labels, metric_labels, orientation, min_iou, answer, window)
         self._thread = threading.Thread(target=self._run, args=arguments, daemon=True)
         self._thread.start()
 
-    def _run(self, sketch_labels, metric_labels, orientation, min_iou, answer) -> None:
+    def _run(self, sketch_labels, metric_labels, orientation, min_iou, answer, window) -> None:
         try:
-            self._laid = _lay(sketch_labels, metric_labels, orientation, min_iou, answer)
+            self._laid = _lay(sketch_labels, metric_labels, orientation, min_iou, answer, window=window)
         except BaseException as error:  # re-raised where the result is read
             self._error = error
 
@@ -63,7 +65,7 @@ def laying_answer(prepared: Prepared, orientation: tuple, result: MatchResult | 
     when it reads the sketch so, else ``result``'s; None for box onto box only. One laying per
     orientation, whatever m: an answer at a small m pairs too few regions to lay the sketch, and
     a flow per m would cost an evaluation's sweep a flow per m."""
-    if prepared.config.elastic_laying != "boxes_or_answer":
+    if not prepared.config.elastic_laying.endswith("_or_answer"):
         return None
     chosen = prepared.chosen
     if chosen is not None and tuple(chosen.orientation) == tuple(orientation) and chosen.pairs:
@@ -71,11 +73,19 @@ def laying_answer(prepared: Prepared, orientation: tuple, result: MatchResult | 
     return list(result.pairs) if result is not None and result.pairs else None
 
 
-def _lay(sketch_labels, metric_labels, orientation, min_iou: float, answer=None):
+def window_laid(config) -> bool:
+    """Whether ``config`` (a :class:`~ursim_core.matching.MatchConfig`) lays the sketch in the
+    metric map's best window when it is clearly better than box onto box (``elastic_laying``)."""
+    return config.elastic_laying.startswith("window")
+
+
+def _lay(sketch_labels, metric_labels, orientation, min_iou: float, answer=None, *, window: bool = False):
     from ursim_core.matching.elastic import lay_sketch
 
     degrees, mirrored = orientation
-    return lay_sketch(sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, answer=answer, min_iou=min_iou)
+    return lay_sketch(
+        sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, answer=answer, window=window, min_iou=min_iou
+    )
 
 
 def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
@@ -96,6 +106,7 @@ def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
             orientation,
             prepared.config.overlay_min_iou,
             laying_answer(prepared, orientation, result),
+            window=window_laid(prepared.config),
         )
     laid = answers[orientation]
     pairs = [] if laid is None else laid.pairs

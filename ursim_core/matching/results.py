@@ -234,7 +234,8 @@ def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
 
 def laid_by(result: MatchResult) -> str:
     """How a laid answer's sketch was laid before it was bent: ``"boxes"`` (box onto box) or
-    ``"answer"`` (by the planar answer's pairs, ``MatchConfig.elastic_laying``); ``""`` when the
+    ``"answer"`` (by the planar answer's pairs) or ``"window"`` (in the window of the metric map it
+    correlates with best; both ``MatchConfig.elastic_laying``); ``""`` when the
     pairs are not the laid sketch's."""
     laying = getattr(result, "laying", None)
     return laying.by if getattr(result, "laid", False) and laying is not None else ""

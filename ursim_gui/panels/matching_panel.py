@@ -62,6 +62,8 @@ PAIRS_FROM = (
 LAYINGS = (
     ("boxes", "box onto box (a sketch of the whole map)"),
     ("boxes_or_answer", "box onto box or where the graph answer puts it (a partial sketch; slower)"),
+    ("window", "box onto box or the part of the map it resembles most (a partial sketch)"),
+    ("window_or_answer", "that, or where the graph answer puts it (a partial sketch; slowest)"),
 )
 #: The matchers that use a known scale; those whose pairs may come from the laid sketch.
 _SCALED_MATCHERS = ("auto", "overlay")
@@ -106,6 +108,8 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
 
             if laid_by(result) == "answer":
                 text += ", laid where the graph answer puts it"
+            elif laid_by(result) == "window":
+                text += ", laid on the part of the map it resembles most"
     found = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
     if found is not None:
         text += f"\nread the sketch {found.describe()}"
@@ -200,8 +204,10 @@ class MatchingPanel(QWidget):
             self.laying,
             _ELASTIC_MATCHERS,
             "Where the sketch is laid before it is bent: box onto box stretches a sketch of part of the "
-            "map over all of it; the graph answer's pairs lay it where they put it, and the laying whose "
-            "bent sketch lands more on the map's free space is kept (a second optical flow per match)",
+            "map over all of it; the window is the part of the map the sketch resembles most, used when it "
+            "resembles it clearly better than the whole map; the graph answer's pairs lay it where they put it, "
+            "and the laying whose bent sketch lands more on the map's free space is kept (a second optical flow "
+            "per match)",
         )
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")

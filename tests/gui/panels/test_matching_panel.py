@@ -225,3 +225,7 @@ def test_the_panel_lays_a_partial_sketch_where_its_answer_puts_it(window, qtbot)
     by_answer = dataclasses.replace(result, laying=Laying("answer", 1.0, 0.0, 1.0, 0.0))
     assert "laid where the graph answer puts it" in describe_result(by_answer)
     assert "graph answer" not in describe_result(dataclasses.replace(result, laying=None))
+    by_window = dataclasses.replace(result, laying=Laying("window", 1.0, 0.0, 1.0, 0.0))
+    assert "part of the map it resembles most" in describe_result(by_window)
+    panel.laying.setCurrentIndex(panel.laying.findData("window"))
+    assert panel.config().elastic_laying == "window"

@@ -1,0 +1,152 @@
+"""Where a sketch of part of a building sits on the metric map: a template search over windows.
+
+Laid box onto box (:func:`~ursim_core.matching.elastic.box_laying`), a sketch of part of a building
+is stretched over the whole metric map, and the flow that bends it cannot undo a stretch of a
+third. :func:`best_window` instead slides the sketch, shrunk to a range of sizes, over the metric
+map at a coarse size and keeps the window where the two maps' signed distance images correlate
+best (OpenCV's normalised cross-correlation, ``TM_CCOEFF_NORMED``), with how much better that
+window correlates than the whole map's box does. :func:`~ursim_core.matching.elastic.lay_sketch`
+lays the sketch in that window only when it is clearly better (:data:`WINDOW_GAIN`): a whole
+sketch correlates a little better with some part of the map too.
+
+Everything here is on boolean free-space images in (row, col); the sketch is already in the
+orientation it is read in.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+__all__ = ["COARSE_SIDE", "WINDOW_CLIP", "WINDOW_SIDES", "WINDOW_ASPECTS", "WINDOW_GAIN", "Window", "best_window"]
+
+#: The metric map's longer side (pixels) during the search: enough for corridors and rooms to show.
+COARSE_SIDE = 128
+#: Signed distances are clipped at this many pixels of the coarse size either side of a wall.
+WINDOW_CLIP = 12.0
+#: The window's size as a share of the largest window of the sketch's shape within the metric
+#: map's box (a sketch of the whole building down to half of its width and height).
+WINDOW_SIDES = (1.0, 0.95, 0.9, 0.85, 0.8, 0.75, 0.7, 0.65, 0.6, 0.55, 0.5)
+#: The window's width over what the sketch's shape gives (a sketch drawn a little wide or narrow).
+WINDOW_ASPECTS = (1.0, 1.1, 1 / 1.1)
+#: How much better (in correlation) the best window must be than the map's whole box for the
+#: sketch to be laid in it (round 47, generated seeds 0-63 told their orientation; docs/options.md).
+WINDOW_GAIN = 0.15
+#: Coarse pixels the window may reach past the metric map's box (a sketch drawn a little large).
+_PAD = 4
+
+
+class Window(NamedTuple):
+    """Where :func:`best_window` puts the sketch's box on the metric map, in the metric map's
+    pixels: ``(top, left)`` and ``(height, width)``; ``correlation`` there, and ``gain``, how
+    much higher it is than the correlation of the sketch stretched over the map's whole box."""
+
+    top: float
+    left: float
+    height: float
+    width: float
+    correlation: float
+    gain: float
+
+
+def _signed(free: np.ndarray, clip: float) -> np.ndarray:
+    import cv2
+
+    inside = cv2.distanceTransform(free.astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5)
+    outside = cv2.distanceTransform((~free).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5)
+    return np.clip(inside - outside, -clip, clip).astype(np.float32)
+
+
+def _box(free: np.ndarray) -> tuple[int, int, int, int] | None:
+    rows, cols = np.flatnonzero(free.any(axis=1)), np.flatnonzero(free.any(axis=0))
+    if not len(rows):
+        return None
+    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+
+
+def best_window(
+    sketch_free: np.ndarray,
+    metric_free: np.ndarray,
+    *,
+    sides=WINDOW_SIDES,
+    aspects=WINDOW_ASPECTS,
+    coarse: int = COARSE_SIDE,
+    clip: float = WINDOW_CLIP,
+) -> Window | None:
+    """The window of the metric map where the sketch's free space correlates best with it.
+
+    Parameters
+    ----------
+    sketch_free, metric_free : ndarray of bool, shape (rows, cols)
+        Free space; the sketch in the orientation it is read in.
+    sides, aspects : keyword-only
+        The windows tried besides the map's whole box: the sketch's box, scaled to the largest
+        of its shape that fits in the map's box, times each of :data:`WINDOW_SIDES`, its width
+        also times each of :data:`WINDOW_ASPECTS`.
+    coarse, clip : keyword-only
+        :data:`COARSE_SIDE` and :data:`WINDOW_CLIP`.
+
+    Returns
+    -------
+    Window or None
+        None when either map has no free space, or the sketch is flat (one value throughout).
+
+    Examples
+    --------
+    Five rooms along a corridor, and a sketch of the plan's left half:
+
+    >>> plan = np.zeros((300, 600), bool)
+    >>> plan[20:130, 20:150] = plan[20:130, 160:400] = plan[20:130, 410:580] = True
+    >>> plan[140:170, 20:580] = True
+    >>> plan[180:280, 20:260] = plan[180:280, 270:580] = True
+    >>> window = best_window(plan[:, :320], plan)
+    >>> abs(window.left - 20) < 10, abs(window.width - 300) < 30, window.gain > WINDOW_GAIN
+    (True, True, True)
+    >>> best_window(plan, plan).gain < WINDOW_GAIN
+    True
+    """
+    import cv2
+
+    sketch_free, metric_free = np.asarray(sketch_free, bool), np.asarray(metric_free, bool)
+    sketch_box, metric_box = _box(sketch_free), _box(metric_free)
+    if sketch_box is None or metric_box is None:
+        return None
+    factor = coarse / max(metric_free.shape)
+    shape = (max(1, round(metric_free.shape[0] * factor)), max(1, round(metric_free.shape[1] * factor)))
+    metric = cv2.resize(metric_free.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_AREA) > 0
+    metric_image = _signed(np.pad(metric, _PAD), clip)
+    (r0, r1, c0, c1), (m0, m1, n0, n1) = sketch_box, metric_box
+    sketch = sketch_free[r0:r1, c0:c1].astype(np.uint8)
+    height, width = (m1 - m0) * factor, (n1 - n0) * factor
+    # The sketch kept in proportion: the largest window of its box's shape within the map's box,
+    # then smaller; the map's whole box (the box laying, stretched to it) is the reference.
+    fit = min(height / (r1 - r0), width / (c1 - c0))
+    windows = [(height, width)] + [
+        ((r1 - r0) * fit * side, (c1 - c0) * fit * side * aspect) for side in sides for aspect in aspects
+    ]
+    best, whole = None, None
+    for index, (rows, cols) in enumerate(windows):
+        rows, cols = max(3, round(rows)), max(3, round(cols))
+        if rows > metric_image.shape[0] or cols > metric_image.shape[1]:
+            continue
+        shrunk = cv2.resize(sketch, (cols, rows), interpolation=cv2.INTER_AREA) > 0
+        # What lies beyond the sketch's box is unknown: a wall (a whole building's outline) or
+        # more rooms (where a partial sketch is cut). Only the pixels whose distance is the same
+        # either way are compared (walled in alone, or open alone, the windows found were
+        # smaller or larger than the part's: round 47).
+        template = _signed(shrunk, clip)
+        known = np.abs(template - _signed(np.pad(shrunk, 1), clip)[1:-1, 1:-1]) < 0.5
+        if np.count_nonzero(known) < known.size // 4 or float(template[known].std()) < 1e-6:
+            continue
+        found = cv2.matchTemplate(metric_image, template, cv2.TM_CCOEFF_NORMED, mask=known.astype(np.float32))
+        _, value, _, (x, y) = cv2.minMaxLoc(np.nan_to_num(found, nan=-1.0, posinf=-1.0, neginf=-1.0))
+        if index == 0:
+            whole = value
+        if best is None or value > best[0]:
+            best = (value, y, x, rows, cols)
+    if best is None:
+        return None
+    value, y, x, rows, cols = best
+    gain = value - whole if whole is not None else 0.0
+    return Window((y - _PAD) / factor, (x - _PAD) / factor, rows / factor, cols / factor, float(value), float(gain))
