@@ -31,6 +31,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ursim_core.matching.template import signed_distance
+
 __all__ = [
     "WORKING_SIDE",
     "DISTANCE_CLIP",
@@ -119,23 +121,6 @@ def oriented_labels(labels: np.ndarray, *, degrees: float, mirrored: bool) -> np
     # Nearest neighbour on float32 keeps the ids exactly (they are far below 2**24).
     turned = cv2.warpAffine(labels.astype(np.float32), matrix, (new_cols, new_rows), flags=cv2.INTER_NEAREST)
     return turned.astype(labels.dtype)
-
-
-def signed_distance(free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:
-    """Distance to the nearest wall, positive inside the free space and negative outside, clipped.
-
-    Examples
-    --------
-    >>> free = np.zeros((7, 7), bool); free[1:6, 1:6] = True
-    >>> signed_distance(free, clip=2)[3].tolist()
-    [-1.0, 1.0, 2.0, 2.0, 2.0, 1.0, -1.0]
-    """
-    import cv2
-
-    free = np.asarray(free, bool)
-    inside = cv2.distanceTransform(free.astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5)
-    outside = cv2.distanceTransform((~free).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5)
-    return np.clip(inside - outside, -clip, clip).astype(np.float32)
 
 
 def elastic_flow(fixed_free: np.ndarray, moving_free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:

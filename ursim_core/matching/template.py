@@ -19,7 +19,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["COARSE_SIDE", "WINDOW_CLIP", "WINDOW_SIDES", "WINDOW_ASPECTS", "WINDOW_GAIN", "Window", "best_window"]
+__all__ = [
+    "COARSE_SIDE",
+    "WINDOW_CLIP",
+    "WINDOW_SIDES",
+    "WINDOW_ASPECTS",
+    "WINDOW_GAIN",
+    "Window",
+    "signed_distance",
+    "best_window",
+]
 
 #: The metric map's longer side (pixels) during the search: enough for corridors and rooms to show.
 COARSE_SIDE = 128
@@ -50,9 +59,19 @@ class Window(NamedTuple):
     gain: float
 
 
-def _signed(free: np.ndarray, clip: float) -> np.ndarray:
+def signed_distance(free: np.ndarray, *, clip: float) -> np.ndarray:
+    """Distance to the nearest wall, positive inside the free space and negative outside, clipped
+    at ``clip`` pixels (also the elastic laying's flow image, ``elastic.signed_distance``).
+
+    Examples
+    --------
+    >>> free = np.zeros((7, 7), bool); free[1:6, 1:6] = True
+    >>> signed_distance(free, clip=2)[3].tolist()
+    [-1.0, 1.0, 2.0, 2.0, 2.0, 1.0, -1.0]
+    """
     import cv2
 
+    free = np.asarray(free, bool)
     inside = cv2.distanceTransform(free.astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5)
     outside = cv2.distanceTransform((~free).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5)
     return np.clip(inside - outside, -clip, clip).astype(np.float32)
@@ -115,7 +134,7 @@ def best_window(
     factor = coarse / max(metric_free.shape)
     shape = (max(1, round(metric_free.shape[0] * factor)), max(1, round(metric_free.shape[1] * factor)))
     metric = cv2.resize(metric_free.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_AREA) > 0
-    metric_image = _signed(np.pad(metric, _PAD), clip)
+    metric_image = signed_distance(np.pad(metric, _PAD), clip=clip)
     (r0, r1, c0, c1), (m0, m1, n0, n1) = sketch_box, metric_box
     sketch = sketch_free[r0:r1, c0:c1].astype(np.uint8)
     height, width = (m1 - m0) * factor, (n1 - n0) * factor
@@ -135,8 +154,8 @@ def best_window(
         # more rooms (where a partial sketch is cut). Only the pixels whose distance is the same
         # either way are compared (walled in alone, or open alone, the windows found were
         # smaller or larger than the part's: round 47).
-        template = _signed(shrunk, clip)
-        known = np.abs(template - _signed(np.pad(shrunk, 1), clip)[1:-1, 1:-1]) < 0.5
+        template = signed_distance(shrunk, clip=clip)
+        known = np.abs(template - signed_distance(np.pad(shrunk, 1), clip=clip)[1:-1, 1:-1]) < 0.5
         if np.count_nonzero(known) < known.size // 4 or float(template[known].std()) < 1e-6:
             continue
         found = cv2.matchTemplate(metric_image, template, cv2.TM_CCOEFF_NORMED, mask=known.astype(np.float32))
