@@ -233,14 +233,14 @@ class MatchConfig:
         ``overlay_min_iou``; 'completed' adds the planar answer's pairs of regions left unpaired on
         both sides. Planar matcher, label images and sketch-sized maps (at most 60 regions each) only.
     elastic_laying : {'boxes', 'boxes_or_answer', 'window', 'window_or_answer'}
-        Where the sketch is laid before it is bent: 'boxes' (default), box onto box;
-        'boxes_or_answer', also by a scale and a shift per axis fitted to the planar answer's pairs
-        (:func:`~ursim_core.matching.elastic.answer_laying`), and the laying whose bent sketch
-        lands more on the metric map's free space gives the pairs: a partial sketch laid box onto
-        box is stretched over the whole map. 'window' lays it instead in the window of the map
-        where it correlates clearly better than over the whole box
-        (:func:`~ursim_core.matching.elastic.window_laying`); 'window_or_answer', that or the
-        answer's laying. Not the default: see docs/options.md.
+        Where the sketch is laid before it is bent: 'window' (default), box onto box, or in the
+        window of the metric map where it correlates clearly better than over the whole box
+        (:func:`~ursim_core.matching.elastic.window_laying`): a partial sketch laid box onto box
+        is stretched over the whole map; 'boxes', box onto box only; 'boxes_or_answer' and
+        'window_or_answer', also by a scale and a shift per axis fitted to the planar answer's
+        pairs (:func:`~ursim_core.matching.elastic.answer_laying`), the laying whose bent sketch
+        lands more on the metric map's free space giving the pairs (a second optical flow).
+        Evidence: docs/options.md.
     """
 
     variant: str = "T4"
@@ -282,7 +282,7 @@ class MatchConfig:
     overlay_angle_step: float = 2.0
     input_kind: str | None = None
     elastic: str = "completed"
-    elastic_laying: str = "boxes"
+    elastic_laying: str = "window"
 
     def __post_init__(self):
         choices = {

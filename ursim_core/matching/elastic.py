@@ -435,7 +435,9 @@ def laid_sketch(
 def window_laying(sketch: np.ndarray, metric_labels: np.ndarray, *, gain: float | None = None) -> Laying | None:
     """The :class:`Laying` that carries the box around the oriented sketch's regions onto the
     window of the metric map where it correlates best (:func:`~ursim_core.matching.template.best_window`),
-    when that window correlates better than the map's whole box by at least ``gain``; else None.
+    when that window correlates better than the map's whole box by at least ``gain``
+    (:data:`~ursim_core.matching.template.WINDOW_GAIN` when None) and at least
+    :data:`~ursim_core.matching.template.WINDOW_MIN_CORRELATION` in all; else None.
 
     Examples
     --------
@@ -448,11 +450,13 @@ def window_laying(sketch: np.ndarray, metric_labels: np.ndarray, *, gain: float 
     >>> window_laying(plan, plan) is None
     True
     """
-    from ursim_core.matching.template import WINDOW_GAIN, best_window
+    from ursim_core.matching.template import WINDOW_GAIN, WINDOW_MIN_CORRELATION, best_window
 
     sketch_free, metric_free = np.asarray(sketch) > 0, np.asarray(metric_labels) > 0
     window = best_window(sketch_free, metric_free)
     if window is None or window.gain < (WINDOW_GAIN if gain is None else gain):
+        return None
+    if window.correlation < WINDOW_MIN_CORRELATION:
         return None
     r0, r1, c0, c1 = _box(sketch_free)
     row_scale, col_scale = window.height / (r1 - r0), window.width / (c1 - c0)

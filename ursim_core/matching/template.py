@@ -23,8 +23,11 @@ __all__ = [
     "COARSE_SIDE",
     "WINDOW_CLIP",
     "WINDOW_SIDES",
+    "WINDOW_REFINE",
     "WINDOW_ASPECTS",
+    "WINDOW_MIN_AREA",
     "WINDOW_GAIN",
+    "WINDOW_MIN_CORRELATION",
     "Window",
     "signed_distance",
     "best_window",
@@ -35,13 +38,27 @@ COARSE_SIDE = 128
 #: Signed distances are clipped at this many pixels of the coarse size either side of a wall.
 WINDOW_CLIP = 12.0
 #: The window's size as a share of the largest window of the sketch's shape within the metric
-#: map's box (a sketch of the whole building down to half of its width and height).
-WINDOW_SIDES = (1.0, 0.95, 0.9, 0.85, 0.8, 0.75, 0.7, 0.65, 0.6, 0.55, 0.5)
-#: The window's width over what the sketch's shape gives (a sketch drawn a little wide or narrow).
-WINDOW_ASPECTS = (1.0, 1.1, 1 / 1.1)
+#: map's box (a sketch of the whole building down to half of its width and height), first pass.
+WINDOW_SIDES = (1.0, 0.9, 0.8, 0.7, 0.6, 0.5)
+#: The second pass: the first pass's best size this much larger and smaller.
+WINDOW_REFINE = 0.05
+#: The window's width over what the sketch's shape gives. The sketch's own shape only: also 1.1
+#: and 1 / 1.1 wide gave told F1 0.965 / 0.958 against 0.964 / 0.955 (round 47, generated seeds
+#: 0-31 / 32-63) at 21 % more time per turned KTH pair against 8 % (interleaved).
+WINDOW_ASPECTS = (1.0,)
+#: The smallest window tried, as a share of the metric map box's area: a sketch of a third of the
+#: map or more. Smaller windows correlate well by chance with a room or two (round 47: the windows
+#: of generated partial sketches that lost F1 covered 0.19-0.29 of the map's box, the right ones
+#: 0.43-0.89; KTH sketches 10 and 18 were laid in windows of 0.18 and 0.16).
+WINDOW_MIN_AREA = 0.35
 #: How much better (in correlation) the best window must be than the map's whole box for the
 #: sketch to be laid in it (round 47, generated seeds 0-63 told their orientation; docs/options.md).
 WINDOW_GAIN = 0.15
+#: How well the best window must correlate at least for the sketch to be laid in it: a sketch of
+#: part of the map resembles that part. (Round 47, generated seeds 0-63 told their orientation, in
+#: sample: of the windows used, those under 0.6 lost F1 in three cases and gained in two; a row of
+#: equal rooms drawn for a row of unequal ones correlates 0.53 with its best window.)
+WINDOW_MIN_CORRELATION = 0.6
 #: Coarse pixels the window may reach past the metric map's box (a sketch drawn a little large).
 _PAD = 4
 
@@ -89,7 +106,9 @@ def best_window(
     metric_free: np.ndarray,
     *,
     sides=WINDOW_SIDES,
+    refine: float = WINDOW_REFINE,
     aspects=WINDOW_ASPECTS,
+    min_area: float = WINDOW_MIN_AREA,
     coarse: int = COARSE_SIDE,
     clip: float = WINDOW_CLIP,
 ) -> Window | None:
@@ -99,10 +118,13 @@ def best_window(
     ----------
     sketch_free, metric_free : ndarray of bool, shape (rows, cols)
         Free space; the sketch in the orientation it is read in.
-    sides, aspects : keyword-only
+    sides, refine, aspects : keyword-only
         The windows tried besides the map's whole box: the sketch's box, scaled to the largest
-        of its shape that fits in the map's box, times each of :data:`WINDOW_SIDES`, its width
-        also times each of :data:`WINDOW_ASPECTS`.
+        of its shape that fits in the map's box, times each of :data:`WINDOW_SIDES`; then the best
+        of those times ``1 +- refine`` (:data:`WINDOW_REFINE`), and its width (and theirs) times
+        each of :data:`WINDOW_ASPECTS`.
+    min_area : float, keyword-only
+        :data:`WINDOW_MIN_AREA`: smaller windows are not tried.
     coarse, clip : keyword-only
         :data:`COARSE_SIDE` and :data:`WINDOW_CLIP`.
 
@@ -136,20 +158,22 @@ def best_window(
     metric = cv2.resize(metric_free.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_AREA) > 0
     metric_image = signed_distance(np.pad(metric, _PAD), clip=clip)
     (r0, r1, c0, c1), (m0, m1, n0, n1) = sketch_box, metric_box
-    sketch = sketch_free[r0:r1, c0:c1].astype(np.uint8)
     height, width = (m1 - m0) * factor, (n1 - n0) * factor
     # The sketch kept in proportion: the largest window of its box's shape within the map's box,
     # then smaller; the map's whole box (the box laying, stretched to it) is the reference.
     fit = min(height / (r1 - r0), width / (c1 - c0))
-    windows = [(height, width)] + [
-        ((r1 - r0) * fit * side, (c1 - c0) * fit * side * aspect) for side in sides for aspect in aspects
-    ]
-    best, whole = None, None
-    for index, (rows, cols) in enumerate(windows):
+    # Shrunk once to twice the largest window (a turned sketch is a thousand pixels a side), and
+    # each window from that: the share of free space in each coarse pixel, free where at least
+    # half is (as the map's, whose 0/1 means OpenCV rounds).
+    largest = max(height, (r1 - r0) * fit * max(sides)), max(width, (c1 - c0) * fit * max(sides) * max(aspects))
+    source_shape = (min(r1 - r0, 2 * round(largest[0]) + 1), min(c1 - c0, 2 * round(largest[1]) + 1))
+    source = cv2.resize(sketch_free[r0:r1, c0:c1].astype(np.float32), source_shape[::-1], interpolation=cv2.INTER_AREA)
+
+    def correlation(rows: float, cols: float):
         rows, cols = max(3, round(rows)), max(3, round(cols))
-        if rows > metric_image.shape[0] or cols > metric_image.shape[1]:
-            continue
-        shrunk = cv2.resize(sketch, (cols, rows), interpolation=cv2.INTER_AREA) > 0
+        if rows > metric_image.shape[0] or cols > metric_image.shape[1] or rows * cols < min_area * height * width:
+            return None
+        shrunk = cv2.resize(source, (cols, rows), interpolation=cv2.INTER_AREA) >= 0.5
         # What lies beyond the sketch's box is unknown: a wall (a whole building's outline) or
         # more rooms (where a partial sketch is cut). Only the pixels whose distance is the same
         # either way are compared (walled in alone, or open alone, the windows found were
@@ -157,13 +181,27 @@ def best_window(
         template = signed_distance(shrunk, clip=clip)
         known = np.abs(template - signed_distance(np.pad(shrunk, 1), clip=clip)[1:-1, 1:-1]) < 0.5
         if np.count_nonzero(known) < known.size // 4 or float(template[known].std()) < 1e-6:
-            continue
+            return None
         found = cv2.matchTemplate(metric_image, template, cv2.TM_CCOEFF_NORMED, mask=known.astype(np.float32))
         _, value, _, (x, y) = cv2.minMaxLoc(np.nan_to_num(found, nan=-1.0, posinf=-1.0, neginf=-1.0))
-        if index == 0:
-            whole = value
-        if best is None or value > best[0]:
-            best = (value, y, x, rows, cols)
+        return value, y, x, rows, cols
+
+    whole = correlation(height, width)
+    # Coarse to fine: the sizes in proportion first, then the best of them a step either way and
+    # a little wider and narrower (half the correlations of the full grid, the same windows found
+    # within a step).
+    tried = {side: correlation((r1 - r0) * fit * side, (c1 - c0) * fit * side) for side in sides}
+    found = {side: value for side, value in tried.items() if value is not None}
+    best = max([whole] + list(found.values()), key=lambda value: -2.0 if value is None else value[0])
+    if found:
+        side = max(found, key=lambda key: found[key][0])
+        refined = [(side + step, 1.0) for step in (-refine, refine)]
+        refined += [(side + step, aspect) for step in (-refine, 0.0, refine) for aspect in aspects if aspect != 1.0]
+        for size, aspect in refined:
+            value = correlation((r1 - r0) * fit * size, (c1 - c0) * fit * size * aspect)
+            if value is not None and (best is None or value[0] > best[0]):
+                best = value
+    whole = None if whole is None else whole[0]
     if best is None:
         return None
     value, y, x, rows, cols = best

@@ -58,12 +58,12 @@ PAIRS_FROM = (
     ("alone", "the sketch laid and bent onto the map only"),
     ("off", "the graph matcher's own answer"),
 )
-#: Where the sketch is laid before it is bent (``MatchConfig.elastic_laying``).
+#: Where the sketch is laid before it is bent (``MatchConfig.elastic_laying``; its default first).
 LAYINGS = (
-    ("boxes", "box onto box (a sketch of the whole map)"),
-    ("boxes_or_answer", "box onto box or where the graph answer puts it (a partial sketch; slower)"),
-    ("window", "box onto box or the part of the map it resembles most (a partial sketch)"),
-    ("window_or_answer", "that, or where the graph answer puts it (a partial sketch; slowest)"),
+    ("window", "box onto box, or the part of the map it resembles most (a partial sketch)"),
+    ("boxes", "box onto box only (a sketch of the whole map)"),
+    ("boxes_or_answer", "box onto box or where the graph answer puts it (slower)"),
+    ("window_or_answer", "the window or where the graph answer puts it (slowest)"),
 )
 #: The matchers that use a known scale; those whose pairs may come from the laid sketch.
 _SCALED_MATCHERS = ("auto", "overlay")

@@ -195,11 +195,16 @@ def test_a_partial_sketch_is_laid_where_its_answer_puts_it():
 def test_the_pipeline_says_how_it_laid_the_sketch():
     metric = _segmentation(_two_rows())
     sketch = _segmentation(_two_rows()[:, :140].copy())
-    told = MatchConfig(orientation="upright", mirrored=False)
+    told = MatchConfig(orientation="upright", mirrored=False, elastic_laying="boxes")
     result = match(sketch, metric, config=told)
-    assert told.elastic_laying == "boxes" and result.laid and result.laying.by == "boxes"
+    assert result.laid and result.laying.by == "boxes"
     drawn = laid_sketch(sketch.labels, metric.labels, laying=result.laying)
     assert (drawn == laid_sketch(sketch.labels, metric.labels)).all()  # box onto box, as drawn before
+    # The default lays this partial sketch in its window, and it is drawn as laid.
+    by_default = match(sketch, metric, config=told.replace(elastic_laying=MatchConfig().elastic_laying))
+    assert by_default.laying.by == "window" and by_default.pairs != result.pairs
+    drawn = laid_sketch(sketch.labels, metric.labels, laying=by_default.laying)
+    assert not drawn[:, 180:].any()  # not stretched over the right of the map
     assert match(sketch, metric, config=told.replace(elastic="off")).laying is None
     with pytest.raises(ParameterError, match="elastic_laying"):
         MatchConfig(elastic_laying="anywhere")

@@ -26,7 +26,7 @@ def test_a_part_of_a_plan_is_found_where_it_was_cut_from(plan_free, part):
     window = {
         "left": (slice(r0, r1), slice(c0, c0 + int(width * 0.65))),
         "top": (slice(r0, r0 + int(height * 0.65)), slice(c0, c1)),
-        "middle": (slice(r0 + height // 5, r1 - height // 5), slice(c0 + width // 5, c1 - width // 5)),
+        "middle": (slice(r0 + height // 7, r1 - height // 7), slice(c0 + width // 7, c1 - width // 7)),
     }[part]
     found = best_window(plan_free[window], plan_free)
     top, left = _box(plan_free[window])[0] + window[0].start, _box(plan_free[window])[2] + window[1].start
@@ -53,6 +53,16 @@ def test_rescaled_part_is_found_at_the_map_scale(plan_free):
     doubled = cv2.resize(part.astype(np.uint8), (part.shape[1] * 2, part.shape[0] * 2), interpolation=cv2.INTER_NEAREST)
     found = best_window(doubled > 0, plan_free)
     assert abs(found.width - part.shape[1]) < 0.15 * part.shape[1]
+
+
+def test_windows_under_a_third_of_the_map_are_not_tried(plan_free):
+    from ursim_core.matching.template import WINDOW_MIN_AREA
+
+    r0, r1, c0, c1 = _box(plan_free)
+    corner = plan_free[r0 : r0 + (r1 - r0) // 2, c0 : c0 + (c1 - c0) // 2]  # a quarter of the map
+    found = best_window(corner, plan_free)
+    assert found.height * found.width >= WINDOW_MIN_AREA * (r1 - r0) * (c1 - c0) * 0.95
+    assert best_window(corner, plan_free, min_area=0.2).height < found.height
 
 
 def test_nothing_to_search_gives_none():

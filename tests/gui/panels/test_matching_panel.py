@@ -211,7 +211,7 @@ def test_the_panel_lays_a_partial_sketch_where_its_answer_puts_it(window, qtbot)
     from ursim_gui.panels.matching_panel import describe_result
 
     panel = window.matching_panel
-    assert panel.config().elastic_laying == "boxes" and panel.laying.isEnabled()
+    assert panel.config().elastic_laying == MatchConfig().elastic_laying == "window" and panel.laying.isEnabled()
     panel.laying.setCurrentIndex(panel.laying.findData("boxes_or_answer"))
     assert panel.config().elastic_laying == "boxes_or_answer"
     panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
