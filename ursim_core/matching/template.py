@@ -6,8 +6,9 @@ third. :func:`best_window` instead slides the sketch, shrunk to a range of sizes
 map at a coarse size and keeps the window where the two maps' signed distance images correlate
 best (OpenCV's normalised cross-correlation, ``TM_CCOEFF_NORMED``), with how much better that
 window correlates than the whole map's box does. :func:`~ursim_core.matching.elastic.lay_sketch`
-lays the sketch in that window only when it is clearly better (:data:`WINDOW_GAIN`): a whole
-sketch correlates a little better with some part of the map too.
+lays the sketch in that window only when it is clearly better (:data:`WINDOW_GAIN`: a whole
+sketch correlates a little better with some part of the map too) and resembles that part
+(:data:`WINDOW_MIN_CORRELATION`).
 
 Everything here is on boolean free-space images in (row, col); the sketch is already in the
 orientation it is read in.

@@ -43,7 +43,7 @@ def test_batch_writes_each_pair_and_a_summary(maps, workers):
     assert rows[0]["resampling_votes"] == "0" and rows[2]["next_reading_gap"] == ""
     # Where the pairs came from: the sketch laid and bent onto the map (MatchConfig.elastic).
     assert batch_record["pairs_from"] == rows[0]["pairs_from"] == "laid sketch" and rows[2]["pairs_from"] == ""
-    # Laid box onto box (MatchConfig.elastic_laying's default).
+    # Laid box onto box: a sketch of the whole map (the default window laying keeps the boxes).
     assert batch_record["laid_by"] == rows[0]["laid_by"] == "boxes" and rows[2]["laid_by"] == ""
     for name in ("a", "b"):
         assert {p.name for p in (out / name).iterdir()} == {
