@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ursim_core.matching.template import signed_distance
+from ursim_core.matching import template
 
 __all__ = [
     "WORKING_SIDE",
@@ -121,6 +121,12 @@ def oriented_labels(labels: np.ndarray, *, degrees: float, mirrored: bool) -> np
     # Nearest neighbour on float32 keeps the ids exactly (they are far below 2**24).
     turned = cv2.warpAffine(labels.astype(np.float32), matrix, (new_cols, new_rows), flags=cv2.INTER_NEAREST)
     return turned.astype(labels.dtype)
+
+
+def signed_distance(free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:
+    """Distance to the nearest wall, positive inside the free space and negative outside, clipped
+    (:func:`ursim_core.matching.template.signed_distance`, clipped at :data:`DISTANCE_CLIP` unless told)."""
+    return template.signed_distance(free, clip=clip)
 
 
 def elastic_flow(fixed_free: np.ndarray, moving_free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:
