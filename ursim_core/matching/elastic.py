@@ -456,13 +456,11 @@ def window_laying(sketch: np.ndarray, metric_labels: np.ndarray, *, gain: float 
     >>> window_laying(plan, plan) is None
     True
     """
-    from ursim_core.matching.template import WINDOW_GAIN, WINDOW_MIN_CORRELATION, best_window
-
     sketch_free, metric_free = np.asarray(sketch) > 0, np.asarray(metric_labels) > 0
-    window = best_window(sketch_free, metric_free)
-    if window is None or window.gain < (WINDOW_GAIN if gain is None else gain):
+    window = template.best_window(sketch_free, metric_free)
+    if window is None or window.gain < (template.WINDOW_GAIN if gain is None else gain):
         return None
-    if window.correlation < WINDOW_MIN_CORRELATION:
+    if window.correlation < template.WINDOW_MIN_CORRELATION:
         return None
     r0, r1, c0, c1 = _box(sketch_free)
     row_scale, col_scale = window.height / (r1 - r0), window.width / (c1 - c0)
