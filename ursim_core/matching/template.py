@@ -188,9 +188,9 @@ def best_window(
         return value, y, x, rows, cols
 
     whole = correlation(height, width)
-    # Coarse to fine: the sizes in proportion first, then the best of them a step either way and
-    # a little wider and narrower (half the correlations of the full grid, the same windows found
-    # within a step).
+    # Coarse to fine: the sizes in proportion first, then the best of them a step either way (and,
+    # with aspects other than 1, a little wider and narrower): about half the correlations of the
+    # full grid of sizes, for the same told F1 on the generated pairs (round 47).
     tried = {side: correlation((r1 - r0) * fit * side, (c1 - c0) * fit * side) for side in sides}
     found = {side: value for side, value in tried.items() if value is not None}
     best = max([whole] + list(found.values()), key=lambda value: -2.0 if value is None else value[0])
@@ -202,9 +202,8 @@ def best_window(
             value = correlation((r1 - r0) * fit * size, (c1 - c0) * fit * size * aspect)
             if value is not None and (best is None or value[0] > best[0]):
                 best = value
-    whole = None if whole is None else whole[0]
     if best is None:
         return None
     value, y, x, rows, cols = best
-    gain = value - whole if whole is not None else 0.0
+    gain = value - whole[0] if whole is not None else 0.0
     return Window((y - _PAD) / factor, (x - _PAD) / factor, rows / factor, cols / factor, float(value), float(gain))
