@@ -27,6 +27,7 @@ __all__ = [
     "ORIENTATIONS",
     "ELASTIC_RULES",
     "ELASTIC_LAYINGS",
+    "ELASTIC_LAYING_RULES",
     "MatchConfig",
 ]
 
@@ -41,8 +42,19 @@ SIZE_WEIGHT_FLOOR = 0.1
 VARIANTS = ("T1", "T2", "T3", "T4", "baseline")
 #: The values of ``MatchConfig.elastic`` (see :mod:`ursim_core.matching.elastic`).
 ELASTIC_RULES = ("off", "alone", "completed")
-#: The values of ``MatchConfig.elastic_laying`` (see :mod:`ursim_core.matching.elastic`).
-ELASTIC_LAYINGS = ("boxes", "boxes_or_answer", "window", "window_or_answer")
+#: What each value of ``MatchConfig.elastic_laying`` lays the sketch by (see
+#: :mod:`ursim_core.matching.elastic`): the window rule ('off'; 'clear', the best window when it
+#: correlates clearly better than the whole box; 'competes', the window and the boxes, whichever
+#: lands more) and whether the planar answer's laying competes too.
+ELASTIC_LAYING_RULES = {
+    "boxes": ("off", False),
+    "boxes_or_answer": ("off", True),
+    "window": ("clear", False),
+    "window_or_answer": ("clear", True),
+    "boxes_or_window": ("competes", False),
+}
+#: The values of ``MatchConfig.elastic_laying``.
+ELASTIC_LAYINGS = tuple(ELASTIC_LAYING_RULES)
 #: The values of ``MatchConfig.orientation`` other than a number of degrees.
 ORIENTATIONS = ("any", "upright")
 
@@ -232,15 +244,16 @@ class MatchConfig:
         optical flow between the two maps (:mod:`ursim_core.matching.elastic`), regions paired at
         ``overlay_min_iou``; 'completed' adds the planar answer's pairs of regions left unpaired on
         both sides. Planar matcher, label images and sketch-sized maps (at most 60 regions each) only.
-    elastic_laying : {'boxes', 'boxes_or_answer', 'window', 'window_or_answer'}
+    elastic_laying : {'boxes', 'boxes_or_answer', 'window', 'window_or_answer', 'boxes_or_window'}
         Where the sketch is laid before it is bent: 'window' (default), box onto box, or in the
         window of the metric map where it correlates clearly better than over the whole box
         (:func:`~ursim_core.matching.elastic.window_laying`): a partial sketch laid box onto box
         is stretched over the whole map; 'boxes', box onto box only; 'boxes_or_answer' and
         'window_or_answer', also by a scale and a shift per axis fitted to the planar answer's
         pairs (:func:`~ursim_core.matching.elastic.answer_laying`), the laying whose bent sketch
-        lands more on the metric map's free space giving the pairs (a second optical flow).
-        Evidence: docs/options.md.
+        lands more on the metric map's free space giving the pairs (a second optical flow);
+        'boxes_or_window', box onto box or the best window whatever its margin, whichever lands
+        more (:data:`ELASTIC_LAYING_RULES`). Evidence: docs/options.md.
     """
 
     variant: str = "T4"

@@ -56,6 +56,9 @@ WORKING_SIDE = 512
 #: do not flatten the gradient. Round 43, the 18 KTH sketches upright in the planar matcher's
 #: orientation (in sample; a study script): mean F1 0.74 / 0.80 / 0.82 at 10 / 30 / 60 px.
 DISTANCE_CLIP = 60.0
+#: With ``window_competes``, any window that correlates better than the whole box (by more than
+#: rounding) is bent too: which of the two lands more decides, not a margin of correlation.
+_ANY_GAIN = 1e-6
 
 
 class Laying(NamedTuple):
@@ -311,6 +314,7 @@ def lay_sketch(
     answer=None,
     laying: Laying | None = None,
     window: bool = False,
+    window_competes: bool = False,
     min_iou: float = 0.15,
     clip: float = DISTANCE_CLIP,
 ) -> LaidSketch | None:
@@ -333,6 +337,10 @@ def lay_sketch(
         Lay the sketch in the window of the metric map where it correlates clearly better than
         over the map's whole box (:func:`window_laying`), instead of box onto box: a sketch of
         part of a building.
+    window_competes : bool, keyword-only
+        With ``window``: bend the sketch laid in the window, whenever one correlates better than the
+        whole box, and laid box onto box, and keep the one that lands more on the metric map's free
+        space, instead of the window only when it correlates clearly better.
     min_iou : float, keyword-only
         Regions are paired when their intersection over union is at least this.
     clip : float, keyword-only
@@ -362,6 +370,7 @@ def lay_sketch(
         answer=answer,
         laying=laying,
         window=window,
+        window_competes=window_competes,
     )
     if found is None:
         return None
@@ -477,18 +486,22 @@ def _laid(
     answer=None,
     laying=None,
     window: bool = False,
+    window_competes: bool = False,
 ):
     """``(bent sketch, metric map, laying, landed)``, the images at the working size, of the
-    laying given, or else of the better of box onto box (or the window, with ``window``, when it
-    is clearly better) and the answer's; None when either map has no region."""
+    laying given, or else of the best of box onto box (or the window, with ``window``, when it
+    is clearly better; with ``window_competes`` too, any window better than the whole box) and the
+    answer's; None when either map has no region."""
     metric_labels = np.asarray(metric_labels)
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
     boxes = _box_laying(sketch, metric_labels)  # None when either map has no region
     if boxes is None:
         return None
-    if laying is None and window:
-        boxes = window_laying(sketch, metric_labels) or boxes
     layings = [boxes if laying is None else laying]
+    if laying is None and window:
+        found = window_laying(sketch, metric_labels, gain=_ANY_GAIN if window_competes else None)
+        if found is not None:
+            layings = [boxes, found] if window_competes else [found]
     if laying is None and answer:
         fitted = _answer_laying(sketch, _metric_centroids(metric_labels), answer)
         if fitted is not None:

@@ -11,9 +11,17 @@ segmentation's laying on a thread (:class:`LaidAhead`) while the other segmentat
 
 from __future__ import annotations
 
+from ursim_core.matching.config import ELASTIC_LAYING_RULES
 from ursim_core.matching.results import MatchResult, Prepared, replaced
 
-__all__ = ["elastic_labels", "LaidAhead", "laying_answer", "laid_elastically"]
+__all__ = [
+    "elastic_labels",
+    "LaidAhead",
+    "laying_answer",
+    "window_rule",
+    "laid_by_answer",
+    "laid_elastically",
+]
 
 
 def elastic_labels(prepared: Prepared, sketch_seg, metric_seg, *, largest: int) -> tuple | None:
@@ -36,7 +44,7 @@ class LaidAhead:
     memos of its working image and centroids)."""
 
     def __init__(
-        self, sketch_labels, metric_labels, orientation, min_iou: float, answer=None, *, window: bool = False
+        self, sketch_labels, metric_labels, orientation, min_iou: float, answer=None, *, window: str = "off"
     ) -> None:
         import threading
 
@@ -65,7 +73,7 @@ def laying_answer(prepared: Prepared, orientation: tuple, result: MatchResult | 
     when it reads the sketch so, else ``result``'s; None for box onto box only. One laying per
     orientation, whatever m: an answer at a small m pairs too few regions to lay the sketch, and
     a flow per m would cost an evaluation's sweep a flow per m."""
-    if not prepared.config.elastic_laying.endswith("_or_answer"):
+    if not laid_by_answer(prepared.config):
         return None
     chosen = prepared.chosen
     if chosen is not None and tuple(chosen.orientation) == tuple(orientation) and chosen.pairs:
@@ -73,18 +81,31 @@ def laying_answer(prepared: Prepared, orientation: tuple, result: MatchResult | 
     return list(result.pairs) if result is not None and result.pairs else None
 
 
-def window_laid(config) -> bool:
-    """Whether ``config`` (a :class:`~ursim_core.matching.MatchConfig`) lays the sketch in the
-    metric map's best window when it is clearly better than box onto box (``elastic_laying``)."""
-    return config.elastic_laying.startswith("window")
+def window_rule(config) -> str:
+    """How ``config`` (a :class:`~ursim_core.matching.MatchConfig`) lays the sketch in the metric
+    map's best window (``elastic_laying``, :data:`~ursim_core.matching.config.ELASTIC_LAYING_RULES`):
+    'off', 'clear' (when clearly better than box onto box) or 'competes' (whichever lands more)."""
+    return ELASTIC_LAYING_RULES[config.elastic_laying][0]
 
 
-def _lay(sketch_labels, metric_labels, orientation, min_iou: float, answer=None, *, window: bool = False):
+def laid_by_answer(config) -> bool:
+    """Whether ``config`` also lays the sketch by the planar answer's pairs (``elastic_laying``)."""
+    return ELASTIC_LAYING_RULES[config.elastic_laying][1]
+
+
+def _lay(sketch_labels, metric_labels, orientation, min_iou: float, answer=None, *, window: str = "off"):
     from ursim_core.matching.elastic import lay_sketch
 
     degrees, mirrored = orientation
     return lay_sketch(
-        sketch_labels, metric_labels, degrees=degrees, mirrored=mirrored, answer=answer, window=window, min_iou=min_iou
+        sketch_labels,
+        metric_labels,
+        degrees=degrees,
+        mirrored=mirrored,
+        answer=answer,
+        window=window != "off",
+        window_competes=window == "competes",
+        min_iou=min_iou,
     )
 
 
@@ -106,7 +127,7 @@ def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
             orientation,
             prepared.config.overlay_min_iou,
             laying_answer(prepared, orientation, result),
-            window=window_laid(prepared.config),
+            window=window_rule(prepared.config),
         )
     laid = answers[orientation]
     pairs = [] if laid is None else laid.pairs

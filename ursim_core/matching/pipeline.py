@@ -36,7 +36,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
-from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically, laying_answer, window_laid
+from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically, laying_answer, window_rule
 from ursim_core.matching.orientation import DOOR_EVIDENCE, broken_adjacencies, misplaced_doors
 from ursim_core.matching.oriented import (
     candidate_overlaps,
@@ -137,7 +137,7 @@ def prepare(
         # meanwhile the thread would only add its start.
         answer = laying_answer(prepared, prepared.orientation)
         answers[prepared.orientation] = LaidAhead(
-            *labels, prepared.orientation, prepared.config.overlay_min_iou, answer, window=window_laid(prepared.config)
+            *labels, prepared.orientation, prepared.config.overlay_min_iou, answer, window=window_rule(prepared.config)
         )
     prepared = with_resampled(prepared, sketch_seg, metric_seg, _prepare_one)
     if labels is not None:

@@ -64,6 +64,7 @@ LAYINGS = (
     ("boxes", "box onto box only (a sketch of the whole map)"),
     ("boxes_or_answer", "box onto box or where the graph answer puts it (slower)"),
     ("window_or_answer", "the window or where the graph answer puts it (slowest)"),
+    ("boxes_or_window", "box onto box or the part of the map it resembles, whichever fits (slower)"),
 )
 #: The matchers that use a known scale; those whose pairs may come from the laid sketch.
 _SCALED_MATCHERS = ("auto", "overlay")

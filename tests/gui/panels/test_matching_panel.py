@@ -8,6 +8,7 @@ import time
 from PySide6.QtCore import Qt, QTimer
 
 from ursim_core.matching import MatchConfig
+from ursim_core.matching.config import ELASTIC_LAYINGS
 
 
 def test_match_button_runs_in_the_worker_and_applies_the_result(window, qtbot):
@@ -229,3 +230,8 @@ def test_the_panel_lays_a_partial_sketch_where_its_answer_puts_it(window, qtbot)
     assert "part of the map it resembles most" in describe_result(by_window)
     panel.laying.setCurrentIndex(panel.laying.findData("window"))
     assert panel.config().elastic_laying == "window"
+    # Every laying the core knows is offered, and none it does not.
+    offered = {panel.laying.itemData(index) for index in range(panel.laying.count())}
+    assert offered == set(ELASTIC_LAYINGS)
+    panel.laying.setCurrentIndex(panel.laying.findData("boxes_or_window"))
+    assert panel.config().elastic_laying == "boxes_or_window"
