@@ -224,6 +224,12 @@ class MatchConfig:
         finalist's is below ``orientation.DOOR_EVIDENCE`` (the doors were drawn where they are);
         0 = not. The same half turn or mirror image puts each room's door at the other end of its
         wall. Evidence: docs/options.md.
+    window_reading_margin : float
+        With ``orientation='any'`` and a window laying (``elastic_laying``), a finalist reading in
+        which the sketch resembles a part of the metric map (its best window correlates clearly
+        better than the map's whole box) by at least this much more correlation than in the reading
+        ranked best is taken instead (:func:`~ursim_core.matching.oriented.window_reading`); 0 =
+        never. Evidence: docs/options.md.
     scale : float or None
         Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
         resolution), for the overlay matcher: it then searches any placement, so either map may
@@ -290,6 +296,7 @@ class MatchConfig:
     orientation_finalists: int = 4
     adjacency_penalty: float = 2.0
     door_penalty: float = 1.0
+    window_reading_margin: float = 0.0
     scale: float | None = None
     overlay_min_iou: float = 0.15
     overlay_angle_step: float = 2.0
@@ -330,6 +337,7 @@ class MatchConfig:
             "orientation_overlap",
             "adjacency_penalty",
             "door_penalty",
+            "window_reading_margin",
             "overlay_min_iou",
             "overlay_angle_step",
         ):

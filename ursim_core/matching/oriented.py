@@ -4,7 +4,8 @@
 (:func:`orientations_to_try`); each is prepared by :func:`prepare_oriented` for the first and
 :func:`reoriented` for the others, which reuse the first's signatures (only the position term and
 the neighbour orders depend on the orientation), and ranked with the free-space overlap of the
-sketch fitted onto the metric map in it (:func:`candidate_overlaps`).
+sketch fitted onto the metric map in it (:func:`candidate_overlaps`); a partial sketch's reading
+may be taken from where it resembles part of the map (:func:`window_reading`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 
 import networkx as nx
+import numpy as np
 
 from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.descriptors import pair_descriptors
@@ -23,6 +25,7 @@ from ursim_core.segmentation.canonical import wall_angle
 from ursim_core.segmentation.interface import Segmentation
 
 __all__ = [
+    "region_graph_of",
     "orientations_to_try",
     "nearest_orientations",
     "sketch_outlines",
@@ -30,7 +33,16 @@ __all__ = [
     "reoriented",
     "candidate_overlaps",
     "carried_overlaps",
+    "finalist_windows",
+    "window_reading",
 ]
+
+
+def region_graph_of(segmentation_or_graph) -> nx.Graph:
+    """The region graph of a :class:`~ursim_core.segmentation.Segmentation`, or the graph given."""
+    if isinstance(segmentation_or_graph, nx.Graph):
+        return segmentation_or_graph
+    return segmentation_or_graph.graph
 
 
 def orientations_to_try(config: MatchConfig, sketch_seg, metric_seg) -> list[tuple[float, bool]]:
@@ -238,3 +250,60 @@ def carried_overlaps(measured: dict, candidates, indices) -> dict[int, float] | 
 
 #: Floor of an overlap used as a divisor (a sketch with no free space, say).
 _SMALLEST_OVERLAP = 1e-3
+
+
+def finalist_windows(sketch_labels, metric_labels, orientations) -> dict:
+    """For each ``(degrees, mirrored)`` orientation, ``(correlation, gain)`` of the best window of
+    the metric map for the sketch turned so (:func:`~ursim_core.matching.template.best_window`),
+    or None when there is none (an empty map).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> plan = np.zeros((300, 600), np.int32)
+    >>> plan[20:130, 20:150], plan[20:130, 160:400], plan[20:130, 410:580] = 1, 2, 3
+    >>> plan[140:170, 20:580], plan[180:280, 20:260], plan[180:280, 270:580] = 4, 5, 6
+    >>> found = finalist_windows(plan[:, :320], plan, [(0.0, False), (180.0, False)])
+    >>> found[(0.0, False)][0] > found[(180.0, False)][0]
+    True
+    """
+    from ursim_core.matching import template
+    from ursim_core.matching.elastic import oriented_labels
+
+    metric_free = np.asarray(metric_labels) > 0
+    found = {}
+    for degrees, mirrored in orientations:
+        turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored) > 0
+        window = template.best_window(turned, metric_free)
+        found[(degrees, mirrored)] = None if window is None else (window.correlation, window.gain)
+    return found
+
+
+def window_reading(windows: dict, ranked_best, *, margin: float):
+    """The key of ``windows`` (by finalist: ``(correlation, gain)`` or None) whose sketch, read so,
+    resembles a part of the metric map clearly better than it does read as ``ranked_best`` (the
+    reading the matcher ranks best): its window correlates at least
+    :data:`~ursim_core.matching.template.WINDOW_GAIN` better than the map's whole box (the sketch
+    looks partial read so), at least :data:`~ursim_core.matching.template.WINDOW_MIN_CORRELATION`
+    in all, and at least ``margin`` better than ``ranked_best``'s; the best correlating of those, or
+    None.
+
+    Examples
+    --------
+    >>> windows = {0: (0.62, 0.02), 1: (0.89, 0.30), 2: (0.70, 0.20)}
+    >>> window_reading(windows, 0, margin=0.1), window_reading(windows, 1, margin=0.1)
+    (1, None)
+    >>> window_reading({0: (0.62, 0.02), 1: (0.68, 0.30)}, 0, margin=0.1) is None
+    True
+    """
+    from ursim_core.matching import template
+
+    if windows.get(ranked_best) is None:
+        return None
+    floor = max(template.WINDOW_MIN_CORRELATION, windows[ranked_best][0] + margin)
+    partial = [
+        (found[0], key)
+        for key, found in windows.items()
+        if found is not None and found[1] >= template.WINDOW_GAIN and found[0] >= floor
+    ]
+    return max(partial, key=lambda item: item[0])[1] if partial else None

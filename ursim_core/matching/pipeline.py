@@ -30,8 +30,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 
-import networkx as nx
-
 from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
 from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
@@ -41,12 +39,16 @@ from ursim_core.matching.orientation import DOOR_EVIDENCE, broken_adjacencies, m
 from ursim_core.matching.oriented import (
     candidate_overlaps,
     carried_overlaps,
+    finalist_windows,
     nearest_orientations,
     orientations_to_try,
     prepare_oriented,
+    region_graph_of,
     reoriented,
     sketch_outlines,
+    window_reading,
 )
+from ursim_core.matching.overlay_answer import prepare_overlay
 from ursim_core.matching.refit import refit_from, refit_positions, signature_start
 from ursim_core.matching.resampling import voted_answer, with_resampled
 from ursim_core.matching.results import MatchResult, Prepared, replaced
@@ -67,12 +69,6 @@ __all__ = [
     "seed_cap",
     "pair_cost_matrix",
 ]
-
-
-def _graph_of(segmentation_or_graph) -> nx.Graph:
-    if isinstance(segmentation_or_graph, nx.Graph):
-        return segmentation_or_graph
-    return segmentation_or_graph.graph
 
 
 def prepare(
@@ -148,15 +144,24 @@ def prepare(
 
 
 def _prepare_one(
-    sketch_seg, metric_seg, config: MatchConfig, *, progress=None, constraints=None, orientations=None, overlaps=None
+    sketch_seg,
+    metric_seg,
+    config: MatchConfig,
+    *,
+    progress=None,
+    constraints=None,
+    orientations=None,
+    overlaps=None,
+    windows=None,
 ) -> Prepared:
     """:func:`prepare` of one segmentation of the sketch; with ``orientations``, only the
     candidates nearest to them are tried (:func:`~ursim_core.matching.oriented.nearest_orientations`);
-    with ``overlaps`` (another segmentation's ``Prepared.orientation_overlaps``), each candidate
-    takes the free-space overlap of the nearest orientation measured there
-    (:func:`~ursim_core.matching.oriented.carried_overlaps`) instead of being fitted again."""
+    with ``overlaps`` and ``windows`` (another segmentation's ``Prepared.orientation_overlaps``
+    and ``orientation_windows``), each candidate takes the free-space overlap and the best window
+    of the nearest orientation measured there (:func:`~ursim_core.matching.oriented.carried_overlaps`)
+    instead of being fitted again."""
     config = config.resolved()
-    sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
+    sketch_graph, metric_graph = region_graph_of(sketch_seg), region_graph_of(metric_seg)
     constraints = constraints or None
     if constraints is not None:
         constraints.check_regions(sketch_graph.nodes, metric_graph.nodes)
@@ -167,7 +172,7 @@ def _prepare_one(
                 field="constraints",
             )
     if config.matcher == "overlay":
-        return _prepare_overlay(sketch_seg, metric_seg, config, constraints)
+        return prepare_overlay(sketch_seg, metric_seg, config, constraints)
     if orientations and config.vote_orientations == "first":
         # Another segmentation of a resampled sketch, in the first one's finalists as they are:
         # its own wall angle is not measured (MatchConfig.vote_orientations).
@@ -267,14 +272,40 @@ def _prepare_one(
         # does, the doors were not drawn where they are, and say nothing of the reading.
         for trial, misplaced in zip(trials, doors):
             trial[0] *= 1.0 + config.door_penalty * misplaced
-    _, _, prepared, result = min(trials, key=lambda trial: (trial[0], trial[1]))
+    found: dict = {}
+    if config.window_reading_margin and len(trials) > 1 and window_rule(config) != "off":
+        found = _windows(base, sketch_seg, metric_seg, candidates, [trial[1] for trial in trials], windows)
+    taken = None
+    if found:
+        # A partial sketch can rank better read wrongly; read rightly it resembles a part of the
+        # map clearly better than read so (round 48).
+        ranked_best = min(trials, key=lambda trial: (trial[0], trial[1]))[1]
+        taken = window_reading(found, ranked_best, margin=config.window_reading_margin)
+    _, _, prepared, result = min(trials, key=lambda trial: (trial[1] != taken, trial[0], trial[1]))
     scan = {candidates[trial[1]]: float(trial[0]) for trial in trials}
     return dataclasses.replace(
         prepared,
         orientation_scan=scan,
         chosen=replaced(result, orientation_scan=scan),
         orientation_overlaps={candidates[index]: value for index, value in overlaps.items()},
+        orientation_windows={candidates[index]: value for index, value in found.items()},
     )
+
+
+def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measured) -> dict:
+    """By candidate index, its best window's ``(correlation, gain)`` (or None): carried from
+    ``measured`` (another segmentation's) when given, else found; ``{}`` for bare graphs and
+    large maps, which are not laid. (Found on a thread while the finalists were matched, they
+    cost as much: the two compete for the same two cores; round 48.)"""
+    if measured:
+        carried = carried_overlaps(measured, candidates, indices)
+        if carried is not None:
+            return carried
+    labels = elastic_labels(base, sketch_seg, metric_seg, largest=_SCREEN_BY_ASSIGNMENT)
+    if labels is None:
+        return {}
+    found = finalist_windows(*labels, [candidates[index] for index in indices])
+    return {index: found[candidates[index]] for index in indices}
 
 
 def _refits(config: MatchConfig) -> int:
@@ -347,69 +378,6 @@ _COARSE_STEP = 2
 #: Above this many regions in either map, orientations are screened by assignment cost instead,
 #: and the answer is not refitted.
 _SCREEN_BY_ASSIGNMENT = 60
-
-
-def _prepare_overlay(sketch_seg, metric_seg, config: MatchConfig, constraints=None) -> Prepared:
-    """The overlay matcher's answer, found once: it does not depend on m.
-
-    With two fixed pairs or more, they lay the input map (:func:`~ursim_core.matching.overlay.fit_to_pairs`,
-    in the mirror readings of the orientation candidates) instead of the search; the answer then
-    holds the fixed pairs and avoids the forbidden ones.
-    """
-    from ursim_core.matching.alignment import Alignment
-    from ursim_core.matching.overlay import constrained_pairs, fit_to_pairs, overlay_pairs, ranked_overlays
-
-    sketch_labels = getattr(sketch_seg, "labels", None)
-    metric_labels = getattr(metric_seg, "labels", None)
-    if sketch_labels is None or metric_labels is None:
-        raise ParameterError("the overlay matcher needs segmentations (label images), not bare graphs", field="matcher")
-    candidates = orientations_to_try(config, sketch_seg, metric_seg)
-    sketch_graph, metric_graph = _graph_of(sketch_seg), _graph_of(metric_seg)
-    fit = None
-    scan: dict = {}
-    if constraints is not None and len(constraints.fixed) >= 2:
-        flags = [mirrored for _, mirrored in candidates]
-        fit = fit_to_pairs(
-            sketch_labels, metric_labels, constraints.fixed, sketch_graph, metric_graph, mirror_flags=flags
-        )
-    if fit is None:
-        # A told orientation is kept exactly; found ones are refined by a few degrees.
-        step = config.overlay_angle_step if config.orientation == "any" else 0.0
-        ranked = ranked_overlays(
-            sketch_labels, metric_labels, orientations=candidates, scale=config.scale, angle_step=step
-        )
-        fit = ranked[0][1] if ranked else Alignment.unfitted(*candidates[0])
-        # Rank values as the planar matcher's (lower is better): 1 - the correlation. The answer's
-        # runner-up reading (orientation.next_reading) then tells a person how close the call was.
-        scan = {(placed.degrees, placed.mirrored): 1.0 - score for score, placed in ranked}
-    orientation = (fit.degrees, fit.mirrored)
-    outlines = sketch_outlines(sketch_seg, sketch_graph, [orientation])
-    base = prepare_oriented(sketch_graph, metric_graph, config, orientation, outlines)
-    pairs = overlay_pairs(sketch_labels, metric_labels, fit.matrix, min_iou=config.overlay_min_iou)
-    pairs = constrained_pairs(pairs, constraints)
-    descriptors = base.descriptors
-    reasons = list(base.notes)
-    if not pairs:
-        reasons.append(f"no regions overlap by IoU >= {config.overlay_min_iou:g}")
-    result = MatchResult(
-        pairs=pairs,
-        anchors=list(descriptors.anchors) if descriptors else [],
-        unique_sketch=list(descriptors.unique_sketch) if descriptors else [],
-        unique_metric=list(descriptors.unique_metric) if descriptors else [],
-        m=0.0,
-        # The share of the input that does not agree with the metric map where it was laid.
-        cost=1.0 - fit.overlap,
-        normalised_cost=1.0 - fit.overlap,
-        signatures=None,
-        c_matrix=base.c_matrix,
-        seeds_count=0,
-        hypotheses=len(candidates),
-        reason="; ".join(dict.fromkeys(reasons)),
-        config=config,
-        orientation=orientation,
-        orientation_scan=scan,
-    )
-    return dataclasses.replace(base, chosen=result, constraints=constraints, orientation_scan=scan)
 
 
 def _share_of(progress, index: int, count: int):

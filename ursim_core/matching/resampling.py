@@ -379,10 +379,10 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
     when it has some (``Segmentation.resampled``), the configuration votes
     (``resampling_vote``) with the planar matcher, and no constraints fix region ids.
 
-    ``prepare_one(sketch_seg, metric_seg, config, *, orientations, overlaps) -> Prepared`` prepares
-    one segmentation (:func:`ursim_core.matching.prepare` without the vote) in the orientations
-    nearest to ``orientations`` (all of its own candidates when None), with the free-space
-    overlaps ``overlaps`` already measured.
+    ``prepare_one(sketch_seg, metric_seg, config, *, orientations, overlaps, windows) -> Prepared``
+    prepares one segmentation (:func:`ursim_core.matching.prepare` without the vote) in the
+    orientations nearest to ``orientations`` (all of its own candidates when None), with the
+    free-space overlaps ``overlaps`` and best windows ``windows`` already measured.
 
     The other segmentations are matched in the orientations the first one's search kept as
     finalists (``Prepared.orientation_scan``), not screened in all eight again: the orientation
@@ -411,8 +411,12 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
     # The refit's start from the signatures alone (``signature_refit``) costs a sweep and a refit
     # per mirror flag: ``vote_signature_refit=False`` leaves it to the first segmentation.
     others_config = config if config.vote_signature_refit else config.replace(signature_refit=False)
+    windows = prepared.orientation_windows
     variants = tuple(
-        (other.labels, prepare_one(other, metric_seg, others_config, orientations=finalists, overlaps=overlaps))
+        (
+            other.labels,
+            prepare_one(other, metric_seg, others_config, orientations=finalists, overlaps=overlaps, windows=windows),
+        )
         for other in others
     )
     labels = sketch_seg.labels

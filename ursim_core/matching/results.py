@@ -43,6 +43,9 @@ class Prepared:
     #: The free-space overlap of every candidate orientation that was measured, ``{(degrees, mirrored):
     #: overlap}``; the sketch's other segmentations take theirs from it (see ``oriented.carried_overlaps``).
     orientation_overlaps: dict = field(default_factory=dict)
+    #: With ``MatchConfig.window_reading_margin``: each finalist orientation's best window,
+    #: ``{(degrees, mirrored): (correlation, gain) or None}``, carried to the other segmentations.
+    orientation_windows: dict = field(default_factory=dict)
     #: The two maps' label images, for ``MatchConfig.elastic`` (set by :func:`prepare` when it is
     #: given segmentations), and its answers by orientation (the flow does not depend on m).
     sketch_labels: Any = None
