@@ -116,6 +116,7 @@ def prepare(
 
     Examples
     --------
+    >>> import networkx as nx
     >>> g = nx.path_graph(3)
     >>> nx.set_node_attributes(g, {0: 50, 1: 10, 2: 12}, "size")
     >>> nx.set_node_attributes(g, 0.3, "pca_shape")
@@ -399,6 +400,7 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
 
     Examples
     --------
+    >>> import networkx as nx
     >>> g = nx.cycle_graph(4)
     >>> nx.set_node_attributes(g, {0: 90, 1: 10, 2: 20, 3: 30}, "size")
     >>> nx.set_node_attributes(g, {0: 0.1, 1: 0.5, 2: 0.3, 3: 0.2}, "pca_shape")
@@ -450,6 +452,7 @@ def match(
 
     Examples
     --------
+    >>> import networkx as nx
     >>> g = nx.cycle_graph(4)
     >>> nx.set_node_attributes(g, {0: 90, 1: 10, 2: 20, 3: 30}, "size")
     >>> nx.set_node_attributes(g, {0: 0.1, 1: 0.5, 2: 0.3, 3: 0.2}, "pca_shape")
