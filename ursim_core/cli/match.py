@@ -68,6 +68,13 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
         choices=["yes", "no", "unknown"],
         help="whether the sketch is a mirror image of the map (default: unknown with 'any', no otherwise)",
     )
+    parser.add_argument(
+        "--partial",
+        action="store_true",
+        help="the sketch shows only part of the metric map: lay it in the part of the map it resembles or box "
+        "onto box, whichever lands better, and read its orientation where it resembles a part of the map "
+        "(elastic_laying=boxes_or_window, window_reading_margin=0.1)",
+    )
     parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     parser.add_argument(
         "--matcher",
@@ -142,6 +149,10 @@ def match_config(args: argparse.Namespace):
         overrides["orientation"] = args.orientation
     if getattr(args, "mirrored", None) is not None:
         overrides["mirrored"] = {"yes": True, "no": False, "unknown": None}[args.mirrored]
+    if getattr(args, "partial", False):
+        from ursim_core.matching.config import PARTIAL_SKETCH
+
+        overrides.update(PARTIAL_SKETCH)
     if args.variant:
         overrides["variant"] = args.variant
     if args.matcher:
@@ -224,6 +235,7 @@ OPTION_NAMES = (
     "m",
     "orientation",
     "mirrored",
+    "partial",
     "variant",
     "matcher",
     "scale",

@@ -210,6 +210,19 @@ class MatchingPanel(QWidget):
             "and the laying whose bent sketch lands more on the map's free space is kept (a second optical flow "
             "per match)",
         )
+        self.partial = QCheckBox("the sketch shows only part of the map")
+        self.partial.setObjectName("match_partial")
+        self._add_option(
+            form,
+            "Part",
+            self.partial,
+            _ELASTIC_MATCHERS,
+            "For a sketch of part of the map: lay it in the part of the map it resembles or box onto box, "
+            "whichever lands better (the Laying above), and read its orientation where it resembles a part "
+            "of the map. Off for a whole sketch: a whole hand-drawn sketch can land better in a window that "
+            "pairs it worse",
+        )
+        self.partial.toggled.connect(self._lay_partial)
         self.orientation = SketchOrientation()
         self.turn_left = QPushButton("⟲ 90°")
         self.turn_left.setObjectName("orient_left")
@@ -275,9 +288,20 @@ class MatchingPanel(QWidget):
         widget.setEnabled(self.matcher.currentData() in matchers)
         self.matcher.currentIndexChanged.connect(lambda _: widget.setEnabled(self.matcher.currentData() in matchers))
 
+    def _lay_partial(self, partial: bool) -> None:
+        """A partial sketch's laying chosen in the Laying list (which a person may change again);
+        the default laying back when the box is cleared, if that laying is still chosen."""
+        from ursim_core.matching import MatchConfig
+        from ursim_core.matching.config import PARTIAL_SKETCH
+
+        wanted = PARTIAL_SKETCH["elastic_laying"] if partial else MatchConfig().elastic_laying
+        if partial or self.laying.currentData() == PARTIAL_SKETCH["elastic_laying"]:
+            self.laying.setCurrentIndex(self.laying.findData(wanted))
+
     def config(self):
         """The ``MatchConfig`` the widgets describe."""
         from ursim_core.matching import MatchConfig
+        from ursim_core.matching.config import PARTIAL_SKETCH
 
         m = "auto" if self.m_auto.isChecked() else float(self.m_value.value())
         fields = {field.name for field in dataclasses.fields(MatchConfig)}
@@ -287,6 +311,8 @@ class MatchingPanel(QWidget):
             extra["scale"] = float(self.scale.value())
         if matcher == "auto" and self.input_kind.currentData() is not None:
             extra["input_kind"] = self.input_kind.currentData()
+        if matcher in _ELASTIC_MATCHERS and self.partial.isChecked():
+            extra["window_reading_margin"] = PARTIAL_SKETCH["window_reading_margin"]
         return MatchConfig(
             variant=self.variant.currentData(),
             matcher=matcher,

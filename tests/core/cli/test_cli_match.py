@@ -286,3 +286,20 @@ def test_any_matching_option_is_set_with_set_and_a_wrong_one_is_refused_first(tm
         assert main(["match", str(sketch), str(metric), "-o", str(elsewhere), "--set", wrong]) == 1
         assert message in capsys.readouterr().err
         assert not elsewhere.exists()  # refused before any work
+
+
+def test_partial_tells_the_matcher_the_sketch_shows_part_of_the_map(tmp_path):
+    from ursim_core.matching.config import PARTIAL_SKETCH
+
+    sketch, metric = two_rooms(tmp_path / "a.png"), two_rooms(tmp_path / "b.png")
+    argv = ["match", str(sketch), str(metric)]
+    assert main([*argv, "-o", str(tmp_path / "partial"), "--partial"]) == 0
+    config = load_correspondences(tmp_path / "partial" / "correspondences.json").extra["matcher"]["config"]
+    assert {name: config[name] for name in PARTIAL_SKETCH} == PARTIAL_SKETCH
+    # --set still wins over it, as over the other options.
+    assert main([*argv, "-o", str(tmp_path / "set"), "--partial", "--set", "elastic_laying=window"]) == 0
+    config = load_correspondences(tmp_path / "set" / "correspondences.json").extra["matcher"]["config"]
+    assert config["elastic_laying"] == "window" and config["window_reading_margin"] == 0.1
+    assert main([*argv, "-o", str(tmp_path / "whole")]) == 0
+    config = load_correspondences(tmp_path / "whole" / "correspondences.json").extra["matcher"]["config"]
+    assert config["window_reading_margin"] == 0 and config["elastic_laying"] == "window"

@@ -235,3 +235,24 @@ def test_the_panel_lays_a_partial_sketch_where_its_answer_puts_it(window, qtbot)
     assert offered == set(ELASTIC_LAYINGS)
     panel.laying.setCurrentIndex(panel.laying.findData("boxes_or_window"))
     assert panel.config().elastic_laying == "boxes_or_window"
+
+
+def test_the_panel_is_told_the_sketch_shows_part_of_the_map(window):
+    from ursim_core.matching.config import PARTIAL_SKETCH
+
+    panel = window.matching_panel
+    assert not panel.partial.isChecked() and panel.config().window_reading_margin == 0
+    panel.partial.setChecked(True)
+    config = panel.config()
+    assert {name: getattr(config, name) for name in PARTIAL_SKETCH} == PARTIAL_SKETCH
+    # The laying it chose stays a choice of its own; cleared, the default laying comes back.
+    panel.laying.setCurrentIndex(panel.laying.findData("boxes_or_answer"))
+    assert panel.config().elastic_laying == "boxes_or_answer" and panel.config().window_reading_margin > 0
+    panel.laying.setCurrentIndex(panel.laying.findData(PARTIAL_SKETCH["elastic_laying"]))
+    panel.partial.setChecked(False)
+    assert panel.config().window_reading_margin == 0
+    assert panel.config().elastic_laying == MatchConfig().elastic_laying
+    # Only the planar matcher reads it.
+    panel.partial.setChecked(True)
+    panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
+    assert not panel.partial.isEnabled() and panel.config().window_reading_margin == 0
