@@ -57,7 +57,7 @@ ELASTIC_LAYING_RULES = {
 #: The values of ``MatchConfig.elastic_laying``.
 ELASTIC_LAYINGS = tuple(ELASTIC_LAYING_RULES)
 #: The options for a sketch known to show only part of the metric map (``ursim match --partial``,
-#: the app's "Part of the map"). Round 48, generated pairs: the cropped kinds 0.812 -> 0.836 mean F1;
+#: the app's "Part" box). Round 48, generated pairs: the partial kinds 0.812 -> 0.836 mean F1;
 #: not the default, since a whole hand-drawn sketch can land better in a window that pairs it worse
 #: (docs/options.md).
 PARTIAL_SKETCH = {"elastic_laying": "boxes_or_window", "window_reading_margin": 0.1}
