@@ -218,13 +218,6 @@ def _centroids(labels: np.ndarray) -> dict:
     return {int(r): (row_sum[r] / count[r], col_sum[r] / count[r]) for r in present if r > 0}
 
 
-def _box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if not len(rows):
-        return None
-    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
-
-
 def box_laying(sketch_labels: np.ndarray, metric_labels: np.ndarray, *, degrees: float = 0.0, mirrored: bool = False):
     """The :class:`Laying` that carries the box around the oriented sketch's regions onto the box
     around the metric map's; None when either map has no region.
@@ -240,7 +233,7 @@ def box_laying(sketch_labels: np.ndarray, metric_labels: np.ndarray, *, degrees:
 
 
 def _box_laying(sketch: np.ndarray, metric_labels: np.ndarray) -> Laying | None:
-    sketch_box, metric_box = _box(sketch > 0), _box(np.asarray(metric_labels) > 0)
+    sketch_box, metric_box = template.free_box(sketch > 0), template.free_box(np.asarray(metric_labels) > 0)
     if sketch_box is None or metric_box is None:
         return None
     (r0, r1, c0, c1), (m0, m1, n0, n1) = sketch_box, metric_box
@@ -471,7 +464,7 @@ def window_laying(sketch: np.ndarray, metric_labels: np.ndarray, *, gain: float 
         return None
     if window.correlation < template.WINDOW_MIN_CORRELATION:
         return None
-    r0, r1, c0, c1 = _box(sketch_free)
+    r0, r1, c0, c1 = template.free_box(sketch_free)
     row_scale, col_scale = window.height / (r1 - r0), window.width / (c1 - c0)
     return Laying("window", row_scale, window.top - row_scale * r0, col_scale, window.left - col_scale * c0)
 

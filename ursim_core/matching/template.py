@@ -31,6 +31,7 @@ __all__ = [
     "WINDOW_MIN_CORRELATION",
     "Window",
     "signed_distance",
+    "free_box",
     "best_window",
 ]
 
@@ -95,7 +96,16 @@ def signed_distance(free: np.ndarray, *, clip: float) -> np.ndarray:
     return np.clip(inside - outside, -clip, clip).astype(np.float32)
 
 
-def _box(free: np.ndarray) -> tuple[int, int, int, int] | None:
+def free_box(free: np.ndarray) -> tuple[int, int, int, int] | None:
+    """``(first row, end row, first col, end col)`` of the box around the non-zero pixels of
+    ``free`` (ends exclusive), or None when there are none.
+
+    Examples
+    --------
+    >>> free = np.zeros((5, 6), bool); free[1:3, 2:5] = True
+    >>> free_box(free), free_box(np.zeros((2, 2), bool))
+    ((1, 3, 2, 5), None)
+    """
     rows, cols = np.flatnonzero(free.any(axis=1)), np.flatnonzero(free.any(axis=0))
     if not len(rows):
         return None
@@ -151,7 +161,7 @@ def best_window(
     import cv2
 
     sketch_free, metric_free = np.asarray(sketch_free, bool), np.asarray(metric_free, bool)
-    sketch_box, metric_box = _box(sketch_free), _box(metric_free)
+    sketch_box, metric_box = free_box(sketch_free), free_box(metric_free)
     if sketch_box is None or metric_box is None:
         return None
     factor = coarse / max(metric_free.shape)
