@@ -146,16 +146,21 @@ def _outline_vote(image: np.ndarray) -> complex:
     import cv2
 
     contours, _ = cv2.findContours(image, cv2.RETR_LIST, cv2.CHAIN_APPROX_NONE)
-    total = 0j
-    for contour in contours:
-        polygon = cv2.approxPolyDP(contour, _POLYGON_TOLERANCE, True).reshape(-1, 2).astype(np.float64)
-        if len(polygon) < 2:
-            continue
-        edges = np.roll(polygon, -1, axis=0) - polygon
-        dx, dy_up = edges[:, 0], -edges[:, 1]
-        lengths = np.hypot(dx, dy_up)
-        total += (lengths * np.exp(4j * np.arctan2(dy_up, dx))).sum()
-    return complex(total)
+    polygons = [cv2.approxPolyDP(contour, _POLYGON_TOLERANCE, True).reshape(-1, 2) for contour in contours]
+    polygons = [polygon for polygon in polygons if len(polygon) >= 2]
+    if not polygons:
+        return 0j
+    # Every polygon's edges at once: each vertex's successor is the next one, the last vertex's
+    # the polygon's first. (A building-sized map has thousands of outlines, and NumPy calls per
+    # outline took 0.06 of the 0.08 s per image; the sum is the same up to rounding, and the
+    # vote stays a function of the image alone, so the eight copies still vote alike.)
+    points = np.concatenate(polygons).astype(np.float64)
+    successor = np.arange(1, len(points) + 1)
+    ends = np.cumsum([len(polygon) for polygon in polygons])
+    successor[ends - 1] = np.concatenate(([0], ends[:-1]))
+    edges = points[successor] - points
+    dx, dy_up = edges[:, 0], -edges[:, 1]
+    return complex((np.hypot(dx, dy_up) * np.exp(4j * np.arctan2(dy_up, dx))).sum())
 
 
 def dihedral(image: np.ndarray, quarter_turns: int, mirrored: bool) -> np.ndarray:
