@@ -32,7 +32,7 @@ __all__ = [
     "prepare_oriented",
     "reoriented",
     "candidate_overlaps",
-    "carried_overlaps",
+    "carried_by_orientation",
     "finalist_windows",
     "window_reading",
 ]
@@ -220,23 +220,25 @@ def candidate_overlaps(config: MatchConfig, sketch_seg, metric_seg, candidates, 
     return {index: max(alignment.overlap, _SMALLEST_OVERLAP) for index, alignment in zip(indices, fitted)}
 
 
-def carried_overlaps(measured: dict, candidates, indices) -> dict[int, float] | None:
-    """Overlaps of ``candidates`` (at ``indices``) taken from those ``measured`` on another
-    segmentation of the same sketch, ``{(degrees, mirrored): overlap}``: each from the measured
+def carried_by_orientation(measured: dict, candidates, indices) -> dict | None:
+    """Values of ``candidates`` (at ``indices``) taken from those ``measured`` on another
+    segmentation of the same sketch, ``{(degrees, mirrored): value}``: each from the measured
     orientation of the same mirror flag nearest in turn. None when a candidate has no such one.
 
-    The segmentations of one sketch share its frame, and their candidate orientations are a
-    fraction of a degree apart, as are their free spaces: fitting each again (about 7 ms per
-    segmentation of a KTH sketch) finds the same overlaps up to resampling noise.
+    The values are the free-space overlaps (:func:`candidate_overlaps`) and the best windows
+    (:func:`finalist_windows`). The segmentations of one sketch share its frame, and their
+    candidate orientations are a fraction of a degree apart, as are their free spaces: fitting each
+    again (about 7 ms per segmentation of a KTH sketch) finds the same overlaps up to resampling
+    noise.
 
     Examples
     --------
     >>> measured = {(0.4, False): 0.8, (90.4, False): 0.5, (0.4, True): 0.6}
-    >>> carried_overlaps(measured, [(90.1, False), (0.1, True)], [0, 1])
+    >>> carried_by_orientation(measured, [(90.1, False), (0.1, True)], [0, 1])
     {0: 0.5, 1: 0.6}
-    >>> carried_overlaps(measured, [(180.0, True), (270.0, True)], [1])
+    >>> carried_by_orientation(measured, [(180.0, True), (270.0, True)], [1])
     {1: 0.6}
-    >>> carried_overlaps({(0.0, False): 0.8}, [(0.0, True)], [0]) is None
+    >>> carried_by_orientation({(0.0, False): 0.8}, [(0.0, True)], [0]) is None
     True
     """
     carried = {}

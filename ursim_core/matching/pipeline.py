@@ -38,7 +38,7 @@ from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically
 from ursim_core.matching.orientation import DOOR_EVIDENCE, broken_adjacencies, misplaced_doors
 from ursim_core.matching.oriented import (
     candidate_overlaps,
-    carried_overlaps,
+    carried_by_orientation,
     finalist_windows,
     nearest_orientations,
     orientations_to_try,
@@ -159,7 +159,7 @@ def _prepare_one(
     candidates nearest to them are tried (:func:`~ursim_core.matching.oriented.nearest_orientations`);
     with ``overlaps`` and ``windows`` (another segmentation's ``Prepared.orientation_overlaps``
     and ``orientation_windows``), each candidate takes the free-space overlap and the best window
-    of the nearest orientation measured there (:func:`~ursim_core.matching.oriented.carried_overlaps`)
+    of the nearest orientation measured there (:func:`~ursim_core.matching.oriented.carried_by_orientation`)
     instead of being fitted again."""
     config = config.resolved()
     sketch_graph, metric_graph = region_graph_of(sketch_seg), region_graph_of(metric_seg)
@@ -221,7 +221,7 @@ def _prepare_one(
     else:
         # Another segmentation of the sketch in the same frame measured them already: its free
         # space differs from this one's by resampling noise (see resampling.with_resampled).
-        overlaps = carried_overlaps(overlaps, candidates, finalists) if overlaps else None
+        overlaps = carried_by_orientation(overlaps, candidates, finalists) if overlaps else None
         if overlaps is None:
             overlaps = candidate_overlaps(config, sketch_seg, metric_seg, candidates, list(finalists))
 
@@ -299,7 +299,7 @@ def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measur
     large maps, which are not laid. (Found on a thread while the finalists were matched, they
     cost as much: the two compete for the same two cores; round 48.)"""
     if measured:
-        carried = carried_overlaps(measured, candidates, indices)
+        carried = carried_by_orientation(measured, candidates, indices)
         if carried is not None:
             return carried
     labels = elastic_labels(base, sketch_seg, metric_seg, largest=_SCREEN_BY_ASSIGNMENT)

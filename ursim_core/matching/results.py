@@ -41,7 +41,7 @@ class Prepared:
     #: :func:`match_prepared` votes over their answers.
     resampled: Any = None
     #: The free-space overlap of every candidate orientation that was measured, ``{(degrees, mirrored):
-    #: overlap}``; the sketch's other segmentations take theirs from it (see ``oriented.carried_overlaps``).
+    #: overlap}``; the sketch's other segmentations take theirs from it (see ``oriented.carried_by_orientation``).
     orientation_overlaps: dict = field(default_factory=dict)
     #: With ``MatchConfig.window_reading_margin``: each finalist orientation's best window,
     #: ``{(degrees, mirrored): (correlation, gain) or None}``, carried to the other segmentations.
