@@ -6,10 +6,10 @@ docs/studies.md), so the overlay pairs of a rigid placement were worse than the 
 Once the planar matcher has read the sketch's orientation, :func:`elastic_pairs`:
 
 1. turns the sketch's label image into that orientation (:func:`oriented_labels`);
-2. lays it on the metric map by the bounding boxes of both maps' regions (a scale and a shift
-   per axis), and, given the planar answer's pairs, also by a scale and a shift per axis fitted to
-   their regions' centroids (:func:`answer_laying`): a partial sketch laid box onto box is
-   stretched over the whole map;
+2. lays it on the metric map by a scale and a shift per axis (:mod:`ursim_core.matching.layings`):
+   box onto box, or in the window of the map it clearly resembles (a partial sketch laid box onto
+   box is stretched over the whole map), and, given the planar answer's pairs, also fitted to
+   their regions' centroids;
 3. bends it by a dense optical flow between the two maps' signed distance images
    (:func:`elastic_flow`: OpenCV's DIS, Kroeger et al., ECCV 2016), which moves each wall of the
    sketch towards the nearest wall of the metric map it resembles;
@@ -32,6 +32,19 @@ from typing import NamedTuple
 import numpy as np
 
 from ursim_core.matching import template
+
+# The layings are layings.py's; Laying, oriented_labels and the public layings stay importable
+# from here, where they were until round 49.
+from ursim_core.matching.layings import (
+    Laying,
+    answer_laying,
+    box_laying,
+    boxes_laying,
+    oriented_labels,
+    pairs_laying,
+    region_centroids,
+    window_laying,
+)
 
 __all__ = [
     "WORKING_SIDE",
@@ -61,31 +74,6 @@ DISTANCE_CLIP = 60.0
 _ANY_GAIN = 1e-6
 
 
-class Laying(NamedTuple):
-    """A scale and a shift per axis that carry the oriented sketch's pixels onto the metric map's:
-    ``row' = row_scale * row + row_shift``, ``col' = col_scale * col + col_shift``. ``by`` says
-    what it was fitted to: ``"boxes"`` (box onto box) or ``"answer"`` (the answer's pairs)."""
-
-    by: str
-    row_scale: float
-    row_shift: float
-    col_scale: float
-    col_shift: float
-
-    def scaled(self, factor: float) -> Laying:
-        """The same laying onto the metric map resized by ``factor``."""
-        return self._replace(
-            row_scale=self.row_scale * factor,
-            row_shift=self.row_shift * factor,
-            col_scale=self.col_scale * factor,
-            col_shift=self.col_shift * factor,
-        )
-
-    def matrix(self) -> np.ndarray:
-        """OpenCV's 2 x 3 affine matrix of the laying, in (x, y) = (col, row)."""
-        return np.array([[self.col_scale, 0.0, self.col_shift], [0.0, self.row_scale, self.row_shift]])
-
-
 class LaidSketch(NamedTuple):
     """What :func:`lay_sketch` found: the region pairs, the laying used, and the share of the bent
     sketch's free space that landed on the metric map's free space (at the working size)."""
@@ -93,37 +81,6 @@ class LaidSketch(NamedTuple):
     pairs: list
     laying: Laying
     landed: float
-
-
-def oriented_labels(labels: np.ndarray, *, degrees: float, mirrored: bool) -> np.ndarray:
-    """A label image mirrored left-right (when asked) then turned counter-clockwise by ``degrees``.
-
-    The same transformation as :func:`~ursim_core.matching.orientation.transform_points`, up to a
-    shift: quarter turns exactly (``np.rot90``), other angles by nearest-neighbour resampling onto
-    a canvas that holds the whole turned image.
-
-    Examples
-    --------
-    >>> labels = np.array([[1, 2]], np.int32)
-    >>> oriented_labels(labels, degrees=90, mirrored=False).tolist()
-    [[2], [1]]
-    >>> oriented_labels(labels, degrees=0, mirrored=True).tolist()
-    [[2, 1]]
-    """
-    import cv2
-
-    labels = np.asarray(labels)
-    if mirrored:
-        labels = labels[:, ::-1]
-    quarter = degrees / 90.0
-    if abs(quarter - round(quarter)) < 1e-9:
-        return np.ascontiguousarray(np.rot90(labels, int(round(quarter)) % 4))
-    from ursim_core.segmentation.canonical import turn_on_canvas
-
-    matrix, (new_rows, new_cols) = turn_on_canvas(labels.shape, degrees)
-    # Nearest neighbour on float32 keeps the ids exactly (they are far below 2**24).
-    turned = cv2.warpAffine(labels.astype(np.float32), matrix, (new_cols, new_rows), flags=cv2.INTER_NEAREST)
-    return turned.astype(labels.dtype)
 
 
 def signed_distance(free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:
@@ -200,102 +157,9 @@ def _memoised(name: str, metric_labels: np.ndarray, extra, make):
 
 
 def _metric_centroids(metric_labels: np.ndarray) -> dict:
-    """:func:`_centroids` of the metric map, kept for the last map seen (many sketches, one map)."""
-    return _memoised("centroids", metric_labels, None, lambda: _centroids(metric_labels))
-
-
-def _centroids(labels: np.ndarray) -> dict:
-    """``{region: (row, col)}``: the mean pixel of every region of a label image (0 = none)."""
-    labels = np.asarray(labels)
-    flat = labels.ravel().astype(np.intp, copy=False)
-    if not flat.size or flat.max() <= 0:
-        return {}
-    rows, cols = labels.shape
-    count = np.bincount(flat)
-    row_sum = np.bincount(flat, weights=np.repeat(np.arange(rows, dtype=np.float64), cols))
-    col_sum = np.bincount(flat, weights=np.tile(np.arange(cols, dtype=np.float64), rows))
-    present = np.flatnonzero(count)
-    return {int(r): (row_sum[r] / count[r], col_sum[r] / count[r]) for r in present if r > 0}
-
-
-def box_laying(sketch_labels: np.ndarray, metric_labels: np.ndarray, *, degrees: float = 0.0, mirrored: bool = False):
-    """The :class:`Laying` that carries the box around the oriented sketch's regions onto the box
-    around the metric map's; None when either map has no region.
-
-    Examples
-    --------
-    >>> metric = np.zeros((60, 100), np.int32); metric[10:50, 20:80] = 1
-    >>> sketch = np.zeros((30, 40), np.int32); sketch[5:25, 10:40] = 1
-    >>> box_laying(sketch, metric)
-    Laying(by='boxes', row_scale=2.0, row_shift=0.0, col_scale=2.0, col_shift=0.0)
-    """
-    return _box_laying(oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored), metric_labels)
-
-
-def _box_laying(sketch: np.ndarray, metric_labels: np.ndarray) -> Laying | None:
-    sketch_box, metric_box = template.free_box(sketch > 0), template.free_box(np.asarray(metric_labels) > 0)
-    if sketch_box is None or metric_box is None:
-        return None
-    (r0, r1, c0, c1), (m0, m1, n0, n1) = sketch_box, metric_box
-    row_scale, col_scale = (m1 - m0) / (r1 - r0), (n1 - n0) / (c1 - c0)
-    return Laying("boxes", row_scale, m0 - row_scale * r0, col_scale, n0 - col_scale * c0)
-
-
-def answer_laying(
-    sketch_labels: np.ndarray, metric_labels: np.ndarray, pairs, *, degrees: float = 0.0, mirrored: bool = False
-):
-    """The :class:`Laying` fitted to an answer: per axis, the least-squares scale and shift that
-    carry the centroids of the oriented sketch's paired regions onto their partners' centroids.
-
-    No assumption that the sketch covers the metric map's extent, as laying box onto box makes.
-    Paired regions in one row (or column) take the other axis' scale across it. None when fewer
-    than three pairs have both regions in the label images, when the paired sketch regions spread
-    along neither axis, or when a fitted scale is not positive (an answer that lays the sketch
-    mirrored or folded is not a laying of it in this orientation).
-
-    Examples
-    --------
-    >>> metric = np.zeros((60, 100), np.int32)
-    >>> metric[10:20, 10:20], metric[10:20, 30:40], metric[30:40, 10:20] = 1, 2, 3
-    >>> sketch = metric[5:45, 5:45] * 1
-    >>> laying = answer_laying(sketch, metric, [(1, 1), (2, 2), (3, 3)])
-    >>> laying.by, [round(value, 6) for value in laying[1:]]
-    ('answer', [1.0, 5.0, 1.0, 5.0])
-    >>> answer_laying(sketch, metric, [(1, 1), (2, 2)]) is None
-    True
-    """
-    sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-    metric_labels = np.asarray(metric_labels)
-    return _answer_laying(sketch, _metric_centroids(metric_labels), pairs)
-
-
-def _answer_laying(sketch: np.ndarray, metric_centroids: dict, pairs) -> Laying | None:
-    sketch_centroids = _centroids(sketch)
-    matched = [
-        (sketch_centroids[a], metric_centroids[b]) for a, b in pairs if a in sketch_centroids and b in metric_centroids
-    ]
-    if len(matched) < 3:
-        return None
-    source, target = (np.array([points[side] for points in matched], dtype=np.float64) for side in (0, 1))
-    spread = [np.ptp(source[:, axis]) >= 1.0 for axis in (0, 1)]
-    if not any(spread):
-        return None
-    fitted = {}
-    for axis in (0, 1):
-        if spread[axis]:
-            design = np.stack([source[:, axis], np.ones(len(source))], axis=1)
-            (scale, shift), *_ = np.linalg.lstsq(design, target[:, axis], rcond=None)
-            if not (np.isfinite(scale) and np.isfinite(shift) and scale > 0):
-                return None
-            fitted[axis] = (float(scale), float(shift))
-    for axis in (0, 1):
-        if not spread[axis]:
-            # Regions in one row (or column) fix no scale across it: the other axis' scale, and
-            # the shift that carries their mean onto their partners'.
-            scale = fitted[1 - axis][0]
-            fitted[axis] = (scale, float(target[:, axis].mean() - scale * source[:, axis].mean()))
-    fitted = [*fitted[0], *fitted[1]]
-    return Laying("answer", *fitted)
+    """:func:`~ursim_core.matching.layings.region_centroids` of the metric map, kept for the last
+    map seen (many sketches, one map)."""
+    return _memoised("centroids", metric_labels, None, lambda: region_centroids(metric_labels))
 
 
 def lay_sketch(
@@ -440,35 +304,6 @@ def laid_sketch(
     return bent.astype(np.int32)
 
 
-def window_laying(sketch: np.ndarray, metric_labels: np.ndarray, *, gain: float | None = None) -> Laying | None:
-    """The :class:`Laying` that carries the box around the oriented sketch's regions onto the
-    window of the metric map where it correlates best (:func:`~ursim_core.matching.template.best_window`),
-    when that window correlates better than the map's whole box by at least ``gain``
-    (:data:`~ursim_core.matching.template.WINDOW_GAIN` when None) and at least
-    :data:`~ursim_core.matching.template.WINDOW_MIN_CORRELATION` in all; else None.
-
-    Examples
-    --------
-    >>> plan = np.zeros((300, 600), np.int32)
-    >>> plan[20:130, 20:150], plan[20:130, 160:400], plan[20:130, 410:580] = 1, 2, 3
-    >>> plan[140:170, 20:580], plan[180:280, 20:260], plan[180:280, 270:580] = 4, 5, 6
-    >>> laying = window_laying(plan[:, :320], plan)
-    >>> laying.by, 0.9 < laying.col_scale < 1.1
-    ('window', True)
-    >>> window_laying(plan, plan) is None
-    True
-    """
-    sketch_free, metric_free = np.asarray(sketch) > 0, np.asarray(metric_labels) > 0
-    window = template.best_window(sketch_free, metric_free)
-    if window is None or window.gain < (template.WINDOW_GAIN if gain is None else gain):
-        return None
-    if window.correlation < template.WINDOW_MIN_CORRELATION:
-        return None
-    r0, r1, c0, c1 = template.free_box(sketch_free)
-    row_scale, col_scale = window.height / (r1 - r0), window.width / (c1 - c0)
-    return Laying("window", row_scale, window.top - row_scale * r0, col_scale, window.left - col_scale * c0)
-
-
 def _laid(
     sketch_labels,
     metric_labels,
@@ -487,7 +322,7 @@ def _laid(
     answer's; None when either map has no region."""
     metric_labels = np.asarray(metric_labels)
     sketch = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-    boxes = _box_laying(sketch, metric_labels)  # None when either map has no region
+    boxes = boxes_laying(sketch, metric_labels)  # None when either map has no region
     if boxes is None:
         return None
     layings = [boxes if laying is None else laying]
@@ -496,7 +331,7 @@ def _laid(
         if found is not None:
             layings = [boxes, found] if window_competes else [found]
     if laying is None and answer:
-        fitted = _answer_laying(sketch, _metric_centroids(metric_labels), answer)
+        fitted = pairs_laying(sketch, _metric_centroids(metric_labels), answer)
         if fitted is not None:
             layings.append(fitted)
     metric, metric_image = _metric_at_working_size(metric_labels, clip)
