@@ -259,10 +259,10 @@ class MatchConfig:
     elastic_laying : {'boxes', 'boxes_or_answer', 'window', 'window_or_answer', 'boxes_or_window'}
         Where the sketch is laid before it is bent: 'window' (default), box onto box, or in the
         window of the metric map where it correlates clearly better than over the whole box
-        (:func:`~ursim_core.matching.elastic.window_laying`): a partial sketch laid box onto box
+        (:func:`~ursim_core.matching.layings.window_laying`): a partial sketch laid box onto box
         is stretched over the whole map; 'boxes', box onto box only; 'boxes_or_answer' and
         'window_or_answer', also by a scale and a shift per axis fitted to the planar answer's
-        pairs (:func:`~ursim_core.matching.elastic.answer_laying`), the laying whose bent sketch
+        pairs (:func:`~ursim_core.matching.layings.answer_laying`), the laying whose bent sketch
         lands more on the metric map's free space giving the pairs (a second optical flow);
         'boxes_or_window', box onto box or the best window whatever its margin, whichever lands
         more (:data:`ELASTIC_LAYING_RULES`). Evidence: docs/options.md.

@@ -132,7 +132,7 @@ class MatchResult:
         orientation are the planar matcher's, which read the orientation.
     laying : Laying or None
         With ``laid``: how the sketch was laid on the metric map before it was bent
-        (:class:`~ursim_core.matching.elastic.Laying`: box onto box, or fitted to the planar
+        (:class:`~ursim_core.matching.layings.Laying`: box onto box, or fitted to the planar
         answer's pairs; ``MatchConfig.elastic_laying``), to draw it again; None otherwise.
     """
 

@@ -1,6 +1,6 @@
 """Where a sketch of part of a building sits on the metric map: a template search over windows.
 
-Laid box onto box (:func:`~ursim_core.matching.elastic.box_laying`), a sketch of part of a building
+Laid box onto box (:func:`~ursim_core.matching.layings.box_laying`), a sketch of part of a building
 is stretched over the whole metric map, and the flow that bends it cannot undo a stretch of a
 third. :func:`best_window` instead slides the sketch, shrunk to a range of sizes, over the metric
 map at a coarse size and keeps the window where the two maps' signed distance images correlate
