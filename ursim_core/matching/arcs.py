@@ -36,6 +36,8 @@ def arc(order: list[int], start: int, stop: int) -> list[int]:
 #: "same" cells packed once (:class:`~ursim_core.matching.edit_distance.PackedOrders`) and their long
 #: arcs aligned 64 rows per word: a building's corridor borders thousands of rooms, and its arcs
 #: are aligned again for every hypothesis. Smaller orders align their arcs as lists (same pairs).
+#: The planar matcher's C loop does the same (``csrc/bitalign.c``); this is its reference, and
+#: runs where the C loop does not (constraints, alternatives kept, no C compiler).
 PACKED_CELLS = 1 << 16
 
 

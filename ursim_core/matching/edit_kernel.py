@@ -8,7 +8,11 @@ compares them on random inputs with many ties.
 
 This module imports numba, so it is imported only when a long alignment is needed: small maps
 (sketches, the KTH model) never load it. The kernel is compiled on its first use in an
-environment (about a second) and cached on disk by numba.
+environment (about a second) and cached on disk by numba. The planar matcher's C loop aligns long
+neighbour orders itself (``csrc/bitalign.c``, a port of :func:`pack_same` and :func:`packed_codes`
+that a test compares with them), so ``ursim match`` of a building no longer imports numba for
+this (about 0.9 s of the process): the Python matcher does, where it runs (constraints, alternatives
+kept, no C compiler).
 """
 
 from __future__ import annotations

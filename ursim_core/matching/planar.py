@@ -41,9 +41,11 @@ Consumed seeds are skipped, which in practice removes most of them on consistent
 :func:`planar_match` takes the seed list from the caller, which may cap it for large graphs
 (see ``ursim_core.matching.MatchConfig.max_seeds``).
 
-Speed: the common case (no constraints, no alternatives kept, sketch-sized graphs) runs the same
-loop in C (:mod:`ursim_core.matching.kernels`; the same answers, which a test checks against
-this code). The code here runs the rest, and everything where no C compiler is.
+Speed: the common case (no constraints, no alternatives kept) runs the same loop in C, graphs of
+any size (:mod:`ursim_core.matching.kernels`; the same answers, which tests check against this
+code, building-sized graphs included). The code here runs the rest (a person's review of a
+building's pair is matched here, with its long alignments in numba), and everything where no C
+compiler is.
 """
 
 from __future__ import annotations

@@ -102,10 +102,11 @@ def test_the_kernel_runs_the_common_case_and_python_the_rest(c_kernel, monkeypat
     # Alternatives kept, and constraints, are the Python loop's: it runs (and here fails).
     with pytest.raises(AssertionError, match="Python loop"):
         planar_match(line, line, same, keep_alternatives=True)
-    # Graphs too large for the kernel's tables go to Python as well.
-    monkeypatch.setattr(kernels, "LARGEST_CELLS", 15)
-    with pytest.raises(AssertionError, match="Python loop"):
-        planar_match(line, line, same)
+    # A corridor's neighbour order, too long for the kernel's table, is aligned bit-parallel in C.
+    star = nx.star_graph(300)
+    nx.set_node_attributes(star, {i: (0.0, 0.0) if i == 0 else (np.sin(i), np.cos(i)) for i in star}, "centroid")
+    hub = planar_graph(star)
+    assert len(planar_match(hub, hub, np.eye(301, dtype=bool), seeds=[(0, 0)]).pairs) == 301
 
 
 def test_bad_arguments_are_refused_by_the_kernel(c_kernel):

@@ -121,7 +121,10 @@ def test_bad_arguments_are_refused_by_the_sweep_kernel(c_kernel):
         kernels.sweep_compiled(first, second, c_matrix, order, values[::-1].copy(), 10, ms)
     with pytest.raises(TypeError, match="planar_sweep: c "):
         c_kernel.planar_sweep(*first.flat_orders[:2], *second.flat_orders[:2], 1, 1, c_matrix.astype(np.float32),
-                              order, values, 10, ms, 1, 1.0, 1, 0)  # fmt: skip
+                              order, values, 10, ms, 1, 1.0, 1, 0, 1, 1 << 16)  # fmt: skip
+    with pytest.raises(ValueError, match="threads >= 1"):
+        c_kernel.planar_sweep(*first.flat_orders[:2], *second.flat_orders[:2], 1, 1, c_matrix, order, values, 10,
+                              ms, 1, 1.0, 1, 0, 0, 1 << 16)  # fmt: skip
 
 
 def _fit_case(rng, n, outliers=0):

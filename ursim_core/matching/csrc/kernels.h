@@ -46,18 +46,46 @@ typedef struct {
     int32_t n1, n2;
     const int32_t *off1, *nb1, *off2, *nb2; /* cyclic neighbour orders (CSR) */
     const uint8_t *same;                    /* n1 x n2: c <= m */
-    int32_t *table;                         /* edit-distance table, (max degree 1 + 1) x (max degree 2 + 1) */
+    int64_t table_cells;                    /* alignments of more cells ((rows + 1) x (cols + 1)) are
+                                             * bit-parallel (bitalign.c), the others fill ``table`` */
+    int32_t *table;
     int32_t *row_buffer;                    /* a rotated or reversed first sequence */
 } Graphs;
+
+/* bitalign.c: the "same" bits of a sketch vertex's neighbour order (reversed when ``reflected``)
+ * against a metric vertex's, packed once per match (edit_kernel.pack_same's layout). */
+typedef struct {
+    int32_t v, w, reflected, size1, size2, words;
+    uint64_t *bits; /* size2 rows of ``words``: bit p of row q is same[order1[p % size1]][order2[q]] */
+} PackedOrders;
+
+/* bitalign.c: the aligned pairs of an arc pair of packed orders, remembered for the match. */
+typedef struct {
+    int32_t key[7]; /* v, w, reflected, start1, rows, start2, cols; rows 0: an empty slot */
+    int32_t count;
+    size_t offset; /* in ``arena`` */
+} ArcEntry;
 
 typedef struct {
     Graphs g;
     int64_t edges1, edges2;
     int rotation_min, reflections;
+    int failed; /* set when memory ran out inside planar_run (which holds no GIL to raise) */
     int32_t n_min, stamp;
     int32_t *work, *stamps; /* scratch; stamps: seen in the sketch, matched in the sketch, seen in the metric map */
-    uint8_t *consumed;      /* n1 x n2: seeds no longer starting a hypothesis */
+    uint8_t *consumed;      /* n1 x n2 bits: seeds no longer starting a hypothesis */
     int32_t *arc1, *arc2, *locks, *aligned, *queue, *pairs, *best_pairs, *partner;
+    int32_t *where2; /* n2: 1 + the position of a metric vertex in the popped pair's order, else 0 */
+    /* bitalign.c's state, emptied by bit_reset at the start of every match */
+    PackedOrders *packs;
+    int32_t n_packs, packs_capacity;
+    size_t pack_words;
+    uint64_t *deltas; /* the columns' +-1 differences of one alignment, for its backtrace */
+    size_t deltas_words;
+    ArcEntry *arcs;
+    size_t n_arcs, arcs_capacity;
+    int32_t *arena;
+    size_t arena_used, arena_capacity;
 } Planar;
 
 typedef struct {
@@ -66,11 +94,28 @@ typedef struct {
     double cost;
 } PlanarOutcome;
 
-int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *name);
+/* Pair costs of a match: none, ``cost[k]`` of an n1 x n2 matrix, or ``cost[k] > above`` as 1 or 0
+ * (the 'substitutions' score, without an n1 x n2 matrix of its own). */
+typedef struct {
+    const double *cost;
+    double weight;
+    int substitutions;
+    double above;
+} PairCosts;
+
+int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *name, PyObject *table_cells);
+int planar_alloc(Planar *p);
 void planar_close(Planar *p);
-void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const double *costs, double weight,
-                PlanarOutcome *out);
+void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const PairCosts *costs, PlanarOutcome *out);
 PyObject *planar_outcome_tuple(const int32_t *pairs, const PlanarOutcome *outcome, int weighted);
+
+/* bitalign.c */
+void bit_reset(Planar *p);
+void bit_free(Planar *p);
+int32_t bit_seed_pairs(Planar *p, int32_t v, int32_t w, int rotation_min, int reflections, int *reflected,
+                       int32_t *out);
+const int32_t *bit_arc_pairs(Planar *p, int32_t v, int32_t w, int reflected, int32_t start1, int32_t rows,
+                             int32_t start2, int32_t cols, int32_t *count);
 
 KERNEL(planar_match);
 /* sweep.c */

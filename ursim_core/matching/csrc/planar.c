@@ -5,11 +5,15 @@
  * edit-distance alignments with the same backtrace ties (edit_distance.py), the same FIFO
  * expansion between locks (arcs.py), the same cost and the same earliest-wins rule. The pair
  * costs are summed in pair order in doubles, as Python's sum does on 3.11, so the costs are
- * the same floats. A test compares both on random graphs with many ties and on the KTH pairs.
+ * the same floats. Tests compare both on random graphs with many ties, on graphs with hubs of
+ * hundreds of neighbours, on the KTH pairs and on generated buildings.
  *
  * Why C: a turned KTH sketch is matched about 740 times (eight segmentations, the finalist
  * orientations, the m grid, the refits), and Python spent 58 of the 130 ms of such a match in
- * this loop.
+ * this loop. Graphs of any size: alignments of up to ``table_cells`` cells fill a table here,
+ * longer ones (a building's corridor against the other map's, 4250 neighbours each) run
+ * bit-parallel (bitalign.c); the consumed seeds are one bit a (sketch, metric) pair (2.3 MB for
+ * two 4250-region maps), and a lock's position in a long metric order is looked up, not searched.
  */
 #include "kernels.h"
 
@@ -95,13 +99,18 @@ static int32_t aligned_index_pairs(const Graphs *g, const int32_t *a, int32_t ro
 
 /* seed_alignment: the rotation (and reflection) of the sketch region's neighbours with the lowest
  * distance to the metric region's (ties: the smallest offset, unreflected first; 'first' keeps
- * offset 0), and the pairs it aligns. Returns the number of pairs; *reflected is set. */
-static int32_t seed_pairs(const Graphs *g, int32_t v, int32_t w, int rotation_min, int reflections, int *reflected,
+ * offset 0), and the pairs it aligns. Returns the number of pairs; *reflected is set. Orders too
+ * long for the table are aligned bit-parallel (bitalign.c; the same pairs). */
+static int32_t seed_pairs(Planar *p, int32_t v, int32_t w, int rotation_min, int reflections, int *reflected,
                           int32_t *out)
 {
+    const Graphs *g = &p->g;
     const int32_t *a = g->nb1 + g->off1[v], *b = g->nb2 + g->off2[w];
     int32_t rows = g->off1[v + 1] - g->off1[v], cols = g->off2[w + 1] - g->off2[w];
     *reflected = 0;
+    if (rows > 0 && cols > 0 && (int64_t)(rows + 1) * (cols + 1) > g->table_cells) {
+        return bit_seed_pairs(p, v, w, rotation_min, reflections, reflected, out);
+    }
     if (!rotation_min || rows <= 1) {
         return aligned_index_pairs(g, a, rows, b, cols, out);
     }
@@ -153,6 +162,18 @@ static int32_t arc(const int32_t *order, int32_t size, int32_t start, int32_t st
     return n;
 }
 
+/* The bit of a (sketch, metric) pair in the consumed bitmap (one bit a pair: 2.3 MB for two
+ * 4250-region maps, against 18 MB as bytes, and emptied at every match). */
+static inline int is_consumed(const uint8_t *consumed, int64_t cell)
+{
+    return (consumed[cell >> 3] >> (cell & 7)) & 1;
+}
+
+static inline void consume(uint8_t *consumed, int64_t cell)
+{
+    consumed[cell >> 3] |= (uint8_t)(1u << (cell & 7));
+}
+
 /* Queue the aligned pairs whose two regions are both unseen in this hypothesis, in order; mark them
  * seen and consumed (a seed equal to one no longer starts a hypothesis). Returns the new tail. */
 static int32_t enqueue(const int32_t *aligned, int32_t count, int32_t *queue, int32_t tail, int32_t *seen1,
@@ -168,7 +189,7 @@ static int32_t enqueue(const int32_t *aligned, int32_t count, int32_t *queue, in
         tail++;
         seen1[a] = stamp;
         seen2[b] = stamp;
-        consumed[(int64_t)a * n2 + b] = 1;
+        consume(consumed, (int64_t)a * n2 + b);
     }
     return tail;
 }
@@ -210,28 +231,82 @@ fail:
     return NULL;
 }
 
+/* The pair cost of cell ``k`` (see PairCosts). */
+static inline double pair_cost(const PairCosts *costs, int64_t k)
+{
+    return costs->substitutions ? (costs->cost[k] > costs->above ? 1.0 : 0.0) : costs->cost[k];
+}
+
+/* Positions of the popped pair's locked neighbours, in the sketch order: (q, r) with order1[q]
+ * matched (``matched1[u] == stamp``) to order2[r], r the last position as planar.py's dict of
+ * positions has it. Long metric orders are looked up through ``where`` (a building corridor's
+ * thousands of neighbours), short ones by a scan. */
+static int32_t find_locks(const int32_t *order1, int32_t size1, const int32_t *order2, int32_t size2,
+                          const int32_t *matched1, const int32_t *partner, int32_t stamp, int32_t *where,
+                          int32_t *locks)
+{
+    int32_t n_locks = 0;
+    int listed = size2 > 16;
+    if (listed) {
+        for (int32_t r = 0; r < size2; r++) {
+            where[order2[r]] = r + 1;
+        }
+    }
+    for (int32_t q = 0; q < size1; q++) {
+        int32_t u = order1[q];
+        if (matched1[u] != stamp) {
+            continue;
+        }
+        int32_t target = partner[u], found = -1;
+        if (listed) {
+            found = where[target] - 1;
+        } else {
+            for (int32_t r = size2 - 1; r >= 0; r--) {
+                if (order2[r] == target) {
+                    found = r;
+                    break;
+                }
+            }
+        }
+        if (found >= 0) {
+            locks[2 * n_locks] = q;
+            locks[2 * n_locks + 1] = found;
+            n_locks++;
+        }
+    }
+    if (listed) {
+        for (int32_t r = 0; r < size2; r++) {
+            where[order2[r]] = 0;
+        }
+    }
+    return n_locks;
+}
+
 /* One planar match from ``seeds`` (n_seeds >= 1, inside the graphs) over ``p->g.same``; ``costs``
  * NULL: not weighted. The best pairs are left in ``p->best_pairs``. Needs no Python (the GIL may
- * be released). Stamps are unique over the calls on one Planar, so they are never cleared. */
-void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const double *costs, double weight,
-                PlanarOutcome *out)
+ * be released); out of memory, it stops with ``p->failed`` set. Stamps are unique over the calls
+ * on one Planar, so they are never cleared. */
+void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const PairCosts *costs, PlanarOutcome *out)
 {
     Graphs *g = &p->g;
     int32_t n1 = g->n1, n2 = g->n2;
     int weighted = costs != NULL;
+    double weight = weighted ? costs->weight : 0.0;
     int32_t *seen1 = p->stamps, *matched1 = p->stamps + n1, *seen2 = p->stamps + 2 * n1;
     int32_t *arc1 = p->arc1, *arc2 = p->arc2, *locks = p->locks, *aligned = p->aligned, *queue = p->queue;
     int32_t *pairs = p->pairs, *best_pairs = p->best_pairs, *partner = p->partner;
     uint8_t *consumed = p->consumed;
-    memset(consumed, 0, (size_t)n1 * (size_t)n2);
+    memset(consumed, 0, ((size_t)n1 * (size_t)n2 + 7) / 8);
+    bit_reset(p);
+    memset(out, 0, sizeof(*out));
 
     int64_t single_structure = (int64_t)(n1 - 1) + (n2 - 1) + p->edges1 + p->edges2;
     Py_ssize_t best_seed = 0;
     double best_term = 0.0;
     if (weighted) {
-        best_term = weight * costs[(int64_t)seeds[0] * n2 + seeds[1]];
+        best_term = weight * pair_cost(costs, (int64_t)seeds[0] * n2 + seeds[1]);
         for (Py_ssize_t k = 1; k < n_seeds; k++) {
-            double term = weight * costs[(int64_t)seeds[2 * k] * n2 + seeds[2 * k + 1]];
+            double term = weight * pair_cost(costs, (int64_t)seeds[2 * k] * n2 + seeds[2 * k + 1]);
             if (term < best_term) {
                 best_term = term;
                 best_seed = k;
@@ -247,14 +322,17 @@ void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const doubl
 
     for (Py_ssize_t k = 0; k < n_seeds; k++) {
         int32_t v = seeds[2 * k], w = seeds[2 * k + 1];
-        if (consumed[(int64_t)v * n2 + w]) {
+        if (is_consumed(consumed, (int64_t)v * n2 + w)) {
             continue;
         }
-        consumed[(int64_t)v * n2 + w] = 1;
+        consume(consumed, (int64_t)v * n2 + w);
         expanded++;
         int32_t stamp = ++p->stamp;
         int reflected = 0;
-        int32_t n_aligned = seed_pairs(g, v, w, p->rotation_min, p->reflections, &reflected, aligned);
+        int32_t n_aligned = seed_pairs(p, v, w, p->rotation_min, p->reflections, &reflected, aligned);
+        if (p->failed) {
+            return;
+        }
         seen1[v] = stamp;
         seen2[w] = stamp;
         matched1[v] = stamp;
@@ -283,33 +361,34 @@ void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const doubl
             for (int32_t q = 0; q < size1; q++) {
                 order1[q] = reflected ? base1[size1 - 1 - q] : base1[q];
             }
-            int32_t n_locks = 0;
-            for (int32_t q = 0; q < size1; q++) {
-                int32_t u = order1[q];
-                if (matched1[u] != stamp) {
-                    continue;
-                }
-                int32_t target = partner[u];
-                for (int32_t r = 0; r < size2; r++) {
-                    if (order2[r] == target) {
-                        locks[2 * n_locks] = q;
-                        locks[2 * n_locks + 1] = r;
-                        n_locks++;
-                        break;
-                    }
-                }
-            }
+            int32_t n_locks = find_locks(order1, size1, order2, size2, matched1, partner, stamp, p->where2, locks);
             for (int32_t l = 0; l < n_locks; l++) {
                 int32_t next = (l + 1) % n_locks;
-                int32_t length1 = arc(order1, size1, locks[2 * l], locks[2 * next], arc1);
-                int32_t length2 = arc(order2, size2, locks[2 * l + 1], locks[2 * next + 1], arc2);
+                int32_t start1 = locks[2 * l], start2 = locks[2 * l + 1];
+                /* The elements strictly between two locks, walking forward (all the others for one). */
+                int32_t length1 = locks[2 * next] - start1 - 1, length2 = locks[2 * next + 1] - start2 - 1;
+                length1 += length1 < 0 ? size1 : 0;
+                length2 += length2 < 0 ? size2 : 0;
                 if (length1 == 0 || length2 == 0) {
                     continue;
                 }
-                /* order1 lives in row_buffer, which the alignment does not touch (it is only the
-                 * seed alignment's rotation buffer). */
-                int32_t found = aligned_index_pairs(g, arc1, length1, arc2, length2, aligned);
-                tail = enqueue(aligned, found, queue, tail, seen1, seen2, stamp, consumed, n2);
+                const int32_t *found_pairs = aligned;
+                int32_t found;
+                if ((int64_t)(length1 + 1) * (length2 + 1) > g->table_cells) {
+                    /* Arcs of a corridor: bit-parallel, once per match (the same pairs). */
+                    found_pairs = bit_arc_pairs(p, vertex, other, reflected, start1 + 1 == size1 ? 0 : start1 + 1,
+                                                length1, start2 + 1 == size2 ? 0 : start2 + 1, length2, &found);
+                    if (found_pairs == NULL) {
+                        return;
+                    }
+                } else {
+                    arc(order1, size1, start1, locks[2 * next], arc1);
+                    arc(order2, size2, start2, locks[2 * next + 1], arc2);
+                    /* order1 lives in row_buffer, which the alignment does not touch (it is only
+                     * the seed alignment's rotation buffer). */
+                    found = aligned_index_pairs(g, arc1, length1, arc2, length2, aligned);
+                }
+                tail = enqueue(found_pairs, found, queue, tail, seen1, seen2, stamp, consumed, n2);
             }
         }
         hypotheses++;
@@ -333,7 +412,7 @@ void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const doubl
         if (weighted) {
             double sum = 0.0;
             for (int32_t q = 0; q < n_pairs; q++) {
-                sum += costs[(int64_t)pairs[2 * q] * n2 + pairs[2 * q + 1]];
+                sum += pair_cost(costs, (int64_t)pairs[2 * q] * n2 + pairs[2 * q + 1]);
             }
             cost = (double)structure + weight * sum;
         }
@@ -353,11 +432,12 @@ void planar_run(Planar *p, const int32_t *seeds, Py_ssize_t n_seeds, const doubl
 }
 
 /* planar_match(off1, nb1, off2, nb2, edges1, edges2, same, seeds, pair_costs, weight, rotation_min,
- * reflections) -> (pairs, cost, structural_cost, hypotheses, seeds_expanded).
- * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). */
+ * reflections, table_cells) -> (pairs, cost, structural_cost, hypotheses, seeds_expanded).
+ * ``pair_costs`` None: not weighted (the cost is the structural cost, an int). ``table_cells``:
+ * alignments of more cells are bit-parallel (the same pairs either way). */
 KERNEL(planar_match)
 {
-    if (check_nargs("planar_match", nargs, 12) < 0) {
+    if (check_nargs("planar_match", nargs, 13) < 0) {
         return NULL;
     }
     Planar p;
@@ -365,7 +445,7 @@ KERNEL(planar_match)
     int n_views = 0;
     PyObject *result = NULL;
     int32_t *seeds = NULL;
-    if (planar_open(&p, args, views, "planar_match") < 0) {
+    if (planar_open(&p, args, views, "planar_match", args[12]) < 0) {
         return NULL;
     }
     n_views = 4;
@@ -403,9 +483,14 @@ KERNEL(planar_match)
         goto done;
     }
     PlanarOutcome outcome;
+    PairCosts pair_costs = {costs, weight, 0, 0.0};
     Py_BEGIN_ALLOW_THREADS
-    planar_run(&p, seeds, n_seeds, costs, weight, &outcome);
+    planar_run(&p, seeds, n_seeds, weighted ? &pair_costs : NULL, &outcome);
     Py_END_ALLOW_THREADS
+    if (p.failed) {
+        PyErr_NoMemory();
+        goto done;
+    }
     result = planar_outcome_tuple(p.best_pairs, &outcome, weighted);
 done:
     for (int k = 0; k < n_views; k++) {

@@ -7,11 +7,19 @@
 #include <string.h>
 
 /* Read the neighbour orders and options shared by planar_match and planar_sweep (arguments 0-5:
- * off1, nb1, off2, nb2, edges1, edges2) and allocate the loop's scratch. ``views`` receives the
- * four order buffers. Returns 0, or -1 with an exception set (the views taken are released). */
-int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *name)
+ * off1, nb1, off2, nb2, edges1, edges2; and the largest table, in cells) and allocate the loop's
+ * scratch. ``views`` receives the four order buffers. Returns 0, or -1 with an exception set (the
+ * views taken are released). */
+int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *name, PyObject *table_cells)
 {
     memset(p, 0, sizeof(*p));
+    p->g.table_cells = PyLong_AsLongLong(table_cells);
+    if (PyErr_Occurred() || p->g.table_cells < 0) {
+        if (!PyErr_Occurred()) {
+            PyErr_Format(PyExc_ValueError, "%s: table_cells must be >= 0", name);
+        }
+        return -1;
+    }
     const char *what[4] = {"off1", "nb1", "off2", "nb2"};
     char label[64];
     for (int k = 0; k < 4; k++) {
@@ -39,6 +47,25 @@ int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *
         }
         goto fail;
     }
+    if (planar_alloc(p) < 0) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    return 0;
+fail:
+    planar_close(p);
+    for (int k = 0; k < 4; k++) {
+        PyBuffer_Release(&views[k]);
+    }
+    return -1;
+}
+
+/* The loop's scratch for the graphs of ``p->g`` (no Python: a sweep's threads call it too).
+ * Returns 0, or -1 when out of memory (what was allocated is freed by planar_close). */
+int planar_alloc(Planar *p)
+{
+    Graphs *g = &p->g;
+    int32_t n1 = g->n1, n2 = g->n2;
     int32_t degree1 = 0, degree2 = 0;
     for (int32_t v = 0; v < n1; v++) {
         int32_t d = g->off1[v + 1] - g->off1[v];
@@ -51,16 +78,18 @@ int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *
     int32_t n_min = n1 < n2 ? n1 : n2;
     int32_t d_max = degree1 > degree2 ? degree1 : degree2;
     /* Scratch: table, row buffer, two arcs, locks (2 per), aligned pairs (2 per), queue and pairs
-     * (2 per, at most n1 + 1 each), the best pairs, the partners. */
+     * (2 per, at most n1 + 1 each), the best pairs, the partners. The table holds the alignments
+     * of at most g->table_cells cells; longer ones are bit-parallel (bitalign.c). */
     size_t table_cells = (size_t)(degree1 + 1) * (size_t)(degree2 + 1);
+    table_cells = table_cells < (size_t)g->table_cells ? table_cells : (size_t)g->table_cells;
     size_t words = table_cells + 3 * (size_t)(d_max + 1) + 4 * (size_t)(d_max + 1)
                    + 2 * 2 * (size_t)(n1 + 2) + 2 * (size_t)(n_min + 1) + (size_t)n1;
     p->work = malloc(sizeof(int32_t) * words);
     p->stamps = calloc((size_t)(2 * n1 + n2 + 1), sizeof(int32_t));
-    p->consumed = malloc((size_t)n1 * (size_t)n2 + 1);
-    if (p->work == NULL || p->stamps == NULL || p->consumed == NULL) {
-        PyErr_NoMemory();
-        goto fail;
+    p->where2 = calloc((size_t)n2 + 1, sizeof(int32_t));
+    p->consumed = malloc(((size_t)n1 * (size_t)n2 + 7) / 8 + 1);
+    if (p->work == NULL || p->stamps == NULL || p->where2 == NULL || p->consumed == NULL) {
+        return -1;
     }
     g->table = p->work;
     g->row_buffer = g->table + table_cells;
@@ -74,22 +103,19 @@ int planar_open(Planar *p, PyObject *const *args, Py_buffer *views, const char *
     p->partner = p->best_pairs + 2 * (n_min + 1);
     p->n_min = n_min;
     return 0;
-fail:
-    planar_close(p);
-    for (int k = 0; k < 4; k++) {
-        PyBuffer_Release(&views[k]);
-    }
-    return -1;
 }
 
 void planar_close(Planar *p)
 {
     free(p->work);
     free(p->stamps);
+    free(p->where2);
     free(p->consumed);
     p->work = NULL;
     p->stamps = NULL;
+    p->where2 = NULL;
     p->consumed = NULL;
+    bit_free(p);
 }
 
 /* (pairs, cost, structural_cost, hypotheses, seeds_expanded) of an outcome whose pairs are
