@@ -4,9 +4,10 @@ At each size two different buildings (seeds 0 and 1 of :func:`~ursim_core.synth.
 are written as PNGs and matched by a fresh ``python -m ursim_core.cli match`` process, as a user
 runs it: loading, both segmentations, the region graphs, the
 orientation search, the automatic m, the figure and the files. Wall time, CPU time (user +
-system) and peak resident memory are those of that child process and the helper process it
-starts for building-sized pairs (``os.wait4`` in a small intermediate process, which also sums
-the resident sizes of the process tree: issue 14's memory bar is on that sum).
+system) and peak resident memory are those of that child process and of any process it starts
+(``os.wait4`` in a small intermediate process, which also sums the resident sizes of the process
+tree: issue 14's memory bar is on that sum; ``ursim match`` starts none since its automatic m's
+sweep runs on two threads of the matcher's C loop instead of a helper process).
 
 Two different maps, not one file twice: a map against itself is the easy case (every region has
 an identical twin, so few seeds expand) and any cache of identical inputs would flatter it. Until
@@ -37,9 +38,8 @@ __all__ = ["bench_match_process"]
 # Run by a fresh interpreter between the benchmark and the measured process: on Linux a child's
 # peak RSS starts at its parent's resident size at fork time, and the benchmark's own process
 # is large after the in-process segmentations; this small one is not. ``ru_maxrss`` is the peak
-# of the largest single process of the tree; ``ursim match`` of a building-sized pair also runs a
-# helper process (ursim_core.matching.sweep_helper), so the resident sizes of every process of
-# the tree are also summed every 20 ms (Linux /proc; shared pages count in each process, so the
+# of the largest single process of the tree; the resident sizes of every process of the tree are
+# also summed every 20 ms (Linux /proc; shared pages count in each process, so the
 # sum can only overstate) and the peak of that sum is reported too.
 _MEASURE = """
 import json, os, subprocess, sys, time
@@ -101,7 +101,7 @@ def bench_match_process(sizes: Iterable[int] = (1000, 2000, 4000, 8000)) -> list
     Returns
     -------
     list of dict
-        ``size``, ``wall_s``, ``cpu_s`` (of the child and its helper), ``maxrss_mb`` (the peak
+        ``size``, ``wall_s``, ``cpu_s`` (of the child and any process it starts), ``maxrss_mb`` (the peak
         resident size of its largest process), ``tree_rss_mb`` (the peak of the resident sizes of
         all its processes summed, sampled every 20 ms) and,
         from the second size on, ``time_ratio`` (wall time over the previous size's) and

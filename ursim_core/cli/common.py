@@ -19,6 +19,7 @@ from ursim_core.errors import ParameterError
 
 __all__ = [
     "UsageError",
+    "keep_freed_memory",
     "parse_param",
     "segmentation_params",
     "add_map_options",
@@ -195,3 +196,30 @@ def add_subcommand(subparsers, name: str, module) -> argparse.ArgumentParser:
     module.configure(parser)
     parser.set_defaults(handler=module.run)
     return parser
+
+
+#: glibc's mallopt parameters (malloc.h) and the value :func:`keep_freed_memory` gives them.
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD, _KEEP_BYTES = -1, -3, 1 << 30
+
+
+def keep_freed_memory() -> None:
+    """Let glibc reuse freed memory instead of handing it back and faulting it in again.
+
+    By default, blocks above a threshold (32 MB at most) are mapped and unmapped on every
+    allocation, and free memory at the top of the heap is returned to the system: a
+    building-sized pair allocates and frees arrays of 10-300 MB over and over (masks of the c
+    matrix, label and distance images), and the kernel zeroes and faults their pages in each
+    time. 8000 px pair (``ursim match``, interleaved with the code before x2): 1.03-1.05 million
+    minor page faults and 8.5-10.5 s of system time without, 0.72-0.75 million and 8.0-8.5 s with
+    this (on a loaded machine), the peak resident size within 2 %. Memory is still given back
+    after the segmentations (:func:`ursim_core.cli.match.load_and_segment` trims explicitly).
+    glibc only; elsewhere nothing. ``ursim match`` calls it.
+    """
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None)
+        libc.mallopt(_M_MMAP_THRESHOLD, _KEEP_BYTES)
+        libc.mallopt(_M_TRIM_THRESHOLD, _KEEP_BYTES)
+    except (OSError, AttributeError, TypeError):
+        pass

@@ -18,6 +18,7 @@ from typing import Any
 from ursim_core.cli.common import (
     add_map_options,
     check_output_folder,
+    keep_freed_memory,
     load,
     segmentation_params,
     staged_folder,
@@ -306,7 +307,7 @@ def _return_freed_memory() -> None:
 
 
 def match_pair(
-    sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None, helper: bool = False, review_path=None
+    sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None, review_path=None
 ) -> dict[str, Any]:
     """Match one pair and write its outputs into ``out``; a record of what was done.
 
@@ -314,14 +315,11 @@ def match_pair(
     place accuracy against that ground truth. Errors propagate (the caller decides).
     ``review_path``: a correspondence file of the pair whose reviewed cliques constrain the
     answer and are written back with it (:func:`reviewed_cliques`).
-    ``helper``: a building-sized pair shares the automatic m's sweep with a helper process
-    (:mod:`ursim_core.matching.sweep_helper`; same answers). ``ursim match`` asks for it; the
-    batch commands, which already run one pair per core, do not.
     """
     from types import SimpleNamespace
 
     from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
-    from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review, sweep_helper
+    from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review
     from ursim_core.matching.results import laid_by, match_record, next_reading_record
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
@@ -346,7 +344,6 @@ def match_pair(
             check_maps(loaded, sketch_map, metric_map, loaded_path)
     # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
     config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
-    large = max(sketch_seg.n_regions, metric_seg.n_regions) >= sweep_helper.MIN_REGIONS
     # The images are staged and moved in together; the JSON, which names them, is written last
     # (atomically, in place, so the paths it stores are relative to its own folder).
     # The two label images are encoded on two threads while the maps are matched (OpenCV
@@ -378,10 +375,9 @@ def match_pair(
                 file=sys.stderr,
             )
             constraints = None
-        with sweep_helper.helping(enabled=helper and large):
-            started = time.perf_counter()
-            result = match(sketch_seg, metric_seg, config=config, constraints=constraints)
-            elapsed = time.perf_counter() - started
+        started = time.perf_counter()
+        result = match(sketch_seg, metric_seg, config=config, constraints=constraints)
+        elapsed = time.perf_counter() - started
         for job in jobs:
             job.result()
         cliques = [
@@ -443,7 +439,6 @@ def match_pair(
 
 def run(args: argparse.Namespace) -> int:
     from ursim_core.matching.orientation import describe_gap
-    from ursim_core.matching.sweep_helper import keep_freed_memory
 
     keep_freed_memory()
     record = match_pair(
@@ -452,7 +447,6 @@ def run(args: argparse.Namespace) -> int:
         Path(args.output),
         options_of(args),
         reference_path=args.reference,
-        helper=True,
         review_path=args.review,
     )
     out = record["out"]

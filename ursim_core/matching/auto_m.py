@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ursim_core.matching import sweep_helper
 from ursim_core.matching.config import AUTO_RULE_NAMES
 from ursim_core.matching.results import replaced
 
@@ -79,7 +78,12 @@ def sweep(prepared, grid=None, *, progress=None, known=None) -> list:
 
 
 def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[list, dict]:
-    """:func:`sweep`, and the results it matched (not reused from the previous m), by m."""
+    """:func:`sweep`, and the results it matched (not reused from the previous m), by m.
+
+    The planar matcher's values of m are matched in one call of its C loop when it takes them
+    (:func:`~ursim_core.matching.single.match_sweep`, on two threads for building-sized pairs),
+    else one by one (:func:`~ursim_core.matching.single.match_at`).
+    """
     from ursim_core.matching.single import SeedSelector, match_at, match_sweep, seed_cap
 
     grid = prepared.config.m_grid if grid is None else grid
@@ -90,10 +94,6 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
     cap = seed_cap(prepared.config.max_seeds, *c_matrix.shape)
     if prepared.config.matcher == "planar" and prepared.descriptors is not None and cap is not None and len(grid) > 1:
         selector = SeedSelector(c_matrix, cap)
-    helper = sweep_helper.active(prepared, len(grid))
-    if helper is not None:
-        # Building-sized pairs (never screened by sweeps, see pipeline.prepare): nothing is known.
-        return _sweep_shared(prepared, grid, selector, helper, progress), {}
     # Two values of m select the same pairs when as many values of c are <= each (the pairs with
     # c <= m grow with m): counted, not compared mask by mask; the later one reuses the result.
     selected = selector.selected_counts(grid) if selector is not None else None
@@ -121,51 +121,6 @@ def matched_sweep(prepared, grid=None, *, progress=None, known=None) -> tuple[li
         if progress is not None:
             progress(index / len(grid), f"matching at m = {m:.3f}")
     return results, matched
-
-
-def _sweep_shared(prepared, grid, selector, helper, progress) -> list:
-    """:func:`sweep` with the planar matching of the distinct m shared with a helper process.
-
-    The values of m are independent; the helper (:mod:`ursim_core.matching.sweep_helper`) runs
-    :func:`~ursim_core.matching.single.planar_outcome` on the same inputs, so every result is the
-    one this process would compute. The same m reuse the previous result as in :func:`sweep`.
-    """
-    from ursim_core.matching.single import match_at, planar_seeds
-
-    c_matrix = prepared.c_matrix
-    computed = []  # grid positions whose "same" relation differs from the previous computed one
-    previous_mask = None
-    for index, m in enumerate(grid):
-        mask = c_matrix <= float(m)
-        if previous_mask is None or not np.array_equal(mask, previous_mask):
-            computed.append(index)
-            previous_mask = mask
-    del mask, previous_mask
-    tasks = [(index, float(grid[index]), planar_seeds(prepared, float(grid[index]), selector)) for index in computed]
-    outcomes = helper.share(
-        prepared, [(m, seeds) for _, m, seeds in tasks if seeds], progress=_counted(progress, len(grid))
-    )
-    by_position = dict(zip((index for index, _, seeds in tasks if seeds), outcomes))
-    results = []
-    for index, m in enumerate(grid):
-        if index in computed:
-            results.append(match_at(prepared, float(m), seed_selector=selector, outcome=by_position.get(index)))
-        else:
-            results.append(replaced(results[-1], m=float(m)))
-    if progress is not None:
-        progress(1.0, f"matching at m = {float(grid[-1]):.3f}")
-    return results
-
-
-def _counted(progress, total: int):
-    """``progress`` called with the share of finished values of m (None stays None)."""
-    if progress is None:
-        return None
-
-    def report(done: int, m: float) -> None:
-        progress(min(done, total) / total, f"matching at m = {m:.3f}")
-
-    return report
 
 
 def _rule_score(prepared, results) -> list[float]:

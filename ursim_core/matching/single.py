@@ -1,12 +1,14 @@
 """One run of the configured matcher at one fixed m: seeds, the planar matcher or a baseline, the score.
 
-:func:`match_sweep` gives the runs at many values of m from one call of the planar matcher's C loop.
+:func:`match_sweep` gives the runs at many values of m from one call of the planar matcher's C loop,
+on two threads for building-sized pairs (:data:`THREADED_REGIONS`).
 """
 
 from __future__ import annotations
 
 import bisect
 import math
+import os
 
 import numpy as np
 
@@ -25,6 +27,7 @@ __all__ = [
     "planar_outcome",
     "match_at",
     "match_sweep",
+    "THREADED_REGIONS",
 ]
 
 
@@ -205,11 +208,7 @@ def planar_seeds(prepared: Prepared, m: float, seed_selector: SeedSelector | Non
 def planar_outcome(
     sketch_planar, metric_planar, c_matrix: np.ndarray, config: MatchConfig, m: float, seeds, constraints=None
 ):
-    """:func:`~ursim_core.matching.planar.planar_match` at m from these seeds, as :func:`match_at` runs it.
-
-    Everything it reads is passed in (no :class:`Prepared`), so that a helper process of a sweep
-    over m (:mod:`ursim_core.matching.auto_m`) runs exactly what :func:`match_at` would.
-    """
+    """:func:`~ursim_core.matching.planar.planar_match` at m from these seeds, as :func:`match_at` runs it."""
     # Arrays, not nested lists: converting an n1 x n2 matrix costs seconds for
     # thousands of regions, and the planar matcher reads only a few of its cells.
     return planar_match(
@@ -225,13 +224,11 @@ def planar_outcome(
     )
 
 
-def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None = None, outcome=None) -> MatchResult:
+def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None = None) -> MatchResult:
     """Run the configured matcher at one fixed m.
 
     ``seed_selector``: a :class:`SeedSelector` of ``prepared.c_matrix`` and the configured
     seed cap, shared by the calls of a sweep over m (the same seeds, found faster).
-    ``outcome``: the planar matcher's result at m, when it was already computed by
-    :func:`planar_outcome` from the seeds of :func:`planar_seeds` (a sweep's helper process).
 
     Examples
     --------
@@ -262,10 +259,9 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
             if not seeds and not (constraints and constraints.fixed):
                 reasons.append(f"no seeds: no pair of regions has c <= m = {m:g}")
             else:
-                if outcome is None:
-                    outcome = planar_outcome(
-                        prepared.sketch_planar, prepared.metric_planar, c_matrix, config, m, seeds, constraints
-                    )
+                outcome = planar_outcome(
+                    prepared.sketch_planar, prepared.metric_planar, c_matrix, config, m, seeds, constraints
+                )
                 index_pairs = outcome.pairs
                 hypotheses = outcome.hypotheses
                 if constraints is None and math.isfinite(outcome.cost):
@@ -323,14 +319,25 @@ def _result(prepared: Prepared, m, index_pairs, cost, normalised, seeds_count, h
     )
 
 
+#: Sweeps of pairs with at least this many regions in either map share their values of m between
+#: two threads of the C loop (:func:`~ursim_core.matching.kernels.sweep_compiled`; each thread
+#: takes the next m, the same results). A value of m costs about 0.13 s at 8000 px (4250 regions),
+#: a sketch-sized one microseconds. The 8000 px pair's sweep (19 distinct m) in C took 2.6 s on one
+#: thread and 1.5 s on two (12.3 s in Python); ``ursim match`` of the pair, interleaved x3 on a
+#: shared machine: 21.8 / 25.2 / 24.8 s on two threads, 23.0 / 30.0 / 28.2 s on one, and 26.3 /
+#: 23.5 / 24.1 s with the helper process that shared the values of m before (each side calling C).
+THREADED_REGIONS = 900
+
+
 def match_sweep(prepared: Prepared, ms, seed_selector: SeedSelector | None) -> list[MatchResult] | None:
     """``[match_at(prepared, m, seed_selector=seed_selector) for m in ms]`` from one call of the
     planar matcher's C loop (:func:`~ursim_core.matching.kernels.sweep_compiled`), or None when
     it does not take the case: another matcher, constraints, no selector with the configured
-    cap, NaN in c, graphs the C loop leaves to Python, or no C module.
+    cap, NaN in c, or no C module.
 
     The same results, field by field: a test compares them. A sweep of a sketch-sized pair spent
-    more time in the Python around each m's C call than in the calls.
+    more time in the Python around each m's C call than in the calls; a building-sized one runs on
+    two threads (:data:`THREADED_REGIONS`).
     """
     config, descriptors = prepared.config, prepared.descriptors
     if config.matcher != "planar" or descriptors is None or seed_selector is None or not ms:
@@ -344,7 +351,7 @@ def match_sweep(prepared: Prepared, ms, seed_selector: SeedSelector | None) -> l
     outcomes = sweep_compiled(
         prepared.sketch_planar, prepared.metric_planar, c_matrix, *ordered, cap, ms,
         score=config.hypothesis_score, weight=config.score_weight if weighted else 0.0,
-        rotation_search=config.rotation_search, reflections=config.reflections,
+        rotation_search=config.rotation_search, reflections=config.reflections, threads=_sweep_threads(c_matrix),
     )  # fmt: skip
     if outcomes is None:
         return None
@@ -356,3 +363,8 @@ def match_sweep(prepared: Prepared, ms, seed_selector: SeedSelector | None) -> l
         cost, normalised = _cost_of(prepared, index_pairs, None, scored)
         results.append(_result(prepared, m, index_pairs, cost, normalised, seeds_count, hypotheses, reasons))
     return results
+
+
+def _sweep_threads(c_matrix: np.ndarray) -> int:
+    """Threads of the C loop for a sweep of a pair with this c matrix (see :data:`THREADED_REGIONS`)."""
+    return min(2, os.cpu_count() or 1) if max(c_matrix.shape) >= THREADED_REGIONS else 1

@@ -191,21 +191,11 @@ class MatchJob:
         """
         # Imported here: matching pulls in the heavy descriptor code, and the model
         # package must stay cheap to import (and importable while it is absent).
-        from ursim_core.matching import MatchConfig, sweep_helper
+        from ursim_core.matching import MatchConfig, match_prepared, prepare
 
         progress(0.0, "preparing")
         _check(cancelled, "matching")
         config = self.config if self.config is not None else MatchConfig()
-        # A building-sized pair shares its sweeps of m with a helper process, as `ursim match`
-        # does (the same answers; 19 planar matches of about a second each at 8000 px, every
-        # one holding the GIL, ran on one core here before). A cancel stops the helper too.
-        large = max(self.sketch_seg.n_regions, self.metric_seg.n_regions) >= sweep_helper.MIN_REGIONS
-        with sweep_helper.helping(enabled=large):
-            return self._matched(config, progress, cancelled)
-
-    def _matched(self, config: Any, progress: ProgressCallback, cancelled: CancelledCallback) -> Any:
-        from ursim_core.matching import match_prepared, prepare
-
         reached = [0.0]
 
         def phase(start: float, end: float):

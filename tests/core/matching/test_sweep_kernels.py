@@ -86,6 +86,27 @@ def test_a_sweep_over_m_is_the_same_with_and_without_the_c_sweep(c_kernel, monke
         assert sorted(compiled[1]) == sorted(reference[1])
 
 
+def test_a_building_sized_pairs_sweep_runs_on_two_threads_with_the_same_results(c_kernel, monkeypatch):
+    import ursim_core.matching.single as single
+
+    threads = []
+
+    def recorded(*args, **kwargs):
+        threads.append(kwargs["threads"])
+        return kernels.sweep_compiled(*args, **kwargs)
+
+    monkeypatch.setattr(single, "sweep_compiled", recorded)
+    monkeypatch.setattr(single.os, "cpu_count", lambda: 4)
+    for trial, first, second in _pairs_of_graphs(6):
+        prepared = prepare(first, second, _CONFIGS[trial % len(_CONFIGS)])
+        monkeypatch.setattr(single, "THREADED_REGIONS", 10**9)
+        alone = matched_sweep(prepared)[0]
+        monkeypatch.setattr(single, "THREADED_REGIONS", 0)  # every pair counts as building-sized
+        shared = matched_sweep(prepared)[0]
+        assert [_fields(result) for result in shared] == [_fields(result) for result in alone]
+    assert threads == [1, 2] * 6
+
+
 def test_the_sweep_in_c_leaves_constraints_nan_and_other_matchers_to_match_at(c_kernel):
     graph = random_region_graph(6, seed=3)
     prepared = prepare(graph, graph.copy(), _CONFIGS[0])

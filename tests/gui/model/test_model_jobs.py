@@ -98,34 +98,3 @@ def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(sess
     assert len(steps) == len(config.m_grid)
 
     assert _cancelled_during_the_sweep(session, config) == 6
-
-
-def test_a_large_pair_shares_its_sweeps_with_the_helper_process_and_a_cancel_stops_it(session, monkeypatch):
-    from ursim_core.matching import MatchConfig, sweep_helper
-
-    config = MatchConfig(m="auto")
-    alone = MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
-        lambda *a: None, lambda: False
-    )
-    # Every pair counts as building-sized: the job must start the helper and hand it values of m.
-    monkeypatch.setattr(sweep_helper, "MIN_REGIONS", 0)
-    shared_calls, closed = [], []
-    share, close = sweep_helper.Helper.share, sweep_helper.Helper.close
-    monkeypatch.setattr(
-        sweep_helper.Helper, "share", lambda self, *a, **k: shared_calls.append(1) or share(self, *a, **k)
-    )
-    monkeypatch.setattr(sweep_helper.Helper, "close", lambda self: closed.append(1) or close(self))
-    shared = MatchJob(session.segmentation("sketch"), session.segmentation("metric"), config).run(
-        lambda *a: None, lambda: False
-    )
-    assert shared_calls, "the sweeps ran without the helper"
-    assert (shared.pairs, shared.m, shared.cost, shared.orientation) == (
-        alone.pairs,
-        alone.m,
-        alone.cost,
-        alone.orientation,
-    )
-    assert closed == [1] and sweep_helper._ACTIVE is None
-
-    _cancelled_during_the_sweep(session, config)
-    assert closed == [1, 1] and sweep_helper._ACTIVE is None  # the helper went with the cancel
