@@ -15,40 +15,18 @@ from ursim_core.matching.planar import planar_graph, planar_match
 from ursim_core.native import NativeModule
 
 
-def _python(monkeypatch):
-    """Run the next planar_match calls in Python."""
-    monkeypatch.setattr(kernels, "kernel", lambda: None)
-
-
-def _answer(result):
-    return (
-        result.pairs,
-        result.cost,
-        type(result.cost),
-        result.structural_cost,
-        result.hypotheses,
-        result.seeds_expanded,
-    )
-
-
-def _small_graph(rng, n):
-    """A graph of ``n`` regions joined to 1-4 nearest others (neighbour orders from centroids)."""
-    points = rng.uniform(0, 100, size=(n, 2))
-    graph = nx.Graph()
-    graph.add_nodes_from((i, {"centroid": tuple(points[i])}) for i in range(n))
-    for i in range(n):
-        distances = np.hypot(*(points - points[i]).T)
-        graph.add_edges_from((i, int(j)) for j in np.argsort(distances)[1 : 1 + rng.integers(1, 5)])
-    return planar_graph(graph)
-
-
-def test_the_c_loop_gives_what_python_gives_on_random_graphs_with_many_ties(c_kernel, monkeypatch):
+def test_the_c_loop_gives_what_python_gives_on_random_graphs_with_many_ties(
+    c_kernel, in_python, planar_answer, small_planar_graph
+):
     """Same pairs in the same order, same cost (float or int), counts: dense "same" relations and
     pair costs on a grid of quarters make many equal distances and equal scores."""
     rng = np.random.default_rng(0)
     cases = []
     for trial in range(400):
-        first, second = _small_graph(rng, int(rng.integers(1, 14))), _small_graph(rng, int(rng.integers(1, 14)))
+        first, second = (
+            small_planar_graph(rng, int(rng.integers(1, 14))),
+            small_planar_graph(rng, int(rng.integers(1, 14))),
+        )
         same = rng.uniform(size=(first.n_vertices, second.n_vertices)) < rng.choice([0.1, 0.3, 0.6, 0.9])
         same[rng.integers(first.n_vertices), rng.integers(second.n_vertices)] = True
         seeds = None
@@ -63,15 +41,15 @@ def test_the_c_loop_gives_what_python_gives_on_random_graphs_with_many_ties(c_ke
             "pair_cost_weight": (0.0, 0.5, 1.0, 2.0)[trial % 4],
         }
         cases.append((first, second, same if trial % 2 else same.tolist(), options))
-    compiled = [_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
-    _python(monkeypatch)
-    reference = [_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
+    compiled = [planar_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
+    in_python()
+    reference = [planar_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
     assert compiled == reference
     assert sum(len(answer[0]) > 2 for answer in reference) > 100  # expansions, not only one-pair answers
 
 
 @pytest.mark.parametrize("n_regions", [12, 60])
-def test_the_c_loop_gives_what_python_gives_on_perturbed_copies(c_kernel, monkeypatch, n_regions):
+def test_the_c_loop_gives_what_python_gives_on_perturbed_copies(c_kernel, n_regions, in_python, planar_answer):
     """A region graph against a perturbed copy of itself, "same" at several thresholds of a cost."""
     graph = random_region_graph(n_regions, seed=n_regions)
     copy, _ = perturbed_copy(graph, seed=1, size_noise=0.3, position_noise=30)
@@ -80,9 +58,9 @@ def test_the_c_loop_gives_what_python_gives_on_perturbed_copies(c_kernel, monkey
     calls = [
         (costs <= m, {"pair_costs": costs, "pair_cost_weight": 1.0, "reflections": True}) for m in (0.05, 0.2, 0.5)
     ]
-    compiled = [_answer(planar_match(first, second, same, **options)) for same, options in calls]
-    _python(monkeypatch)
-    assert compiled == [_answer(planar_match(first, second, same, **options)) for same, options in calls]
+    compiled = [planar_answer(planar_match(first, second, same, **options)) for same, options in calls]
+    in_python()
+    assert compiled == [planar_answer(planar_match(first, second, same, **options)) for same, options in calls]
     assert max(len(answer[0]) for answer in compiled) >= n_regions // 3
 
 

@@ -20,22 +20,6 @@ from ursim_core.matching.planar import planar_graph, planar_match
 from ursim_core.matching.single import SeedSelector, pair_cost_matrix
 
 
-def _python(monkeypatch):
-    """Run the next planar matches in Python."""
-    monkeypatch.setattr(kernels, "kernel", lambda: None)
-
-
-def _answer(result):
-    return (
-        result.pairs,
-        result.cost,
-        type(result.cost),
-        result.structural_cost,
-        result.hypotheses,
-        result.seeds_expanded,
-    )
-
-
 def _hub_graph(rng, n: int, hubs=(0.9, 0.3)):
     """Regions at random points joined to 1-3 nearest others, and regions 0, 1, ... (corridors)
     joined to the given share of all the others: orders of hundreds of neighbours."""
@@ -51,24 +35,18 @@ def _hub_graph(rng, n: int, hubs=(0.9, 0.3)):
     return planar_graph(graph)
 
 
-def _small_graph(rng, n):
-    """A graph of ``n`` regions joined to 1-4 nearest others."""
-    points = rng.uniform(0, 100, size=(n, 2))
-    graph = nx.Graph()
-    graph.add_nodes_from((i, {"centroid": tuple(points[i])}) for i in range(n))
-    for i in range(n):
-        distances = np.hypot(*(points - points[i]).T)
-        graph.add_edges_from((i, int(j)) for j in np.argsort(distances)[1 : 1 + rng.integers(1, 5)])
-    return planar_graph(graph)
-
-
-def test_every_alignment_bit_parallel_gives_what_python_gives(c_kernel, monkeypatch):
+def test_every_alignment_bit_parallel_gives_what_python_gives(
+    c_kernel, monkeypatch, in_python, planar_answer, small_planar_graph
+):
     """Small graphs with many ties, every alignment (seeds' rotations, arcs of one element) through
     the bit-parallel path: its backtrace breaks ties as the table's."""
     rng = np.random.default_rng(7)
     cases = []
     for trial in range(300):
-        first, second = _small_graph(rng, int(rng.integers(1, 16))), _small_graph(rng, int(rng.integers(1, 16)))
+        first, second = (
+            small_planar_graph(rng, int(rng.integers(1, 16))),
+            small_planar_graph(rng, int(rng.integers(1, 16))),
+        )
         same = rng.uniform(size=(first.n_vertices, second.n_vertices)) < rng.choice([0.1, 0.3, 0.6, 0.9])
         same[rng.integers(first.n_vertices), rng.integers(second.n_vertices)] = True
         options = {
@@ -79,15 +57,15 @@ def test_every_alignment_bit_parallel_gives_what_python_gives(c_kernel, monkeypa
         }
         cases.append((first, second, same, options))
     monkeypatch.setattr(kernels, "TABLE_CELLS", 0)
-    compiled = [_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
-    _python(monkeypatch)
-    reference = [_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
+    compiled = [planar_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
+    in_python()
+    reference = [planar_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
     assert compiled == reference
     assert sum(len(answer[0]) > 2 for answer in reference) > 100
 
 
 @pytest.mark.parametrize("table_cells", [1 << 16, 1 << 8])
-def test_long_orders_give_in_c_what_python_gives(c_kernel, monkeypatch, table_cells):
+def test_long_orders_give_in_c_what_python_gives(c_kernel, monkeypatch, table_cells, in_python, planar_answer):
     """Hubs of about 330 and 110 neighbours, dense and sparse "same" relations (many equal
     distances), seeds on the hubs (rotations of their orders), both rotation searches, reflections
     and pair costs on a grid of quarters; with the default table, and with a small one (the arcs
@@ -111,15 +89,15 @@ def test_long_orders_give_in_c_what_python_gives(c_kernel, monkeypatch, table_ce
             "pair_cost_weight": (0.0, 0.5, 1.0, 2.0)[trial % 4],
         }
         cases.append((first, second, same, options))
-    compiled = [_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
-    _python(monkeypatch)
-    reference = [_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
+    compiled = [planar_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
+    in_python()
+    reference = [planar_answer(planar_match(first, second, same, **options)) for first, second, same, options in cases]
     assert compiled == reference
     assert sum(len(answer[0]) > 100 for answer in reference) >= 4  # expansions through the hubs
 
 
 @pytest.mark.parametrize("score", ["signature", "substitutions", "structure"])
-def test_a_sweep_over_long_orders_gives_in_c_what_python_gives_at_every_m(c_kernel, monkeypatch, score):
+def test_a_sweep_over_long_orders_gives_in_c_what_python_gives_at_every_m(c_kernel, score, in_python):
     """sweep_compiled, on one thread and on two, against Python's planar_match at each m from the
     same seeds (c on a grid of eighths: ties at the seed cap and between values of m)."""
     rng = np.random.default_rng({"signature": 1, "substitutions": 2, "structure": 3}[score])
@@ -132,7 +110,7 @@ def test_a_sweep_over_long_orders_gives_in_c_what_python_gives_at_every_m(c_kern
     one = kernels.sweep_compiled(first, second, c_matrix, *selector.ordered, 16, ms, **options, threads=1)
     two = kernels.sweep_compiled(first, second, c_matrix, *selector.ordered, 16, ms, **options, threads=2)
     assert one == two
-    _python(monkeypatch)
+    in_python()
     reference = []
     for m in ms:
         seeds = selector.at(m)
@@ -163,7 +141,7 @@ def building_pair():
     return prepare(sketch, metric, MatchConfig(orientation=270.0, mirrored=True, position_refits=0))
 
 
-def test_a_buildings_sweep_is_the_same_in_c_and_in_python(c_kernel, building_pair, monkeypatch):
+def test_a_buildings_sweep_is_the_same_in_c_and_in_python(c_kernel, building_pair, monkeypatch, in_python):
     import ursim_core.matching.single as single
 
     prepared = building_pair
@@ -178,7 +156,7 @@ def test_a_buildings_sweep_is_the_same_in_c_and_in_python(c_kernel, building_pai
     )
     compiled = [(r.m, r.pairs, r.cost, r.seeds_count, r.hypotheses, r.reason) for r in matched_sweep(prepared)[0]]
     assert swept and swept[0] is not None  # the whole sweep in one call of the C loop
-    _python(monkeypatch)
+    in_python()
     monkeypatch.setattr(single, "match_sweep", lambda *args: None)
     reference = [(r.m, r.pairs, r.cost, r.seeds_count, r.hypotheses, r.reason) for r in matched_sweep(prepared)[0]]
     assert compiled == reference

@@ -278,13 +278,7 @@ static int32_t packed_pairs(Planar *p, const PackedOrders *o, int32_t start1, in
             i--;
         }
     }
-    for (int32_t k = 0; k < count / 2; k++) { /* first elements first */
-        int32_t x = out[2 * k], y = out[2 * k + 1];
-        out[2 * k] = out[2 * (count - 1 - k)];
-        out[2 * k + 1] = out[2 * (count - 1 - k) + 1];
-        out[2 * (count - 1 - k)] = x;
-        out[2 * (count - 1 - k) + 1] = y;
-    }
+    reverse_pairs(out, count); /* first elements first */
     return count;
 }
 

@@ -41,6 +41,19 @@ static inline int get_buffer(PyObject *obj, Py_ssize_t itemsize, char kind, int 
     return 0;
 }
 
+/* Reverse the order of ``count`` (first, second) pairs in ``out``: the alignments' backtraces
+ * (planar.c's table, bitalign.c's bit-parallel one) find the last pair first. */
+static inline void reverse_pairs(int32_t *out, int32_t count)
+{
+    for (int32_t k = 0; k < count / 2; k++) {
+        int32_t x = out[2 * k], y = out[2 * k + 1];
+        out[2 * k] = out[2 * (count - 1 - k)];
+        out[2 * k + 1] = out[2 * (count - 1 - k) + 1];
+        out[2 * (count - 1 - k)] = x;
+        out[2 * (count - 1 - k) + 1] = y;
+    }
+}
+
 /* planar.c: the seed-and-expand loop, shared by planar_match and planar_sweep (sweep.c). */
 typedef struct {
     int32_t n1, n2;
