@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import bisect
 import math
-import os
 
 import numpy as np
 
@@ -366,5 +365,9 @@ def match_sweep(prepared: Prepared, ms, seed_selector: SeedSelector | None) -> l
 
 
 def _sweep_threads(c_matrix: np.ndarray) -> int:
-    """Threads of the C loop for a sweep of a pair with this c matrix (see :data:`THREADED_REGIONS`)."""
-    return min(2, os.cpu_count() or 1) if max(c_matrix.shape) >= THREADED_REGIONS else 1
+    """Threads of the C loop for a sweep of a pair with this c matrix (see :data:`THREADED_REGIONS`):
+    two at most, and no more than this process may use (:func:`ursim_core.cpus.usable_cpus`: a
+    worker of ``ursim evaluate``'s or ``match-batch``'s pool is told its share)."""
+    from ursim_core.cpus import usable_cpus
+
+    return min(2, usable_cpus()) if max(c_matrix.shape) >= THREADED_REGIONS else 1

@@ -96,7 +96,7 @@ def test_a_building_sized_pairs_sweep_runs_on_two_threads_with_the_same_results(
         return kernels.sweep_compiled(*args, **kwargs)
 
     monkeypatch.setattr(single, "sweep_compiled", recorded)
-    monkeypatch.setattr(single.os, "cpu_count", lambda: 4)
+    monkeypatch.setenv("URSIM_THREADS", "4")
     for trial, first, second in _pairs_of_graphs(6):
         prepared = prepare(first, second, _CONFIGS[trial % len(_CONFIGS)])
         monkeypatch.setattr(single, "THREADED_REGIONS", 10**9)
@@ -105,6 +105,25 @@ def test_a_building_sized_pairs_sweep_runs_on_two_threads_with_the_same_results(
         shared = matched_sweep(prepared)[0]
         assert [_fields(result) for result in shared] == [_fields(result) for result in alone]
     assert threads == [1, 2] * 6
+
+
+def test_a_worker_told_one_thread_sweeps_a_building_sized_pair_on_one(c_kernel, monkeypatch):
+    """``ursim evaluate``'s and ``match-batch``'s workers are told their share of the CPUs
+    (``URSIM_THREADS``): a building-sized pair's sweep then takes no second thread."""
+    import ursim_core.matching.single as single
+
+    threads = []
+
+    def recorded(*args, **kwargs):
+        threads.append(kwargs["threads"])
+        return kernels.sweep_compiled(*args, **kwargs)
+
+    monkeypatch.setattr(single, "sweep_compiled", recorded)
+    monkeypatch.setattr(single, "THREADED_REGIONS", 0)
+    monkeypatch.setenv("URSIM_THREADS", "1")
+    _, first, second = next(iter(_pairs_of_graphs(1)))
+    matched_sweep(prepare(first, second, _CONFIGS[0]))
+    assert threads == [1]
 
 
 def test_the_sweep_in_c_leaves_constraints_nan_and_other_matchers_to_match_at(c_kernel):
