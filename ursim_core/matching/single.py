@@ -23,7 +23,6 @@ __all__ = [
     "seed_cap",
     "pair_cost_matrix",
     "planar_seeds",
-    "planar_outcome",
     "match_at",
     "match_sweep",
     "THREADED_REGIONS",
@@ -204,25 +203,6 @@ def planar_seeds(prepared: Prepared, m: float, seed_selector: SeedSelector | Non
     return seed_pairs(c_matrix, m, max_seeds=cap)
 
 
-def planar_outcome(
-    sketch_planar, metric_planar, c_matrix: np.ndarray, config: MatchConfig, m: float, seeds, constraints=None
-):
-    """:func:`~ursim_core.matching.planar.planar_match` at m from these seeds, as :func:`match_at` runs it."""
-    # Arrays, not nested lists: converting an n1 x n2 matrix costs seconds for
-    # thousands of regions, and the planar matcher reads only a few of its cells.
-    return planar_match(
-        sketch_planar,
-        metric_planar,
-        np.asarray(c_matrix) <= m,
-        seeds=seeds,
-        rotation_search=config.rotation_search,
-        reflections=config.reflections,
-        pair_costs=pair_cost_matrix(config, c_matrix, m),
-        pair_cost_weight=config.score_weight,
-        constraints=constraints,
-    )
-
-
 def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None = None) -> MatchResult:
     """Run the configured matcher at one fixed m.
 
@@ -258,8 +238,18 @@ def match_at(prepared: Prepared, m: float, *, seed_selector: SeedSelector | None
             if not seeds and not (constraints and constraints.fixed):
                 reasons.append(f"no seeds: no pair of regions has c <= m = {m:g}")
             else:
-                outcome = planar_outcome(
-                    prepared.sketch_planar, prepared.metric_planar, c_matrix, config, m, seeds, constraints
+                # Arrays, not nested lists: converting an n1 x n2 matrix costs seconds for
+                # thousands of regions, and the planar matcher reads only a few of its cells.
+                outcome = planar_match(
+                    prepared.sketch_planar,
+                    prepared.metric_planar,
+                    np.asarray(c_matrix) <= m,
+                    seeds=seeds,
+                    rotation_search=config.rotation_search,
+                    reflections=config.reflections,
+                    pair_costs=pair_costs,
+                    pair_cost_weight=config.score_weight,
+                    constraints=constraints,
                 )
                 index_pairs = outcome.pairs
                 hypotheses = outcome.hypotheses
