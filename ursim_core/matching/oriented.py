@@ -34,6 +34,7 @@ __all__ = [
     "candidate_overlaps",
     "carried_by_orientation",
     "finalist_windows",
+    "window_position_starts",
     "window_reading",
 ]
 
@@ -279,6 +280,62 @@ def finalist_windows(sketch_labels, metric_labels, orientations) -> dict:
         window = template.best_window(turned, metric_free)
         found[(degrees, mirrored)] = None if window is None else (window.correlation, window.gain)
     return found
+
+
+def window_position_starts(sketch_labels, metric_labels, preparations: dict) -> dict:
+    """For each ``(degrees, mirrored): Prepared`` of ``preparations``, the scale and shift per axis
+    (a :func:`~ursim_core.matching.refit.fit_axis_transform` array) that carry its sketch graph's
+    centroids into the window of the metric map where the sketch, turned so, correlates best
+    (:func:`~ursim_core.matching.template.best_window`); None when that window correlates no
+    better than the map's whole box or under ``WINDOW_MIN_CORRELATION``, or fewer than three
+    regions are found in both frames.
+
+    Positions normalised by each map's extent assume the sketch shows the whole map; a sketch
+    of part of it, laid in the part it resembles, starts the refit where its regions are
+    (``MatchConfig.window_start``). The graph's centroids and the turned label image's differ by
+    a shift per axis (the turn's canvas): the transform is fitted from one to the other, then
+    composed with the window's laying.
+
+    Examples
+    --------
+    >>> import networkx as nx
+    >>> plan = np.zeros((300, 600), np.int32)
+    >>> plan[20:130, 20:150], plan[20:130, 160:400], plan[20:130, 410:580] = 1, 2, 3
+    >>> plan[140:170, 20:580], plan[180:280, 20:260], plan[180:280, 270:580] = 4, 5, 6
+    >>> sketch = plan[:, :320]
+    >>> graph = nx.Graph()
+    >>> graph.add_nodes_from((r, {"centroid": tuple(np.argwhere(sketch == r).mean(axis=0))}) for r in (1, 2, 4, 5, 6))
+    >>> class Oriented: sketch_graph = graph
+    >>> transform = window_position_starts(sketch, plan, {(0.0, False): Oriented()})[(0.0, False)]
+    >>> np.round(transform[:, 0], 1).tolist()   # the left half laid on the plan's left half: scale 1
+    [1.0, 1.0]
+    """
+    from ursim_core.matching import template
+    from ursim_core.matching.layings import oriented_labels, region_centroids
+
+    metric_free = np.asarray(metric_labels) > 0
+    starts = {}
+    for (degrees, mirrored), prepared in preparations.items():
+        starts[(degrees, mirrored)] = None
+        turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
+        window = template.best_window(turned > 0, metric_free)
+        if window is None or window.gain < template.WINDOW_GAIN or window.correlation < template.WINDOW_MIN_CORRELATION:
+            continue
+        row0, row1, col0, col1 = template.free_box(turned > 0)
+        scale = np.array([window.height / (row1 - row0), window.width / (col1 - col0)])
+        shift = np.array([window.top, window.left]) - scale * np.array([row0, col0])
+        centroids = region_centroids(turned)
+        nodes = [node for node in prepared.sketch_graph.nodes if node in centroids]
+        if len(nodes) < 3:
+            continue
+        graph_points = np.array([prepared.sketch_graph.nodes[node]["centroid"] for node in nodes], dtype=np.float64)
+        laid = scale * np.array([centroids[node] for node in nodes], dtype=np.float64) + shift
+        transform = np.zeros((2, 2))
+        for axis in range(2):
+            design = np.stack([graph_points[:, axis], np.ones(len(nodes))], axis=1)
+            transform[axis] = np.linalg.lstsq(design, laid[:, axis], rcond=None)[0]
+        starts[(degrees, mirrored)] = transform
+    return starts
 
 
 def window_reading(windows: dict, ranked_best, *, margin: float):

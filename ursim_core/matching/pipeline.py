@@ -46,10 +46,11 @@ from ursim_core.matching.oriented import (
     region_graph_of,
     reoriented,
     sketch_outlines,
+    window_position_starts,
     window_reading,
 )
 from ursim_core.matching.overlay_answer import prepare_overlay
-from ursim_core.matching.refit import refit_from, refit_positions, signature_start
+from ursim_core.matching.refit import refit_by_transform, refit_from, refit_positions, signature_start
 from ursim_core.matching.resampling import voted_answer, with_resampled
 from ursim_core.matching.results import MatchResult, Prepared, replaced
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
@@ -154,13 +155,14 @@ def _prepare_one(
     orientations=None,
     overlaps=None,
     windows=None,
+    window_starts=None,
 ) -> Prepared:
     """:func:`prepare` of one segmentation of the sketch; with ``orientations``, only the
     candidates nearest to them are tried (:func:`~ursim_core.matching.oriented.nearest_orientations`);
     with ``overlaps`` and ``windows`` (another segmentation's ``Prepared.orientation_overlaps``
     and ``orientation_windows``), each candidate takes the free-space overlap and the best window
     of the nearest orientation measured there (:func:`~ursim_core.matching.oriented.carried_by_orientation`)
-    instead of being fitted again."""
+    instead of being fitted again; so do ``window_starts`` (``Prepared.orientation_window_starts``)."""
     config = config.resolved()
     sketch_graph, metric_graph = region_graph_of(sketch_seg), region_graph_of(metric_seg)
     constraints = constraints or None
@@ -248,6 +250,9 @@ def _prepare_one(
     trials = []
     doors: list[float] = []  # per trial, with a door penalty: misplaced_doors of its answer
     starts: dict = {}  # the signature starts of the refit, by mirror flag (see _refitted)
+    laid_starts = _window_starts(
+        config, sketch_seg, metric_seg, candidates, prepared_candidates, finalists, window_starts
+    )
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
         share = _share_of(progress, step, len(finalists))
@@ -256,7 +261,7 @@ def _prepare_one(
             result = choose_m(prepared, progress=share, known=known.get(index))
         else:
             result = match_prepared(prepared, progress=share)
-        refitted, answer = _refitted(prepared, result, starts)
+        refitted, answer = _refitted(prepared, result, starts, laid_starts.get(index))
         # Ranked by the refitted answer's score either way; keep_refit=False keeps the first answer.
         kept = (refitted, answer) if config.keep_refit else (prepared, result)
         cost = answer.normalised_cost
@@ -290,6 +295,7 @@ def _prepare_one(
         chosen=replaced(result, orientation_scan=scan),
         orientation_overlaps={candidates[index]: value for index, value in overlaps.items()},
         orientation_windows={candidates[index]: value for index, value in found.items()},
+        orientation_window_starts={candidates[index]: value for index, value in laid_starts.items()},
     )
 
 
@@ -309,12 +315,35 @@ def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measur
     return {index: found[candidates[index]] for index in indices}
 
 
+def _window_starts(config, sketch_seg, metric_seg, candidates, preparations, indices, measured) -> dict:
+    """By candidate index, the laying of its sketch's positions in its best window
+    (``MatchConfig.window_start``, :func:`~ursim_core.matching.oriented.window_position_starts`)
+    or None: carried from ``measured`` (another segmentation's) when given, else found; ``{}``
+    without the option, a refit, label images, or for large maps."""
+    if not config.window_start or not _refits(config):
+        return {}
+    if measured:
+        carried = carried_by_orientation(measured, candidates, list(indices))
+        if carried is not None:
+            return carried
+    sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
+    first = preparations[next(iter(indices))]
+    if sketch_labels is None or metric_labels is None or max(first.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
+        return {}
+    found = window_position_starts(
+        sketch_labels, metric_labels, {candidates[index]: preparations[index] for index in indices}
+    )
+    return {index: found[candidates[index]] for index in indices}
+
+
 def _refits(config: MatchConfig) -> int:
     """How many position refits apply (:mod:`ursim_core.matching.refit`): planar, with positions."""
     return config.position_refits if config.matcher == "planar" and config.position_weight else 0
 
 
-def _refitted(prepared: Prepared, result: MatchResult, starts: dict | None = None) -> tuple[Prepared, MatchResult]:
+def _refitted(
+    prepared: Prepared, result: MatchResult, starts: dict | None = None, window_start=None
+) -> tuple[Prepared, MatchResult]:
     """The answer after the position refits (:mod:`ursim_core.matching.refit`), or as given.
 
     With ``signature_refit``, the sketch is also laid on the metric map by the pairs of the answer
@@ -343,6 +372,14 @@ def _refitted(prepared: Prepared, result: MatchResult, starts: dict | None = Non
             refitted = refit_from(first, start.pairs, _match_coarsely)
             if refitted is not None and refitted[1].normalised_cost < result.normalised_cost:
                 prepared, result = refitted
+    if window_start is not None:
+        # Laid in the window its free space resembles (MatchConfig.window_start), refitted by its
+        # own pairs as the first answer is, and kept when its score is lower (round 50).
+        laid = refit_by_transform(first, window_start, _match_coarsely)
+        if laid is not None:
+            laid = refit_positions(*laid, _match_coarsely)
+            if laid[1].normalised_cost < result.normalised_cost:
+                prepared, result = laid
     return prepared, result
 
 

@@ -40,6 +40,7 @@ __all__ = [
     "refitted_graph",
     "refitted_positions",
     "refit_from",
+    "refit_by_transform",
     "refit_positions",
     "signature_start",
 ]
@@ -216,6 +217,23 @@ def refit_from(prepared, pairs, match_once):
         return None
     transform = fit_axis_transform(pairs, prepared.sketch_graph, prepared.metric_graph)
     if transform is None:
+        return None
+    return refit_by_transform(prepared, transform, match_once)
+
+
+def refit_by_transform(prepared, transform, match_once):
+    """The preparation with the sketch's positions carried into the metric map's frame by
+    ``transform`` (a scale and shift per axis, as :func:`fit_axis_transform` gives), and its
+    answer; None when there is no position term to refit.
+
+    :func:`refit_from` lays the sketch by an answer's pairs; ``MatchConfig.window_start`` by the
+    window of the metric map the sketch resembles
+    (:func:`~ursim_core.matching.oriented.window_position_starts`)."""
+    descriptors = prepared.descriptors
+    config = prepared.config
+    if descriptors is None or descriptors.signature_c is None or not config.position_weight:
+        return None
+    if any("bbox" not in data for _, data in prepared.metric_graph.nodes(data=True)):
         return None
     c_matrix = blend_position_arrays(
         descriptors.signature_c,

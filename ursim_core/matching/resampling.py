@@ -415,7 +415,15 @@ def with_resampled(prepared: Any, sketch_seg: Any, metric_seg: Any, prepare_one)
     variants = tuple(
         (
             other.labels,
-            prepare_one(other, metric_seg, others_config, orientations=finalists, overlaps=overlaps, windows=windows),
+            prepare_one(
+                other,
+                metric_seg,
+                others_config,
+                orientations=finalists,
+                overlaps=overlaps,
+                windows=windows,
+                window_starts=prepared.orientation_window_starts,
+            ),
         )
         for other in others
     )

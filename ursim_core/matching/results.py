@@ -46,6 +46,10 @@ class Prepared:
     #: With ``MatchConfig.window_reading_margin``: each finalist orientation's best window,
     #: ``{(degrees, mirrored): (correlation, gain) or None}``, carried to the other segmentations.
     orientation_windows: dict = field(default_factory=dict)
+    #: With ``MatchConfig.window_start``: each finalist orientation's laying of the sketch's positions
+    #: in its best window, a scale and shift per axis (``refit`` transform) or None, carried to the
+    #: other segmentations.
+    orientation_window_starts: dict = field(default_factory=dict)
     #: The two maps' label images, for ``MatchConfig.elastic`` (set by :func:`prepare` when it is
     #: given segmentations), and its answers by orientation (the flow does not depend on m).
     sketch_labels: Any = None

@@ -312,7 +312,8 @@ class MatchingPanel(QWidget):
         if matcher == "auto" and self.input_kind.currentData() is not None:
             extra["input_kind"] = self.input_kind.currentData()
         if matcher in _ELASTIC_MATCHERS and self.partial.isChecked():
-            extra["window_reading_margin"] = PARTIAL_SKETCH["window_reading_margin"]
+            # The laying is the Laying list's own choice (see _lay_partial); the rest as told.
+            extra.update({name: value for name, value in PARTIAL_SKETCH.items() if name != "elastic_laying"})
         return MatchConfig(
             variant=self.variant.currentData(),
             matcher=matcher,

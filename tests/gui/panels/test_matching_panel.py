@@ -256,3 +256,4 @@ def test_the_panel_is_told_the_sketch_shows_part_of_the_map(window):
     panel.partial.setChecked(True)
     panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
     assert not panel.partial.isEnabled() and panel.config().window_reading_margin == 0
+    assert not panel.config().window_start
