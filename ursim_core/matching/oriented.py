@@ -270,16 +270,23 @@ def finalist_windows(sketch_labels, metric_labels, orientations) -> dict:
     >>> found[(0.0, False)][0] > found[(180.0, False)][0]
     True
     """
+
+    found = {}
+    for orientation, (_, window) in _turned_windows(sketch_labels, metric_labels, orientations):
+        found[orientation] = None if window is None else (window.correlation, window.gain)
+    return found
+
+
+def _turned_windows(sketch_labels, metric_labels, orientations):
+    """For each ``(degrees, mirrored)``: the orientation, and the sketch's label image turned so
+    with its best window on the metric map (None when there is none)."""
     from ursim_core.matching import template
-    from ursim_core.matching.elastic import oriented_labels
+    from ursim_core.matching.layings import oriented_labels
 
     metric_free = np.asarray(metric_labels) > 0
-    found = {}
     for degrees, mirrored in orientations:
-        turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored) > 0
-        window = template.best_window(turned, metric_free)
-        found[(degrees, mirrored)] = None if window is None else (window.correlation, window.gain)
-    return found
+        turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
+        yield (degrees, mirrored), (turned, template.best_window(turned > 0, metric_free))
 
 
 def window_position_starts(sketch_labels, metric_labels, preparations: dict) -> dict:
@@ -311,14 +318,12 @@ def window_position_starts(sketch_labels, metric_labels, preparations: dict) -> 
     [1.0, 1.0]
     """
     from ursim_core.matching import template
-    from ursim_core.matching.layings import oriented_labels, region_centroids
+    from ursim_core.matching.layings import region_centroids
 
-    metric_free = np.asarray(metric_labels) > 0
     starts = {}
-    for (degrees, mirrored), prepared in preparations.items():
-        starts[(degrees, mirrored)] = None
-        turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-        window = template.best_window(turned > 0, metric_free)
+    for orientation, (turned, window) in _turned_windows(sketch_labels, metric_labels, preparations):
+        prepared = preparations[orientation]
+        starts[orientation] = None
         if window is None or window.gain < template.WINDOW_GAIN or window.correlation < template.WINDOW_MIN_CORRELATION:
             continue
         row0, row1, col0, col1 = template.free_box(turned > 0)
@@ -334,7 +339,7 @@ def window_position_starts(sketch_labels, metric_labels, preparations: dict) -> 
         for axis in range(2):
             design = np.stack([graph_points[:, axis], np.ones(len(nodes))], axis=1)
             transform[axis] = np.linalg.lstsq(design, laid[:, axis], rcond=None)[0]
-        starts[(degrees, mirrored)] = transform
+        starts[orientation] = transform
     return starts
 
 

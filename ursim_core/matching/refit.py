@@ -192,6 +192,15 @@ def refitted_graph(sketch_graph: nx.Graph, metric_graph: nx.Graph, transform: np
     return moved
 
 
+def _refittable(prepared) -> bool:
+    """Whether ``prepared`` has a position term to refit: signatures apart from positions, a
+    position weight, and the metric regions' boxes (the extent positions are normalised by)."""
+    descriptors = prepared.descriptors
+    if descriptors is None or descriptors.signature_c is None or not prepared.config.position_weight:
+        return False
+    return all("bbox" in data for _, data in prepared.metric_graph.nodes(data=True))
+
+
 def refit_from(prepared, pairs, match_once):
     """The preparation with the sketch laid on the metric map by ``pairs``, and its answer.
 
@@ -209,11 +218,7 @@ def refit_from(prepared, pairs, match_once):
     (Prepared, MatchResult) or None
         None when there is no position term to refit or no fit (fewer than 3 pairs, degenerate).
     """
-    descriptors = prepared.descriptors
-    config = prepared.config
-    if descriptors is None or descriptors.signature_c is None or not config.position_weight:
-        return None
-    if any("bbox" not in data for _, data in prepared.metric_graph.nodes(data=True)):
+    if not _refittable(prepared):
         return None
     transform = fit_axis_transform(pairs, prepared.sketch_graph, prepared.metric_graph)
     if transform is None:
@@ -229,12 +234,9 @@ def refit_by_transform(prepared, transform, match_once):
     :func:`refit_from` lays the sketch by an answer's pairs; ``MatchConfig.window_start`` by the
     window of the metric map the sketch resembles
     (:func:`~ursim_core.matching.oriented.window_position_starts`)."""
-    descriptors = prepared.descriptors
-    config = prepared.config
-    if descriptors is None or descriptors.signature_c is None or not config.position_weight:
+    if not _refittable(prepared):
         return None
-    if any("bbox" not in data for _, data in prepared.metric_graph.nodes(data=True)):
-        return None
+    descriptors, config = prepared.descriptors, prepared.config
     c_matrix = blend_position_arrays(
         descriptors.signature_c,
         refitted_positions(prepared.sketch_graph, descriptors.sketch_nodes, prepared.metric_graph, transform),
