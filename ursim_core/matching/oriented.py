@@ -34,6 +34,7 @@ __all__ = [
     "candidate_overlaps",
     "carried_by_orientation",
     "finalist_windows",
+    "turned_windows",
     "window_position_starts",
     "window_reading",
 ]
@@ -255,10 +256,10 @@ def carried_by_orientation(measured: dict, candidates, indices) -> dict | None:
 _SMALLEST_OVERLAP = 1e-3
 
 
-def finalist_windows(sketch_labels, metric_labels, orientations) -> dict:
+def finalist_windows(sketch_labels, metric_labels, orientations, *, searched=None) -> dict:
     """For each ``(degrees, mirrored)`` orientation, ``(correlation, gain)`` of the best window of
     the metric map for the sketch turned so (:func:`~ursim_core.matching.template.best_window`),
-    or None when there is none (an empty map).
+    or None when there is none (an empty map). ``searched``: :func:`turned_windows` already found.
 
     Examples
     --------
@@ -270,32 +271,54 @@ def finalist_windows(sketch_labels, metric_labels, orientations) -> dict:
     >>> found[(0.0, False)][0] > found[(180.0, False)][0]
     True
     """
+    searched = turned_windows(sketch_labels, metric_labels, orientations, searched=searched)
+    return {
+        orientation: None if window is None else (window.correlation, window.gain)
+        for orientation, (_, window) in searched.items()
+    }
 
-    found = {}
-    for orientation, (_, window) in _turned_windows(sketch_labels, metric_labels, orientations):
-        found[orientation] = None if window is None else (window.correlation, window.gain)
-    return found
 
+def turned_windows(sketch_labels, metric_labels, orientations, *, searched=None) -> dict:
+    """``{(degrees, mirrored): (turned labels, window)}``: the sketch's label image turned so
+    (:func:`~ursim_core.matching.layings.oriented_labels`) and its best window on the metric map
+    (:func:`~ursim_core.matching.template.best_window`, None when there is none); those already in
+    ``searched`` are taken from it. The reading's windows (``window_reading_margin``) and the
+    refit's starts (``window_start``) are found once for both.
 
-def _turned_windows(sketch_labels, metric_labels, orientations):
-    """For each ``(degrees, mirrored)``: the orientation, and the sketch's label image turned so
-    with its best window on the metric map (None when there is none)."""
+    Examples
+    --------
+    >>> plan = np.zeros((300, 600), np.int32)
+    >>> plan[20:130, 20:150], plan[20:130, 160:400], plan[20:130, 410:580] = 1, 2, 3
+    >>> plan[140:170, 20:580], plan[180:280, 20:260], plan[180:280, 270:580] = 4, 5, 6
+    >>> found = turned_windows(plan[:, :320], plan, [(90.0, False)])
+    >>> turned, window = found[(90.0, False)]
+    >>> turned.shape, turned_windows(None, None, [(90.0, False)], searched=found) == found
+    ((320, 300), True)
+    """
     from ursim_core.matching import template
     from ursim_core.matching.layings import oriented_labels
 
-    metric_free = np.asarray(metric_labels) > 0
+    searched = searched or {}
+    found = {}
+    metric_free = None
     for degrees, mirrored in orientations:
+        if (degrees, mirrored) in searched:
+            found[(degrees, mirrored)] = searched[(degrees, mirrored)]
+            continue
+        if metric_free is None:
+            metric_free = np.asarray(metric_labels) > 0
         turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-        yield (degrees, mirrored), (turned, template.best_window(turned > 0, metric_free))
+        found[(degrees, mirrored)] = (turned, template.best_window(turned > 0, metric_free))
+    return found
 
 
-def window_position_starts(sketch_labels, metric_labels, preparations: dict) -> dict:
+def window_position_starts(sketch_labels, metric_labels, preparations: dict, *, searched=None) -> dict:
     """For each ``(degrees, mirrored): Prepared`` of ``preparations``, the scale and shift per axis
     (a :func:`~ursim_core.matching.refit.fit_axis_transform` array) that carry its sketch graph's
     centroids into the window of the metric map where the sketch, turned so, correlates best
     (:func:`~ursim_core.matching.template.best_window`); None when that window correlates no
     better than the map's whole box or under ``WINDOW_MIN_CORRELATION``, or fewer than three
-    regions are found in both frames.
+    regions are found in both frames. ``searched``: :func:`turned_windows` already found.
 
     Positions normalised by each map's extent assume the sketch shows the whole map; a sketch
     of part of it, laid in the part it resembles, starts the refit where its regions are
@@ -321,7 +344,9 @@ def window_position_starts(sketch_labels, metric_labels, preparations: dict) -> 
     from ursim_core.matching.layings import region_centroids
 
     starts = {}
-    for orientation, (turned, window) in _turned_windows(sketch_labels, metric_labels, preparations):
+    for orientation, (turned, window) in turned_windows(
+        sketch_labels, metric_labels, preparations, searched=searched
+    ).items():
         prepared = preparations[orientation]
         starts[orientation] = None
         if window is None or window.gain < template.WINDOW_GAIN or window.correlation < template.WINDOW_MIN_CORRELATION:

@@ -46,6 +46,7 @@ from ursim_core.matching.oriented import (
     region_graph_of,
     reoriented,
     sketch_outlines,
+    turned_windows,
     window_position_starts,
     window_reading,
 )
@@ -250,7 +251,8 @@ def _prepare_one(
     trials = []
     doors: list[float] = []  # per trial, with a door penalty: misplaced_doors of its answer
     starts: dict = {}  # the signature starts of the refit, by mirror flag (see _refitted)
-    laid_starts = _window_starts(
+    # The windows are searched once (per finalist) for the refit's starts and the reading.
+    laid_starts, searched = _window_starts(
         config, sketch_seg, metric_seg, candidates, prepared_candidates, finalists, window_starts
     )
     for step, index in enumerate(finalists):
@@ -280,7 +282,7 @@ def _prepare_one(
             trial[0] *= 1.0 + config.door_penalty * misplaced
     found: dict = {}
     if config.window_reading_margin and len(trials) > 1 and window_rule(config) != "off":
-        found = _windows(base, sketch_seg, metric_seg, candidates, [trial[1] for trial in trials], windows)
+        found = _windows(base, sketch_seg, metric_seg, candidates, [trial[1] for trial in trials], windows, searched)
     taken = None
     if found:
         # A partial sketch can rank better read wrongly; read rightly it resembles a part of the
@@ -299,11 +301,12 @@ def _prepare_one(
     )
 
 
-def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measured) -> dict:
+def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measured, searched=None) -> dict:
     """By candidate index, its best window's ``(correlation, gain)`` (or None): carried from
-    ``measured`` (another segmentation's) when given, else found; ``{}`` for bare graphs and
-    large maps, which are not laid. (Found on a thread while the finalists were matched, they
-    cost as much: the two compete for the same two cores; round 48.)"""
+    ``measured`` (another segmentation's) when given, else found, or taken from ``searched``
+    (:func:`~ursim_core.matching.oriented.turned_windows` found for the window starts); ``{}`` for
+    bare graphs and large maps, which are not laid. (Found on a thread while the finalists were
+    matched, they cost as much: the two compete for the same two cores; round 48.)"""
     if measured:
         carried = carried_by_orientation(measured, candidates, indices)
         if carried is not None:
@@ -311,29 +314,32 @@ def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measur
     labels = elastic_labels(base, sketch_seg, metric_seg, largest=_SCREEN_BY_ASSIGNMENT)
     if labels is None:
         return {}
-    found = finalist_windows(*labels, [candidates[index] for index in indices])
+    found = finalist_windows(*labels, [candidates[index] for index in indices], searched=searched)
     return {index: found[candidates[index]] for index in indices}
 
 
-def _window_starts(config, sketch_seg, metric_seg, candidates, preparations, indices, measured) -> dict:
+def _window_starts(config, sketch_seg, metric_seg, candidates, preparations, indices, measured) -> tuple[dict, dict]:
     """By candidate index, the laying of its sketch's positions in its best window
     (``MatchConfig.window_start``, :func:`~ursim_core.matching.oriented.window_position_starts`)
     or None: carried from ``measured`` (another segmentation's) when given, else found; ``{}``
-    without the option, a refit, label images, or for large maps."""
+    without the option, a refit, label images, or for large maps. With the windows found, by
+    orientation (:func:`~ursim_core.matching.oriented.turned_windows`; ``{}`` when carried), for
+    the reading's windows to reuse."""
     if not config.window_start or not _refits(config):
-        return {}
+        return {}, {}
     if measured:
         carried = carried_by_orientation(measured, candidates, list(indices))
         if carried is not None:
-            return carried
+            return carried, {}
     sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
     first = preparations[next(iter(indices))]
     if sketch_labels is None or metric_labels is None or max(first.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
-        return {}
+        return {}, {}
+    searched = turned_windows(sketch_labels, metric_labels, [candidates[index] for index in indices])
     found = window_position_starts(
-        sketch_labels, metric_labels, {candidates[index]: preparations[index] for index in indices}
+        sketch_labels, metric_labels, {candidates[index]: preparations[index] for index in indices}, searched=searched
     )
-    return {index: found[candidates[index]] for index in indices}
+    return {index: found[candidates[index]] for index in indices}, searched
 
 
 def _refits(config: MatchConfig) -> int:

@@ -383,3 +383,22 @@ def test_the_window_starts_are_found_once_and_carried_to_the_other_segmentations
     assert not prepare(sketch_seg, plan_seg, MatchConfig()).orientation_window_starts
     with pytest.raises(ParameterError, match="window_start"):
         MatchConfig(window_start="yes")
+
+
+def test_the_reading_and_the_refit_search_the_finalists_windows_once(monkeypatch):
+    # With both window_reading_margin and window_start (as --partial), each finalist's window is
+    # searched once for both; only the laying's own search comes on top.
+    from ursim_core.bench.invariance import run_case
+    from ursim_core.matching import template
+
+    calls = []
+    search = template.best_window
+    monkeypatch.setattr(template, "best_window", lambda *a, **k: calls.append(1) or search(*a, **k))
+    run_case(4, "cropped", config=MatchConfig(window_start=True))
+    alone = len(calls)
+    calls.clear()
+    both = run_case(4, "cropped", config=MatchConfig(window_start=True, window_reading_margin=0.1))
+    assert len(calls) == alone and both.read_right
+    calls.clear()
+    run_case(4, "cropped", config=MatchConfig(window_reading_margin=0.1))
+    assert len(calls) == alone
