@@ -73,8 +73,9 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
         "--partial",
         action="store_true",
         help="the sketch shows only part of the metric map: lay it in the part of the map it resembles or box "
-        "onto box, whichever lands better, and read its orientation where it resembles a part of the map "
-        "(elastic_laying=boxes_or_window, window_reading_margin=0.1)",
+        "onto box, whichever lands better, read its orientation where it resembles a part of the map, and "
+        "start placing its regions there (elastic_laying=boxes_or_window, window_reading_margin=0.1, "
+        "window_start=true)",
     )
     parser.add_argument("--variant", choices=["T1", "T2", "T3", "T4", "baseline"], help="descriptor variant")
     parser.add_argument(

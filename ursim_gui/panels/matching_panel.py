@@ -218,9 +218,9 @@ class MatchingPanel(QWidget):
             self.partial,
             _ELASTIC_MATCHERS,
             "For a sketch of part of the map: lay it in the part of the map it resembles or box onto box, "
-            "whichever lands better (the Laying above), and read its orientation where it resembles a part "
-            "of the map. Off for a whole sketch: a whole hand-drawn sketch can land better in a window that "
-            "pairs it worse",
+            "whichever lands better (the Laying above), read its orientation where it resembles a part of "
+            "the map, and start placing its regions there. Off for a whole sketch: a whole hand-drawn sketch "
+            "can land better in a window that pairs it worse",
         )
         self.partial.toggled.connect(self._lay_partial)
         self.orientation = SketchOrientation()
