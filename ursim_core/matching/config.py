@@ -152,7 +152,8 @@ class MatchConfig:
     window_start : bool
         With position refits: also lay the sketch's positions in the window of the metric map
         its free space resembles best (:func:`ursim_core.matching.template.best_window`, when it
-        correlates better than the whole box and at least ``WINDOW_MIN_CORRELATION``), match
+        correlates ``WINDOW_GAIN`` better than the whole box and at least
+        ``WINDOW_MIN_CORRELATION``, as the window laying asks), match
         again and keep that answer when its hypothesis score is lower
         (:func:`ursim_core.matching.oriented.window_position_starts`). A start for a sketch of
         part of the map; the other segmentations take the first one's windows. Evidence:

@@ -316,9 +316,9 @@ def window_position_starts(sketch_labels, metric_labels, preparations: dict, *, 
     """For each ``(degrees, mirrored): Prepared`` of ``preparations``, the scale and shift per axis
     (a :func:`~ursim_core.matching.refit.fit_axis_transform` array) that carry its sketch graph's
     centroids into the window of the metric map where the sketch, turned so, correlates best
-    (:func:`~ursim_core.matching.template.best_window`); None when that window correlates no
-    better than the map's whole box or under ``WINDOW_MIN_CORRELATION``, or fewer than three
-    regions are found in both frames. ``searched``: :func:`turned_windows` already found.
+    (:func:`~ursim_core.matching.template.best_window`); None when that window correlates less than
+    ``WINDOW_GAIN`` better than the map's whole box or under ``WINDOW_MIN_CORRELATION`` (the window
+    laying's thresholds), or fewer than three regions are found in both frames. ``searched``: :func:`turned_windows` already found.
 
     Positions normalised by each map's extent assume the sketch shows the whole map; a sketch
     of part of it, laid in the part it resembles, starts the refit where its regions are
