@@ -246,6 +246,13 @@ class MatchConfig:
         better than the map's whole box) by at least this much more correlation than in the reading
         ranked best is taken instead (:func:`~ursim_core.matching.oriented.window_reading`); 0 =
         never. Evidence: docs/options.md.
+    auto_partial : bool
+        When the sketch, read as the matcher reads it, is laid in the window of the metric map it
+        resembles clearly better than the whole (the window laying of ``elastic_laying``:
+        ``template.WINDOW_GAIN`` better than the whole box, at least ``WINDOW_MIN_CORRELATION``),
+        match it again as a sketch of part of the map, with :data:`PARTIAL_SKETCH`'s options
+        (what ``ursim match --partial`` tells). The answer's config then holds them, and its
+        reason says so. Evidence: docs/options.md.
     scale : float or None
         Metric-map pixels per sketch pixel when known (1 for two robot maps of the same
         resolution), for the overlay matcher: it then searches any placement, so either map may
@@ -314,6 +321,7 @@ class MatchConfig:
     adjacency_penalty: float = 2.0
     door_penalty: float = 1.0
     window_reading_margin: float = 0.0
+    auto_partial: bool = True
     scale: float | None = None
     overlay_min_iou: float = 0.15
     overlay_angle_step: float = 2.0
@@ -382,6 +390,7 @@ class MatchConfig:
         for name in (
             "signature_refit",
             "window_start",
+            "auto_partial",
             "keep_refit",
             "resampling_vote",
             "vote_by_reading",

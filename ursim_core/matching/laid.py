@@ -20,6 +20,7 @@ __all__ = [
     "laying_answer",
     "window_rule",
     "laid_by_answer",
+    "laid_in",
     "laid_elastically",
 ]
 
@@ -109,14 +110,11 @@ def _lay(sketch_labels, metric_labels, orientation, min_iou: float, answer=None,
     )
 
 
-def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
-    """``result`` with the pairs of the sketch laid elastically in its orientation
-    (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`), within the constraints; with
-    ``MatchConfig.elastic_laying='boxes_or_answer'`` laid box onto box or by the planar answer's
-    pairs (:func:`laying_answer`), whichever lands more on the metric map's free space once bent."""
-    from ursim_core.matching.overlay import constrained_pairs
-
-    orientation = tuple(result.orientation)
+def laid_in(prepared: Prepared, orientation: tuple, result: MatchResult | None = None):
+    """The sketch laid and bent onto the metric map in ``orientation``
+    (:class:`~ursim_core.matching.elastic.LaidSketch`, or None when either map has no region):
+    found once per orientation and kept in ``Prepared.elastic_answers`` (waited for when it was
+    laid ahead); ``result``'s pairs lay it too with a laying by the answer (:func:`laying_answer`)."""
     answers = prepared.elastic_answers
     if isinstance(answers.get(orientation), LaidAhead):
         answers[orientation] = answers[orientation].laid()
@@ -129,7 +127,17 @@ def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
             laying_answer(prepared, orientation, result),
             window=window_rule(prepared.config),
         )
-    laid = answers[orientation]
+    return answers[orientation]
+
+
+def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
+    """``result`` with the pairs of the sketch laid elastically in its orientation
+    (``MatchConfig.elastic``, :mod:`ursim_core.matching.elastic`), within the constraints; with
+    ``MatchConfig.elastic_laying='boxes_or_answer'`` laid box onto box or by the planar answer's
+    pairs (:func:`laying_answer`), whichever lands more on the metric map's free space once bent."""
+    from ursim_core.matching.overlay import constrained_pairs
+
+    laid = laid_in(prepared, tuple(result.orientation), result)
     pairs = [] if laid is None else laid.pairs
     if prepared.config.elastic == "completed":
         # Regions the overlay leaves alone on both sides keep the graph answer's pairs: a small

@@ -32,25 +32,29 @@ import functools
 
 from ursim_core.errors import ParameterError
 from ursim_core.matching.auto_m import choose_m, chosen_of, matched_sweep
-from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, MatchConfig
+from ursim_core.matching.config import M_GRID, MATCH_PRESETS, MATCHERS, PARTIAL_SKETCH, MatchConfig
 from ursim_core.matching.constraints import CONSTRAINED_MATCHERS
-from ursim_core.matching.laid import LaidAhead, elastic_labels, laid_elastically, laying_answer, window_rule
+from ursim_core.matching.laid import (
+    LaidAhead,
+    elastic_labels,
+    laid_elastically,
+    laying_answer,
+    window_rule,
+)
 from ursim_core.matching.orientation import DOOR_EVIDENCE, broken_adjacencies, misplaced_doors
 from ursim_core.matching.oriented import (
     candidate_overlaps,
     carried_by_orientation,
-    finalist_windows,
     nearest_orientations,
     orientations_to_try,
     prepare_oriented,
     region_graph_of,
     reoriented,
     sketch_outlines,
-    turned_windows,
-    window_position_starts,
     window_reading,
 )
 from ursim_core.matching.overlay_answer import prepare_overlay
+from ursim_core.matching.partial import PARTIAL_NOTE, looks_partial, reading_windows, window_starts_of
 from ursim_core.matching.refit import refit_by_transform, refit_from, refit_positions, signature_start
 from ursim_core.matching.resampling import voted_answer, with_resampled
 from ursim_core.matching.results import MatchResult, Prepared, replaced
@@ -143,6 +147,10 @@ def prepare(
         prepared = dataclasses.replace(
             prepared, sketch_labels=labels[0], metric_labels=labels[1], elastic_answers=answers
         )
+        if looks_partial(prepared):
+            partial = config.replace(**PARTIAL_SKETCH)
+            again = prepare(sketch_seg, metric_seg, partial, progress=progress, constraints=constraints)
+            return dataclasses.replace(again, notes=(*again.notes, PARTIAL_NOTE))
     return prepared
 
 
@@ -252,8 +260,16 @@ def _prepare_one(
     doors: list[float] = []  # per trial, with a door penalty: misplaced_doors of its answer
     starts: dict = {}  # the signature starts of the refit, by mirror flag (see _refitted)
     # The windows are searched once (per finalist) for the refit's starts and the reading.
-    laid_starts, searched = _window_starts(
-        config, sketch_seg, metric_seg, candidates, prepared_candidates, finalists, window_starts
+    laid_starts, searched = window_starts_of(
+        config,
+        sketch_seg,
+        metric_seg,
+        candidates,
+        prepared_candidates,
+        finalists,
+        window_starts,
+        refits=bool(_refits(config)),
+        largest=_SCREEN_BY_ASSIGNMENT,
     )
     for step, index in enumerate(finalists):
         prepared = prepared_candidates[index]
@@ -282,7 +298,16 @@ def _prepare_one(
             trial[0] *= 1.0 + config.door_penalty * misplaced
     found: dict = {}
     if config.window_reading_margin and len(trials) > 1 and window_rule(config) != "off":
-        found = _windows(base, sketch_seg, metric_seg, candidates, [trial[1] for trial in trials], windows, searched)
+        found = reading_windows(
+            base,
+            sketch_seg,
+            metric_seg,
+            candidates,
+            [trial[1] for trial in trials],
+            windows,
+            searched,
+            largest=_SCREEN_BY_ASSIGNMENT,
+        )
     taken = None
     if found:
         # A partial sketch can rank better read wrongly; read rightly it resembles a part of the
@@ -299,47 +324,6 @@ def _prepare_one(
         orientation_windows={candidates[index]: value for index, value in found.items()},
         orientation_window_starts={candidates[index]: value for index, value in laid_starts.items()},
     )
-
-
-def _windows(base: Prepared, sketch_seg, metric_seg, candidates, indices, measured, searched=None) -> dict:
-    """By candidate index, its best window's ``(correlation, gain)`` (or None): carried from
-    ``measured`` (another segmentation's) when given, else found, or taken from ``searched``
-    (:func:`~ursim_core.matching.oriented.turned_windows` found for the window starts); ``{}`` for
-    bare graphs and large maps, which are not laid. (Found on a thread while the finalists were
-    matched, they cost as much: the two compete for the same two cores; round 48.)"""
-    if measured:
-        carried = carried_by_orientation(measured, candidates, indices)
-        if carried is not None:
-            return carried
-    labels = elastic_labels(base, sketch_seg, metric_seg, largest=_SCREEN_BY_ASSIGNMENT)
-    if labels is None:
-        return {}
-    found = finalist_windows(*labels, [candidates[index] for index in indices], searched=searched)
-    return {index: found[candidates[index]] for index in indices}
-
-
-def _window_starts(config, sketch_seg, metric_seg, candidates, preparations, indices, measured) -> tuple[dict, dict]:
-    """By candidate index, the laying of its sketch's positions in its best window
-    (``MatchConfig.window_start``, :func:`~ursim_core.matching.oriented.window_position_starts`)
-    or None: carried from ``measured`` (another segmentation's) when given, else found; ``{}``
-    without the option, a refit, label images, or for large maps. With the windows found, by
-    orientation (:func:`~ursim_core.matching.oriented.turned_windows`; ``{}`` when carried), for
-    the reading's windows to reuse."""
-    if not config.window_start or not _refits(config):
-        return {}, {}
-    if measured:
-        carried = carried_by_orientation(measured, candidates, list(indices))
-        if carried is not None:
-            return carried, {}
-    sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
-    first = preparations[next(iter(indices))]
-    if sketch_labels is None or metric_labels is None or max(first.c_matrix.shape) > _SCREEN_BY_ASSIGNMENT:
-        return {}, {}
-    searched = turned_windows(sketch_labels, metric_labels, [candidates[index] for index in indices])
-    found = window_position_starts(
-        sketch_labels, metric_labels, {candidates[index]: preparations[index] for index in indices}, searched=searched
-    )
-    return {index: found[candidates[index]] for index in indices}, searched
 
 
 def _refits(config: MatchConfig) -> int:
@@ -455,6 +439,9 @@ def match_prepared(prepared: Prepared, m: float | None = None, *, progress=None)
         result = voted_answer(prepared, m, functools.partial(_match_one, progress=progress))
     else:
         result = _match_one(prepared, m, progress=progress)
+    if PARTIAL_NOTE in prepared.notes and PARTIAL_NOTE not in result.reason:
+        # The answers found while the orientation was chosen came before the note (auto_partial).
+        result = replaced(result, reason="; ".join(filter(None, (result.reason, PARTIAL_NOTE))))
     if prepared.sketch_labels is None:
         return result
     return laid_elastically(prepared, result)

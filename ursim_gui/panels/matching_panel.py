@@ -220,7 +220,8 @@ class MatchingPanel(QWidget):
             "For a sketch of part of the map: lay it in the part of the map it resembles or box onto box, "
             "whichever lands better (the Laying above), read its orientation where it resembles a part of "
             "the map, and start placing its regions there. Off for a whole sketch: a whole hand-drawn sketch "
-            "can land better in a window that pairs it worse",
+            "can land better in a window that pairs it worse. Left off, the matcher still does this when it "
+            "lays the sketch in part of the map (the answer's reason then says so)",
         )
         self.partial.toggled.connect(self._lay_partial)
         self.orientation = SketchOrientation()

@@ -394,11 +394,40 @@ def test_the_reading_and_the_refit_search_the_finalists_windows_once(monkeypatch
     calls = []
     search = template.best_window
     monkeypatch.setattr(template, "best_window", lambda *a, **k: calls.append(1) or search(*a, **k))
-    run_case(4, "cropped", config=MatchConfig(window_start=True))
+    # (Not matched again as a partial sketch: that would search again, with the partial options.)
+    run_case(4, "cropped", config=MatchConfig(window_start=True, auto_partial=False))
     alone = len(calls)
     calls.clear()
-    both = run_case(4, "cropped", config=MatchConfig(window_start=True, window_reading_margin=0.1))
+    both = run_case(4, "cropped", config=MatchConfig(window_start=True, window_reading_margin=0.1, auto_partial=False))
     assert len(calls) == alone and both.read_right
     calls.clear()
-    run_case(4, "cropped", config=MatchConfig(window_reading_margin=0.1))
+    run_case(4, "cropped", config=MatchConfig(window_reading_margin=0.1, auto_partial=False))
     assert len(calls) == alone
+
+
+def test_a_sketch_laid_in_part_of_the_map_is_matched_again_as_a_partial_sketch():
+    # Generated pair 72 cropped (upright, 54 % of the sketch kept) is laid in the window it
+    # resembles, so it looks partial; matched again with --partial's options it is read right
+    # (round 50: F1 0.13 -> 1.00). auto_partial=False keeps the first answer.
+    from ursim_core.bench.invariance import _parameters, run_case, transformed_sketch
+    from ursim_core.matching import match
+    from ursim_core.matching.config import PARTIAL_SKETCH
+    from ursim_core.matching.partial import PARTIAL_NOTE
+    from ursim_core.segmentation import segment_canonical
+    from ursim_core.synth import make_pair
+
+    first = run_case(72, "cropped", config=MatchConfig(auto_partial=False))
+    again = run_case(72, "cropped")
+    assert not first.read_right and again.read_right and again.f1 >= 0.9
+    plan, sketch = make_pair(seed=72)
+    degrees, mirrored, scale, kept = _parameters(72, "cropped")
+    image, _ = transformed_sketch(sketch.free, [], degrees=degrees, mirrored=mirrored, scale=scale, kept=kept, seed=72)
+    plan_seg = segment_canonical(plan.free, preset="default")
+    result = match(segment_canonical(image, preset="default", resampled=True), plan_seg)
+    assert PARTIAL_NOTE in result.reason
+    assert all(getattr(result.config, name) == value for name, value in PARTIAL_SKETCH.items())
+    # A whole sketch is not laid in a window: the first answer stands, with the default options.
+    whole = match(segment_canonical(sketch.free, preset="default", resampled=True), plan_seg)
+    assert PARTIAL_NOTE not in whole.reason and whole.config.window_start is False
+    with pytest.raises(ParameterError, match="auto_partial"):
+        MatchConfig(auto_partial=1)
