@@ -55,8 +55,9 @@ def reading_windows(
     """By candidate index, its best window's ``(correlation, gain)`` (or None): carried from
     ``measured`` (another segmentation's) when given, else found, or taken from ``searched``
     (:func:`~ursim_core.matching.oriented.turned_windows` found for the window starts); ``{}`` for
-    bare graphs and maps of more than ``largest`` regions, which are not laid. (Found on a thread while the finalists were
-    matched, they cost as much: the two compete for the same two cores; round 48.)"""
+    bare graphs and maps of more than ``largest`` regions, which are not laid. (Found on a thread
+    while the finalists were matched, they cost as much: the two compete for the same two cores;
+    round 48.)"""
     if measured:
         carried = carried_by_orientation(measured, candidates, indices)
         if carried is not None:

@@ -98,7 +98,9 @@ def prepare(
     (:mod:`ursim_core.matching.refit`), and with ``config.signature_refit`` also laid by the answer
     matched without the position term; the orientations are ranked by the refitted answers, and
     the answer found (the refitted one, or with ``config.keep_refit=False`` the one before the
-    refit) is kept in ``Prepared.chosen``.
+    refit) is kept in ``Prepared.chosen``. With ``config.auto_partial``, a sketch laid in the part of
+    the metric map it resembles (the window laying) is prepared again with
+    :data:`~ursim_core.matching.config.PARTIAL_SKETCH`'s options (:mod:`ursim_core.matching.partial`).
     ``config.matcher='auto'`` is resolved first (:meth:`MatchConfig.resolved`).
 
     Parameters
