@@ -279,11 +279,11 @@ def finalist_windows(sketch_labels, metric_labels, orientations, *, searched=Non
 
 
 def turned_windows(sketch_labels, metric_labels, orientations, *, searched=None) -> dict:
-    """``{(degrees, mirrored): (turned labels, window)}``: the sketch's label image turned so
-    (:func:`~ursim_core.matching.layings.oriented_labels`) and its best window on the metric map
-    (:func:`~ursim_core.matching.template.best_window`, None when there is none); those already in
-    ``searched`` are taken from it. The reading's windows (``window_reading_margin``) and the
-    refit's starts (``window_start``) are found once for both.
+    """``{(degrees, mirrored): (turned free space, window)}``: the sketch's free space turned so
+    (:func:`~ursim_core.matching.layings.oriented_labels` of its mask: the turned labels' mask) and
+    its best window on the metric map (:func:`~ursim_core.matching.template.best_window`, None when
+    there is none); those already in ``searched`` are taken from it. The reading's windows
+    (``window_reading_margin``) and the refit's starts (``window_start``) are found once for both.
 
     Examples
     --------
@@ -292,23 +292,24 @@ def turned_windows(sketch_labels, metric_labels, orientations, *, searched=None)
     >>> plan[140:170, 20:580], plan[180:280, 20:260], plan[180:280, 270:580] = 4, 5, 6
     >>> found = turned_windows(plan[:, :320], plan, [(90.0, False)])
     >>> turned, window = found[(90.0, False)]
-    >>> turned.shape, turned_windows(None, None, [(90.0, False)], searched=found) == found
-    ((320, 300), True)
+    >>> turned.shape, turned.dtype, turned_windows(None, None, [(90.0, False)], searched=found) == found
+    ((320, 300), dtype('bool'), True)
     """
     from ursim_core.matching import template
     from ursim_core.matching.layings import oriented_labels
 
     searched = searched or {}
     found = {}
-    metric_free = None
+    metric_free = sketch_free = None
     for degrees, mirrored in orientations:
         if (degrees, mirrored) in searched:
             found[(degrees, mirrored)] = searched[(degrees, mirrored)]
             continue
         if metric_free is None:
-            metric_free = np.asarray(metric_labels) > 0
-        turned = oriented_labels(np.asarray(sketch_labels), degrees=degrees, mirrored=mirrored)
-        found[(degrees, mirrored)] = (turned, template.best_window(turned > 0, metric_free))
+            metric_free, sketch_free = np.asarray(metric_labels) > 0, np.asarray(sketch_labels) > 0
+        # The window reads only the free space: its mask is turned, not the ids (a third of the time).
+        turned = oriented_labels(sketch_free, degrees=degrees, mirrored=mirrored)
+        found[(degrees, mirrored)] = (turned, template.best_window(turned, metric_free))
     return found
 
 
@@ -341,7 +342,7 @@ def window_position_starts(sketch_labels, metric_labels, preparations: dict, *, 
     [1.0, 1.0]
     """
     from ursim_core.matching import template
-    from ursim_core.matching.layings import region_centroids
+    from ursim_core.matching.layings import oriented_labels, region_centroids
 
     starts = {}
     for orientation, (turned, window) in turned_windows(
@@ -351,10 +352,13 @@ def window_position_starts(sketch_labels, metric_labels, preparations: dict, *, 
         starts[orientation] = None
         if window is None or window.gain < template.WINDOW_GAIN or window.correlation < template.WINDOW_MIN_CORRELATION:
             continue
-        row0, row1, col0, col1 = template.free_box(turned > 0)
+        row0, row1, col0, col1 = template.free_box(turned)
         scale = np.array([window.height / (row1 - row0), window.width / (col1 - col0)])
         shift = np.array([window.top, window.left]) - scale * np.array([row0, col0])
-        centroids = region_centroids(turned)
+        # The ids are turned only for a window that starts the refit.
+        centroids = region_centroids(
+            oriented_labels(np.asarray(sketch_labels), degrees=orientation[0], mirrored=orientation[1])
+        )
         nodes = [node for node in prepared.sketch_graph.nodes if node in centroids]
         if len(nodes) < 3:
             continue

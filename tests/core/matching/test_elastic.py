@@ -53,6 +53,30 @@ def test_oriented_labels_move_regions_as_transform_points_moves_points(degrees, 
     assert np.abs(offsets - offsets.mean(axis=0)).max() < 2.0
 
 
+@pytest.mark.parametrize("degrees, mirrored", [(30, False), (135, True), (331.04, False), (90, True)])
+def test_a_turned_free_space_mask_is_the_mask_of_the_turned_labels(degrees, mirrored):
+    # The window search turns the sketch's mask alone (one byte a pixel): it must select the same
+    # pixels as the labels turned on float32.
+    labels = np.pad(_rooms([20, 30, 14, 40]), ((3, 11), (0, 5)))
+    labels[40:45, 10:100] = 7
+    turned = oriented_labels(labels, degrees=degrees, mirrored=mirrored)
+    mask = oriented_labels(labels > 0, degrees=degrees, mirrored=mirrored)
+    assert mask.dtype == bool and np.array_equal(mask, turned > 0)
+
+
+@pytest.mark.parametrize("degrees", [0, 30, 200])
+def test_region_centroids_are_the_mean_pixel_of_each_region(degrees):
+    from ursim_core.matching.layings import region_centroids
+
+    turned = oriented_labels(_rooms([20, 30, 14, 40]), degrees=degrees, mirrored=False)
+    ids, means = _centroids(turned)
+    found = region_centroids(turned)
+    assert sorted(found) == ids.tolist()
+    # Exact: both are sums of integer rows and columns divided by the same counts.
+    assert all(found[i] == tuple(mean) for i, mean in zip(ids.tolist(), means))
+    assert region_centroids(np.zeros((4, 4), np.int32)) == {}
+
+
 def test_signed_distance_is_positive_inside_and_clipped():
     free = np.zeros((40, 40), bool)
     free[5:35, 5:35] = True
