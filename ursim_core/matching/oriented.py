@@ -307,7 +307,7 @@ def turned_windows(sketch_labels, metric_labels, orientations, *, searched=None)
             continue
         if metric_free is None:
             metric_free, sketch_free = np.asarray(metric_labels) > 0, np.asarray(sketch_labels) > 0
-        # The window reads only the free space: its mask is turned, not the ids (a third of the time).
+        # The window reads only the free space: its mask is turned, not the ids (half the time).
         turned = oriented_labels(sketch_free, degrees=degrees, mirrored=mirrored)
         found[(degrees, mirrored)] = (turned, template.best_window(turned, metric_free))
     return found
