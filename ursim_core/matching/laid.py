@@ -15,6 +15,7 @@ from ursim_core.matching.config import ELASTIC_LAYING_RULES
 from ursim_core.matching.results import MatchResult, Prepared, replaced
 
 __all__ = [
+    "sketch_sized_labels",
     "elastic_labels",
     "LaidAhead",
     "laying_answer",
@@ -25,17 +26,23 @@ __all__ = [
 ]
 
 
-def elastic_labels(prepared: Prepared, sketch_seg, metric_seg, *, largest: int) -> tuple | None:
-    """The two label images when the answer's pairs are to be the laid sketch's (``MatchConfig.elastic``):
-    the planar matcher, segmentations, and at most ``largest`` regions a map."""
-    if prepared.config.elastic == "off" or prepared.config.matcher != "planar":
-        return None
+def sketch_sized_labels(prepared: Prepared, sketch_seg, metric_seg, *, largest: int) -> tuple | None:
+    """The two label images of segmentations (not bare graphs) of at most ``largest`` regions a map
+    (``prepared``'s c matrix), which are laid on each other; else None."""
     sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
     # Sketch-sized maps only: at the working size (512 px) a building's thousands of regions
     # would be a few pixels wide, and its graph answer is not screened by orientation alike.
     if sketch_labels is None or metric_labels is None or max(prepared.c_matrix.shape) > largest:
         return None
     return sketch_labels, metric_labels
+
+
+def elastic_labels(prepared: Prepared, sketch_seg, metric_seg, *, largest: int) -> tuple | None:
+    """The two label images when the answer's pairs are to be the laid sketch's (``MatchConfig.elastic``):
+    the planar matcher and :func:`sketch_sized_labels`."""
+    if prepared.config.elastic == "off" or prepared.config.matcher != "planar":
+        return None
+    return sketch_sized_labels(prepared, sketch_seg, metric_seg, largest=largest)
 
 
 class LaidAhead:

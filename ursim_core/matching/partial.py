@@ -16,7 +16,7 @@ for :func:`~ursim_core.matching.pipeline.prepare`:
 from __future__ import annotations
 
 from ursim_core.matching.config import PARTIAL_SKETCH
-from ursim_core.matching.laid import elastic_labels, laid_by_answer, laid_in, window_rule
+from ursim_core.matching.laid import elastic_labels, laid_by_answer, laid_in, sketch_sized_labels, window_rule
 from ursim_core.matching.oriented import (
     carried_by_orientation,
     finalist_windows,
@@ -85,10 +85,10 @@ def window_starts_of(
         carried = carried_by_orientation(measured, candidates, list(indices))
         if carried is not None:
             return carried, {}
-    sketch_labels, metric_labels = getattr(sketch_seg, "labels", None), getattr(metric_seg, "labels", None)
-    first = preparations[next(iter(indices))]
-    if sketch_labels is None or metric_labels is None or max(first.c_matrix.shape) > largest:
+    labels = sketch_sized_labels(preparations[next(iter(indices))], sketch_seg, metric_seg, largest=largest)
+    if labels is None:
         return {}, {}
+    sketch_labels, metric_labels = labels
     searched = turned_windows(sketch_labels, metric_labels, [candidates[index] for index in indices])
     found = window_position_starts(
         sketch_labels, metric_labels, {candidates[index]: preparations[index] for index in indices}, searched=searched
