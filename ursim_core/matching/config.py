@@ -28,6 +28,7 @@ __all__ = [
     "ELASTIC_RULES",
     "ELASTIC_LAYINGS",
     "ELASTIC_LAYING_RULES",
+    "ELASTIC_PARTNERS",
     "PARTIAL_SKETCH",
     "MatchConfig",
 ]
@@ -56,6 +57,8 @@ ELASTIC_LAYING_RULES = {
 }
 #: The values of ``MatchConfig.elastic_laying``.
 ELASTIC_LAYINGS = tuple(ELASTIC_LAYING_RULES)
+#: The values of ``MatchConfig.elastic_partners``.
+ELASTIC_PARTNERS = ("neighbours", "all")
 #: The options for a sketch known to show only part of the metric map (``ursim match --partial``,
 #: the app's "Part" box). Round 48, generated pairs: the partial kinds 0.812 -> 0.836 mean F1;
 #: round 50 added ``window_start``: 0.835 -> 0.854 and 0.838 -> 0.860 (seeds 0-63 / 64-127). Not
@@ -283,6 +286,12 @@ class MatchConfig:
         lands more on the metric map's free space giving the pairs (a second optical flow);
         'boxes_or_window', box onto box or the best window whatever its margin, whichever lands
         more (:data:`ELASTIC_LAYING_RULES`). Evidence: docs/options.md.
+    elastic_partners : {'neighbours', 'all'}
+        A sketch region the laid sketch pairs with several metric regions keeps one (its partner in
+        the graph answer, else the one it overlaps most) and those that neighbour a kept one on the
+        metric map ('neighbours', default: a drawn room bent over two rooms with a wall between
+        belongs to one of them), or all of them ('all', before round 53;
+        :func:`~ursim_core.matching.laid.joined_partners`). Evidence: docs/options.md.
     """
 
     variant: str = "T4"
@@ -328,6 +337,7 @@ class MatchConfig:
     input_kind: str | None = None
     elastic: str = "completed"
     elastic_laying: str = "window"
+    elastic_partners: str = "neighbours"
 
     def __post_init__(self):
         choices = {
@@ -343,6 +353,7 @@ class MatchConfig:
             "vote_orientations": VOTE_ORIENTATIONS,
             "elastic": ELASTIC_RULES,
             "elastic_laying": ELASTIC_LAYINGS,
+            "elastic_partners": ELASTIC_PARTNERS,
         }
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:

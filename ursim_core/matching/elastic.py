@@ -75,12 +75,14 @@ _ANY_GAIN = 1e-6
 
 
 class LaidSketch(NamedTuple):
-    """What :func:`lay_sketch` found: the region pairs, the laying used, and the share of the bent
-    sketch's free space that landed on the metric map's free space (at the working size)."""
+    """What :func:`lay_sketch` found: the region pairs, the laying used, the share of the bent
+    sketch's free space that landed on the metric map's free space (at the working size), and the
+    pairs' intersections over union (:func:`~ursim_core.matching.overlay.overlay_overlaps`)."""
 
     pairs: list
     laying: Laying
     landed: float
+    overlaps: dict
 
 
 def signed_distance(free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:
@@ -216,7 +218,7 @@ def lay_sketch(
     >>> laid.pairs, laid.laying.by, round(laid.landed, 2)
     ([(1, 1), (2, 2)], 'boxes', 1.0)
     """
-    from ursim_core.matching.overlay import overlay_pairs
+    from ursim_core.matching.overlay import overlay_overlaps
 
     found = _laid(
         sketch_labels,
@@ -232,8 +234,8 @@ def lay_sketch(
     if found is None:
         return None
     bent, metric, chosen, landed = found
-    pairs = overlay_pairs(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
-    return LaidSketch(pairs, chosen, landed)
+    overlaps = overlay_overlaps(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
+    return LaidSketch(sorted(overlaps), chosen, landed, overlaps)
 
 
 def elastic_pairs(

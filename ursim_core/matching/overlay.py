@@ -52,6 +52,7 @@ __all__ = [
     "fit_to_pairs",
     "estimate_scale",
     "overlay_pairs",
+    "overlay_overlaps",
     "constrained_pairs",
     "SCALE_SPREAD",
     "SCALE_SEARCH",
@@ -312,13 +313,27 @@ def overlay_pairs(sketch_labels, metric_labels, matrix: np.ndarray, *, min_iou: 
     >>> overlay_pairs(labels, labels, np.array([[1.0, 0, 0], [0, 1.0, 0]]))
     [(1, 1), (2, 2)]
     """
+    return sorted(overlay_overlaps(sketch_labels, metric_labels, matrix, min_iou=min_iou))
+
+
+def overlay_overlaps(sketch_labels, metric_labels, matrix: np.ndarray, *, min_iou: float = 0.15) -> dict:
+    """:func:`overlay_pairs` with each pair's intersection over union: ``{(input region, metric
+    region): iou}``.
+
+    Examples
+    --------
+    >>> labels = np.zeros((20, 30), np.int32); labels[2:18, 2:14] = 1; labels[2:18, 16:28] = 2
+    >>> metric = np.zeros((20, 30), np.int32); metric[2:18, 2:28] = 1
+    >>> {pair: round(iou, 2) for pair, iou in overlay_overlaps(labels, metric, np.eye(2, 3)).items()}
+    {(1, 1): 0.46, (2, 1): 0.46}
+    """
     import cv2
 
     sketch_labels = np.asarray(sketch_labels)
     metric_labels = np.asarray(metric_labels)
     n_sketch, n_metric = int(sketch_labels.max()) + 1, int(metric_labels.max()) + 1
     if n_sketch < 2 or n_metric < 2:
-        return []
+        return {}
     opencv = np.array([[matrix[1, 1], matrix[1, 0], matrix[1, 2]], [matrix[0, 1], matrix[0, 0], matrix[0, 2]]])
     # Nearest neighbour on float32 keeps the ids exactly (they are far below 2**24).
     warped = cv2.warpAffine(
@@ -332,16 +347,16 @@ def overlay_pairs(sketch_labels, metric_labels, matrix: np.ndarray, *, min_iou: 
     metric_area = np.bincount(metric_labels.ravel(), minlength=n_metric).astype(np.float64)[1:]
     inter = counts[1:, 1:]
     iou = inter / np.maximum(sketch_area[:, None] + metric_area[None, :] - inter, 1.0)
-    pairs = set()
+    overlaps = {}
     for i in np.flatnonzero(sketch_area > 0):
         j = int(np.argmax(iou[i]))
         if iou[i, j] >= min_iou:
-            pairs.add((int(i) + 1, j + 1))
+            overlaps[int(i) + 1, j + 1] = float(iou[i, j])
     for j in np.flatnonzero(metric_area > 0):
         i = int(np.argmax(iou[:, j]))
         if iou[i, j] >= min_iou:
-            pairs.add((i + 1, int(j) + 1))
-    return sorted(pairs)
+            overlaps[i + 1, int(j) + 1] = float(iou[i, j])
+    return overlaps
 
 
 def _similarity(source: np.ndarray, target: np.ndarray, *, mirrored: bool) -> np.ndarray | None:
