@@ -140,6 +140,29 @@ def test_elastic_must_be_a_rule():
     assert MatchConfig.paper().elastic == "off" and MatchConfig.released().elastic == "off"
 
 
+def test_a_drawn_room_over_two_walled_rooms_is_paired_with_one():
+    # The sketch draws the last two rooms of the map as one room: bent onto the map, it covers
+    # both, which are rooms apart (a wall between them, no door).
+    metric = _segmentation(_rooms([40, 40, 40, 40]))
+    sketch = _segmentation(_rooms([40, 40, 84]))
+    told = MatchConfig(orientation="upright", mirrored=False)
+    assert sorted(match(sketch, metric, config=told).pairs) == [(1, 1), (2, 2), (3, 3)]
+    before = match(sketch, metric, config=told.replace(elastic_partners="all"))
+    assert sorted(before.pairs) == [(1, 1), (2, 2), (3, 3), (3, 4)]
+
+
+def test_a_drawn_room_over_a_room_the_map_splits_is_paired_with_both():
+    # The same room on the map, split by its segmentation into two regions that touch.
+    labels = _rooms([40, 40, 84])
+    right = labels[:, 150:]
+    right[right == 3] = 4
+    metric = _segmentation(labels)
+    assert metric.graph.has_edge(3, 4)
+    sketch = _segmentation(_rooms([40, 40, 84]))
+    told = MatchConfig(orientation="upright", mirrored=False)
+    assert sorted(match(sketch, metric, config=told).pairs) == [(1, 1), (2, 2), (3, 3), (3, 4)]
+
+
 def test_building_sized_maps_keep_the_graph_answer():
     # 70 rooms in a row: at the 512 px working size they would be a few pixels wide.
     labels = _rooms([12] * 70, height=40, wall=2)
