@@ -298,6 +298,8 @@ def test_a_partial_generated_sketch_is_laid_in_its_window(seed):
     boxes = run_case(seed, "cropped", told=True, config=every.replace(elastic_laying="boxes"))
     window = run_case(seed, "cropped", told=True, config=every.replace(elastic_laying="window"))
     assert window.f1 > boxes.f1 + 0.3 and window.f1 >= 0.9
+    by_default = run_case(seed, "cropped", told=True)
+    assert by_default.f1 > boxes.f1 + 0.3 and by_default.f1 >= 0.85
 
 
 def test_the_window_competes_with_the_boxes_by_where_they_land():

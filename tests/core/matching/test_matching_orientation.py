@@ -329,6 +329,7 @@ def test_a_partial_sketch_is_read_where_it_resembles_part_of_the_map():
     ranked = run_case(22, "cropped", config=every)
     windowed = run_case(22, "cropped", config=every.replace(window_reading_margin=0.1))
     assert windowed.read_right and windowed.f1 >= 0.85 and windowed.f1 >= ranked.f1
+    assert run_case(22, "cropped", config=MatchConfig(window_reading_margin=0.1)).read_right
     # A whole sketch resembles no part of the plan better than the whole: read as before.
     whole = run_case(22, "mirrored", config=MatchConfig(window_reading_margin=0.1))
     assert whole.read_right and whole.f1 == run_case(22, "mirrored").f1
