@@ -75,14 +75,18 @@ _ANY_GAIN = 1e-6
 
 
 class LaidSketch(NamedTuple):
-    """What :func:`lay_sketch` found: the region pairs, the laying used, the share of the bent
-    sketch's free space that landed on the metric map's free space (at the working size), and the
-    pairs' intersections over union (:func:`~ursim_core.matching.overlay.overlay_overlaps`)."""
+    """What :func:`lay_sketch` found: the laying used, the share of the bent sketch's free space
+    that landed on the metric map's free space (at the working size), and the region pairs with
+    their intersections over union (:func:`~ursim_core.matching.overlay.overlay_overlaps`)."""
 
-    pairs: list
     laying: Laying
     landed: float
     overlaps: dict
+
+    @property
+    def pairs(self) -> list:
+        """The region pairs, sorted."""
+        return sorted(self.overlaps)
 
 
 def signed_distance(free: np.ndarray, *, clip: float = DISTANCE_CLIP) -> np.ndarray:
@@ -235,7 +239,7 @@ def lay_sketch(
         return None
     bent, metric, chosen, landed = found
     overlaps = overlay_overlaps(bent, metric, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), min_iou=min_iou)
-    return LaidSketch(sorted(overlaps), chosen, landed, overlaps)
+    return LaidSketch(chosen, landed, overlaps)
 
 
 def elastic_pairs(
