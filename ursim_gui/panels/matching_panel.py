@@ -259,6 +259,17 @@ class MatchingPanel(QWidget):
         )
         self.keep_found.clicked.connect(lambda: self.set_orientation(self.found_orientation or self.orientation))
         form.addRow(self.keep_found)
+        # The reading the matcher ranked next, one click away: of the 27 generated partial sketches
+        # misread (seeds 0-127), 16 are read right in it (docs/studies.md, round 54).
+        self.runner_up: SketchOrientation | None = None
+        self.try_runner_up = QPushButton("")
+        self.try_runner_up.setObjectName("orient_try_runner_up")
+        self.try_runner_up.setToolTip(
+            "Tell the matcher the reading it ranked next and match again (Undo gives the last answer "
+            "back; 'unknown' lets the matcher choose the orientation again)"
+        )
+        self.try_runner_up.clicked.connect(self._match_runner_up)
+        form.addRow(self.try_runner_up)
         self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
         self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
         self.angle.editingFinished.connect(lambda: self.set_orientation(self.orientation.at(self.angle.value())))
@@ -347,6 +358,17 @@ class MatchingPanel(QWidget):
         self.keep_found.setVisible(found is not None and found != orientation)
         if found is not None:
             self.keep_found.setText(f"Keep the orientation read: {found.describe()}")
+        runner_up = self.runner_up
+        self.try_runner_up.setVisible(runner_up is not None and runner_up != orientation)
+        if runner_up is not None:
+            self.try_runner_up.setText(f"Match as read next best: {runner_up.describe()}")
+
+    def _match_runner_up(self) -> None:
+        """Tell the matcher the runner-up reading (the view turns to it) and ask for a match."""
+        if self.runner_up is None:
+            return
+        self.set_orientation(self.runner_up)
+        self.match_requested.emit(self.config())
 
     def set_input_kind(self, kind: str | None) -> None:
         """Say what the input map is (None = unknown; see :data:`INPUT_KINDS`)."""
@@ -359,11 +381,15 @@ class MatchingPanel(QWidget):
     def set_ready(self, ready: bool) -> None:
         """Enable Match only when both maps are segmented and no job runs."""
         self.match_button.setEnabled(ready)
+        self.try_runner_up.setEnabled(ready)
 
     def show_result(self, result, *, automatic_cliques: int = 0, record=None) -> None:
         """Summarise the last match, or the file's (``record``: its ``matcher`` record) without one."""
         self.summary.setText(describe_result(result, automatic_cliques=automatic_cliques, record=record))
         self.found_orientation = orientation_read(result, automatic_cliques=automatic_cliques, record=record)
+        # Offered only beside a reading the matcher chose (as the summary names it).
+        runner_up = SketchOrientation.runner_up_in(result, None if result is not None else record)
+        self.runner_up = runner_up[0] if runner_up is not None and self.found_orientation is not None else None
         self._show_orientation()
 
 

@@ -257,3 +257,35 @@ def test_the_panel_is_told_the_sketch_shows_part_of_the_map(window):
     panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
     assert not panel.partial.isEnabled() and panel.config().window_reading_margin == 0
     assert not panel.config().window_start
+
+
+def test_the_reading_ranked_next_is_one_click_away(window, qtbot):
+    panel, sketch = window.matching_panel, window.views["sketch"]
+    assert not panel.try_runner_up.isVisible()  # nothing matched yet
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        panel.match_button.click()
+    first = window.session.last_match
+    first_pairs = _region_pairs(window.session)
+    runner_up = panel.runner_up
+    assert runner_up is not None and runner_up != panel.found_orientation
+    assert panel.try_runner_up.isVisible() and runner_up.describe() in panel.try_runner_up.text()
+    assert runner_up.describe() in panel.summary.text()  # the summary's "next best"
+    panel.set_ready(False)
+    assert not panel.try_runner_up.isEnabled()  # one job at a time
+    panel.set_ready(True)
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        panel.try_runner_up.click()
+    # The matcher was told the runner-up reading, and the view turned to it.
+    result = window.session.last_match
+    assert result is not first
+    assert (result.config.orientation, result.config.mirrored) == (runner_up.angle, runner_up.mirrored)
+    assert (panel.orientation.angle, panel.orientation.mirrored) == sketch.orientation
+    assert panel.orientation == runner_up
+    # Told the orientation, the matcher ranks no other reading: nothing more is offered.
+    assert panel.runner_up is None and not panel.try_runner_up.isVisible()
+    assert window.session.undo()  # the second answer is one undo step
+    assert _region_pairs(window.session) == first_pairs
+
+
+def _region_pairs(session) -> list:
+    return sorted((c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques)
