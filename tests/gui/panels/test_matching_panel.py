@@ -59,8 +59,7 @@ def test_the_overlay_matcher_with_a_known_scale_runs_from_the_panel(window, qtbo
     panel.scale.setValue(1.0)
     # A known scale: the automatic matcher lays the maps on each other.
     assert panel.config().matcher == "auto" and panel.config().scale == 1.0
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    _match_by(window, qtbot, panel.match_button)
     result = window.session.last_match
     assert result.config.matcher == "overlay" and result.pairs
     assert "pairs" in panel.summary.text()
@@ -96,8 +95,7 @@ def test_the_orientation_goes_to_the_match_config(window):
 def test_the_orientation_the_matcher_read_can_be_kept(window, qtbot):
     panel, sketch = window.matching_panel, window.views["sketch"]
     assert not panel.keep_found.isVisible()  # nothing matched yet
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        panel.match_button.click()
+    _match_by(window, qtbot, panel.match_button)
     result = window.session.last_match
     found = (float(round(result.orientation[0] % 360.0, 1) % 360.0), result.orientation[1])
     assert "read the sketch" in panel.summary.text()
@@ -113,8 +111,7 @@ def test_the_orientation_the_matcher_read_can_be_kept(window, qtbot):
 
 def test_a_file_opened_again_offers_the_orientation_its_match_read(window, qtbot, tmp_path):
     panel = window.matching_panel
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        panel.match_button.click()
+    _match_by(window, qtbot, panel.match_button)
     offered = panel.keep_found.text()
     window.documents.save_as(tmp_path / "pair.json")
     window.documents.open_correspondences(tmp_path / "pair.json")
@@ -195,13 +192,11 @@ def test_the_panel_says_where_a_sketchs_pairs_come_from(window, qtbot):
     panel.matcher.setCurrentIndex(panel.matcher.findData("auto"))
     panel.pairs_from.setCurrentIndex(panel.pairs_from.findData("off"))
     assert panel.config().elastic == "off"
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    _match_by(window, qtbot, panel.match_button)
     assert not window.session.last_match.laid and "laid" not in panel.summary.text()
     qtbot.waitUntil(lambda: panel.match_button.isEnabled())
     panel.pairs_from.setCurrentIndex(panel.pairs_from.findData("completed"))
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    _match_by(window, qtbot, panel.match_button)
     result = window.session.last_match
     assert result.laid and result.config.elastic == "completed" and result.pairs
     assert "pairs from the sketch laid and bent onto the map" in panel.summary.text()
@@ -218,8 +213,7 @@ def test_the_panel_lays_a_partial_sketch_where_its_answer_puts_it(window, qtbot)
     panel.matcher.setCurrentIndex(panel.matcher.findData("hungarian"))
     assert not panel.laying.isEnabled()  # the Hungarian baseline lays nothing
     panel.matcher.setCurrentIndex(panel.matcher.findData("auto"))
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
+    _match_by(window, qtbot, panel.match_button)
     result = window.session.last_match
     assert result.laid and result.config.elastic_laying == "boxes_or_answer"
     assert result.laying.by in ("boxes", "answer")
@@ -262,8 +256,7 @@ def test_the_panel_is_told_the_sketch_shows_part_of_the_map(window):
 def test_the_reading_ranked_next_is_one_click_away(window, qtbot):
     panel, sketch = window.matching_panel, window.views["sketch"]
     assert not panel.try_runner_up.isVisible()  # nothing matched yet
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        panel.match_button.click()
+    _match_by(window, qtbot, panel.match_button)
     first = window.session.last_match
     first_pairs = _region_pairs(window.session)
     runner_up = panel.runner_up
@@ -273,8 +266,7 @@ def test_the_reading_ranked_next_is_one_click_away(window, qtbot):
     panel.set_ready(False)
     assert not panel.try_runner_up.isEnabled()  # one job at a time
     panel.set_ready(True)
-    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
-        panel.try_runner_up.click()
+    _match_by(window, qtbot, panel.try_runner_up)
     # The matcher was told the runner-up reading, and the view turned to it.
     result = window.session.last_match
     assert result is not first
@@ -289,3 +281,9 @@ def test_the_reading_ranked_next_is_one_click_away(window, qtbot):
 
 def _region_pairs(session) -> list:
     return sorted((c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques)
+
+
+def _match_by(window, qtbot, button) -> None:
+    """Click ``button`` and wait until the match it starts has changed the correspondences."""
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
