@@ -135,6 +135,8 @@ class MatchingPanel(QWidget):
     match_requested = Signal(object)
     #: The sketch orientation changed (a :class:`~ursim_gui.model.orientation.SketchOrientation`).
     orientation_changed = Signal(object)
+    #: Whether a runner-up reading is offered may have changed (:meth:`runner_up_offered`).
+    runner_up_changed = Signal()
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -268,7 +270,7 @@ class MatchingPanel(QWidget):
             "Tell the matcher the reading it ranked next and match again (Undo gives the last answer "
             "back; 'unknown' lets the matcher choose the orientation again)"
         )
-        self.try_runner_up.clicked.connect(self._match_runner_up)
+        self.try_runner_up.clicked.connect(self.match_runner_up)
         form.addRow(self.try_runner_up)
         self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
         self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
@@ -358,14 +360,19 @@ class MatchingPanel(QWidget):
         self.keep_found.setVisible(found is not None and found != orientation)
         if found is not None:
             self.keep_found.setText(f"Keep the orientation read: {found.describe()}")
-        runner_up = self.runner_up
-        self.try_runner_up.setVisible(runner_up is not None and runner_up != orientation)
-        if runner_up is not None:
-            self.try_runner_up.setText(f"Match as read next best: {runner_up.describe()}")
+        self.try_runner_up.setVisible(self.runner_up_offered())
+        if self.runner_up is not None:
+            self.try_runner_up.setText(f"Match as read next best: {self.runner_up.describe()}")
+        self.runner_up_changed.emit()
 
-    def _match_runner_up(self) -> None:
-        """Tell the matcher the runner-up reading (the view turns to it) and ask for a match."""
-        if self.runner_up is None:
+    def runner_up_offered(self) -> bool:
+        """Whether the last match ranked another reading next, not the orientation set now."""
+        return self.runner_up is not None and self.runner_up != self.orientation
+
+    def match_runner_up(self) -> None:
+        """Tell the matcher the runner-up reading (the view turns to it) and ask for a match;
+        nothing when none is offered."""
+        if not self.runner_up_offered():
             return
         self.set_orientation(self.runner_up)
         self.match_requested.emit(self.config())

@@ -260,6 +260,8 @@ class MainWindow(QMainWindow):
             box.load_labels_requested.connect(lambda s: self.tools.load_label_image(s))
         self.matching_panel.match_requested.connect(self.jobs.match)
         self.actions["match"].triggered.connect(lambda: self.jobs.match(self.matching_panel.config()))
+        self.actions["match_runner_up"].triggered.connect(self.matching_panel.match_runner_up)
+        self.matching_panel.runner_up_changed.connect(self._update_ready)
         self.matching_panel.orientation_changed.connect(
             lambda o: self.views["sketch"].set_orientation(o.angle or 0.0, o.mirrored)
         )
@@ -352,6 +354,8 @@ class MainWindow(QMainWindow):
         segmented = all(self.session.segmentation(side) is not None for side in SIDES)
         self.matching_panel.set_ready(segmented and not self.jobs.busy)
         self.actions["match"].setEnabled(segmented and not self.jobs.busy)
+        offered = self.matching_panel.runner_up_offered()
+        self.actions["match_runner_up"].setEnabled(segmented and not self.jobs.busy and offered)
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
 

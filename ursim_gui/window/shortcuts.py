@@ -85,6 +85,13 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "and steer the answer (best after linking what it missed)",
         "Edit",
     ),
+    ActionSpec(
+        "match_runner_up",
+        "Match as read &next best",
+        ("Ctrl+Shift+M",),
+        "Tell the matcher the reading it ranked next after the last match and match again (Undo gives the answer back)",
+        "Edit",
+    ),
     ActionSpec("clear_selection", "Clear selection", ("Esc",), "Deselect all regions", "Edit"),
     ActionSpec("fit", "&Fit to window", ("F",), "Fit both maps to their views", "View"),
     ActionSpec("zoom_clique", "&Zoom to clique", ("Z",), "Zoom both views to the selected clique", "View"),

@@ -283,6 +283,22 @@ def _region_pairs(session) -> list:
     return sorted((c.sketch_regions, c.metric_regions) for c in session.correspondences.cliques)
 
 
+def test_the_reading_ranked_next_is_an_edit_action_too(window, qtbot):
+    action, panel = window.actions["match_runner_up"], window.matching_panel
+    assert action.shortcut().toString() == "Ctrl+Shift+M"
+    assert not action.isEnabled()  # nothing matched yet: no reading to offer
+    _match_by(window, qtbot, panel.match_button)
+    runner_up = panel.runner_up
+    assert runner_up is not None and action.isEnabled()
+    with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
+        action.trigger()
+    config = window.session.last_match.config
+    assert (config.orientation, config.mirrored) == (runner_up.angle, runner_up.mirrored)
+    assert not action.isEnabled()  # told the orientation: no other reading ranked
+    panel.match_runner_up()  # nothing offered: no match asked for
+    assert window.session.last_match.config is config
+
+
 def _match_by(window, qtbot, button) -> None:
     """Click ``button`` and wait until the match it starts has changed the correspondences."""
     with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
