@@ -351,11 +351,10 @@ class MainWindow(QMainWindow):
             view.fit_to_window()
 
     def _update_ready(self) -> None:
-        segmented = all(self.session.segmentation(side) is not None for side in SIDES)
-        self.matching_panel.set_ready(segmented and not self.jobs.busy)
-        self.actions["match"].setEnabled(segmented and not self.jobs.busy)
-        offered = self.matching_panel.runner_up_offered()
-        self.actions["match_runner_up"].setEnabled(segmented and not self.jobs.busy and offered)
+        ready = all(self.session.segmentation(side) is not None for side in SIDES) and not self.jobs.busy
+        self.matching_panel.set_ready(ready)
+        self.actions["match"].setEnabled(ready)
+        self.actions["match_runner_up"].setEnabled(ready and self.matching_panel.runner_up_offered())
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
 
