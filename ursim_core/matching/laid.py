@@ -191,9 +191,12 @@ def laid_elastically(prepared: Prepared, result: MatchResult) -> MatchResult:
     from ursim_core.matching.overlay import constrained_pairs
 
     laid = laid_in(prepared, tuple(result.orientation), result)
-    pairs = [] if laid is None else laid.pairs
-    if laid is not None and prepared.config.elastic_partners == "neighbours":
+    if laid is None:
+        pairs = []
+    elif prepared.config.elastic_partners == "neighbours":
         pairs = joined_partners(laid.overlaps, prepared.metric_graph, preferred=result.pairs)
+    else:
+        pairs = laid.pairs
     if prepared.config.elastic == "completed":
         # Regions the overlay leaves alone on both sides keep the graph answer's pairs: a small
         # region the bent sketch misses still has its partner (a stub, a cut-off room).
