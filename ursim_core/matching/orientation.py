@@ -44,6 +44,7 @@ __all__ = [
     "turn_between",
     "SAME_READING",
     "same_reading",
+    "ranked_readings",
     "next_reading",
     "CLOSE_READING",
     "describe_gap",
@@ -93,16 +94,46 @@ def same_reading(first: tuple[float, bool], second: tuple[float, bool]) -> bool:
 CLOSE_READING = 0.02
 
 
-def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[float, bool], float] | None:
-    """The runner-up: the best-ranked orientation of ``scan`` that reads the sketch otherwise than
-    ``orientation``, and how much worse it ranked than the best of ``orientation``'s reading.
+def ranked_readings(orientation: tuple[float, bool], scan: dict) -> list[tuple[tuple[float, bool], float]]:
+    """Every reading of ``scan``, ranked: ``orientation``'s own first, then the others from the best
+    ranked, each with how much worse it ranked than the best of ``orientation``'s reading.
 
     ``scan`` is a result's ``orientation_scan`` (rank values, lower is better; for a vote over
-    resamplings, the means over them). The gap is relative, ``(runner-up - best) / best``: a few
-    percent means the matcher could nearly as well have read the sketch the other way, and a
-    person should check the orientation. It is negative when the runner-up ranked better (a vote
-    by count can choose so). None when ``scan`` holds no other reading, or none of this one, with
-    a finite rank value (and this one's above 0).
+    resamplings, the means over them). Orientations that read the sketch alike
+    (:func:`same_reading`) are one reading, given by its best-ranked orientation. The gap is
+    relative, ``(value - best) / best``: a few percent means the matcher could nearly as well have
+    read the sketch that way, and a person should check the orientation. It is negative when a
+    reading ranked better (a vote by count can choose so). Empty when ``scan`` holds none of this
+    reading with a finite rank value (or its best is not above 0); values that are not finite (a
+    reading no segmentation could rank) say nothing of the gap and are left out.
+
+    Examples
+    --------
+    >>> scan = {(90.0, False): 0.50, (0.0, True): 0.51, (270.0, False): 0.8, (0.4, True): 0.6}
+    >>> ranked_readings((90.2, False), scan)
+    [((90.2, False), 0.0), ((0.0, True), 0.02), ((270.0, False), 0.6)]
+    >>> ranked_readings((0.0, False), {(0.0, False): 0.5, (180.0, False): float("inf")})
+    [((0.0, False), 0.0)]
+    >>> ranked_readings((0.0, False), {(90.0, False): 0.5})
+    []
+    """
+    scan = {tried: float(value) for tried, value in scan.items() if math.isfinite(value)}
+    own = [value for tried, value in scan.items() if same_reading(tried, orientation)]
+    if not own or min(own) <= 0:
+        return []
+    best = min(own)
+    ranked = [((float(orientation[0]), bool(orientation[1])), 0.0)]
+    # By value, ties by the orientation: the first of each reading is its best.
+    for value, tried in sorted((value, tried) for tried, value in scan.items() if not same_reading(tried, orientation)):
+        if not any(same_reading(tried, kept) for kept, _ in ranked):
+            ranked.append(((float(tried[0]), bool(tried[1])), round((value - best) / best, 12)))
+    return ranked
+
+
+def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[float, bool], float] | None:
+    """The runner-up: the best-ranked reading of ``scan`` other than ``orientation``'s, and how much
+    worse it ranked than the best of ``orientation``'s reading (:func:`ranked_readings`' second);
+    None when there is no other.
 
     Examples
     --------
@@ -113,15 +144,8 @@ def next_reading(orientation: tuple[float, bool], scan: dict) -> tuple[tuple[flo
     >>> next_reading((0.0, False), {(0.0, False): 0.5, (180.0, False): float("inf")}) is None
     True
     """
-    # A value that is not finite (a reading no segmentation could rank) says nothing of the gap.
-    scan = {tried: float(value) for tried, value in scan.items() if math.isfinite(value)}
-    own = [value for tried, value in scan.items() if same_reading(tried, orientation)]
-    others = [(value, tried) for tried, value in scan.items() if not same_reading(tried, orientation)]
-    if not own or not others or min(own) <= 0:
-        return None
-    best = min(own)
-    value, tried = min(others)
-    return (float(tried[0]), bool(tried[1])), round((value - best) / best, 12)
+    ranked = ranked_readings(orientation, scan)
+    return ranked[1] if len(ranked) > 1 else None
 
 
 def broken_adjacencies(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) -> float:

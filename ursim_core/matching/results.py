@@ -15,7 +15,16 @@ from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, 
 from ursim_core.matching.descriptors import PairDescriptors
 from ursim_core.matching.planar import PlanarGraph
 
-__all__ = ["Prepared", "MatchResult", "replaced", "new_result", "match_record", "next_reading_record", "laid_by"]
+__all__ = [
+    "Prepared",
+    "MatchResult",
+    "replaced",
+    "new_result",
+    "match_record",
+    "next_reading_record",
+    "readings_record",
+    "laid_by",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -236,6 +245,7 @@ def match_record(config: MatchConfig, result: MatchResult) -> dict[str, Any]:
         # How the sketch was laid before it was bent: box onto box, or by the planar answer's pairs.
         **({"laid_by": laid_by(result)} if laid_by(result) else {}),
         **next_reading_record(result),
+        **readings_record(result),
     }
 
 
@@ -269,3 +279,30 @@ def next_reading_record(result: MatchResult) -> dict[str, Any]:
         return {}
     (degrees, mirrored), gap = found
     return {"next_reading": {"degrees": round(degrees, 6), "mirrored": mirrored, "ranked_worse_by": round(gap, 6)}}
+
+
+def readings_record(result: MatchResult) -> dict[str, Any]:
+    """``{"readings": [{"degrees", "mirrored", "ranked_worse_by"}, ...]}``: every reading the matcher
+    ranked when it chose the orientation, its own first
+    (:func:`~ursim_core.matching.orientation.ranked_readings`), JSON-safe; empty when there is no
+    other (the orientation was told, or one reading was tried). The app offers them side by side
+    to be matched in.
+
+    Examples
+    --------
+    >>> result = MatchResult([], [], [], [], 0.1, 3.0, 0.2, None, np.zeros((1, 1)), 1, 1, "", MatchConfig(),
+    ...                      orientation=(0.0, False), orientation_scan={(0.0, False): 0.4, (180.0, True): 0.5})
+    >>> [reading["ranked_worse_by"] for reading in readings_record(result)["readings"]]
+    [0.0, 0.25]
+    """
+    from ursim_core.matching.orientation import ranked_readings
+
+    ranked = ranked_readings(result.orientation, result.orientation_scan) if result.orientation_scan else []
+    if len(ranked) < 2:
+        return {}
+    return {
+        "readings": [
+            {"degrees": round(degrees, 6), "mirrored": mirrored, "ranked_worse_by": round(gap, 6)}
+            for (degrees, mirrored), gap in ranked
+        ]
+    }

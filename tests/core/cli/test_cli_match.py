@@ -257,6 +257,11 @@ def test_a_turned_sketch_is_matched_in_its_resamplings_and_voted(tmp_path, capsy
         chosen["mirrored"],
     )
     assert f"next best reading: turned {runner_up['degrees']:.1f} deg" in printed
+    # Every reading ranked, for the app to show side by side: the chosen one first, then the
+    # runner-up, then the others ranked no better.
+    readings = corr.extra["matcher"]["readings"]
+    assert readings[0] == {**chosen, "ranked_worse_by": 0.0} and readings[1] == runner_up
+    assert [r["ranked_worse_by"] for r in readings[1:]] == sorted(r["ranked_worse_by"] for r in readings[1:])
     # The voted pairs are in the regions of the label image written beside them.
     labels = cv2.imread(str(out / "sketch.labels.png"), cv2.IMREAD_UNCHANGED)
     assert {r for c in corr.cliques for r in c.sketch_regions} <= set(np.unique(labels).tolist()) - {0}
@@ -266,7 +271,8 @@ def test_a_told_orientation_has_no_runner_up(tmp_path, pair, capsys):
     out = tmp_path / "out"
     assert main(["match", str(pair[0]), str(pair[1]), "-o", str(out), "--orientation", "upright"]) == 0
     assert "next best reading" not in capsys.readouterr().out
-    assert "next_reading" not in load_correspondences(out / "correspondences.json").extra["matcher"]
+    record = load_correspondences(out / "correspondences.json").extra["matcher"]
+    assert "next_reading" not in record and "readings" not in record
 
 
 def test_any_matching_option_is_set_with_set_and_a_wrong_one_is_refused_first(tmp_path, capsys):

@@ -17,9 +17,12 @@ from ursim_core.matching.orientation import (
     UNRELATED_DOOR,
     broken_adjacencies,
     misplaced_doors,
+    next_reading,
     orientation_candidates,
     oriented_graph,
+    ranked_readings,
     region_outlines,
+    same_reading,
     transform_points,
 )
 from ursim_core.matching.positions import region_positions
@@ -171,6 +174,35 @@ def test_the_best_screened_orientations_get_the_full_sweep():
     assert [len(tried[k]) for k in (1, 3, 4, 8)] == [1, 3, 4, 8]
     assert set(tried[1]) < set(tried[3]) < set(tried[4]) < set(tried[8])
     assert MatchConfig().orientation_finalists == 4
+
+
+def test_ranked_readings_are_the_chosen_one_then_one_orientation_per_other_reading_best_first():
+    scan = {
+        (90.3, False): 0.40,
+        (89.8, False): 0.45,  # the same reading as the chosen one: not another
+        (180.0, True): 0.60,
+        (179.5, True): 0.50,  # the best of its reading stands for it
+        (0.0, False): 0.44,
+        (270.0, False): float("nan"),  # no rank value: left out
+    }
+    ranked = ranked_readings((90.0, False), scan)
+    assert [reading for reading, _ in ranked] == [(90.0, False), (0.0, False), (179.5, True)]
+    assert [gap for _, gap in ranked] == pytest.approx([0.0, 0.1, 0.25])
+    # A vote by count may choose a reading another one outranks: its gap is negative.
+    assert ranked_readings((0.0, False), scan)[1] == ((90.3, False), pytest.approx(-1 / 11))
+
+
+def test_the_runner_up_is_the_second_ranked_reading():
+    rng = np.random.default_rng(3)
+    orientations = [(float(d), m) for d in (0.0, 0.4, 90.0, 180.0, 270.0) for m in (False, True)]
+    for _ in range(200):
+        kept = rng.choice(len(orientations), size=rng.integers(1, len(orientations)), replace=False)
+        scan = {orientations[k]: float(rng.choice([0.0, rng.uniform(0.1, 1.0), np.inf])) for k in kept}
+        chosen = orientations[kept[0]]
+        ranked = ranked_readings(chosen, scan)
+        assert next_reading(chosen, scan) == (ranked[1] if len(ranked) > 1 else None)
+        values = [min(v for o, v in scan.items() if np.isfinite(v) and same_reading(o, r)) for r, _ in ranked[1:]]
+        assert values == sorted(values)  # the others from the best ranked
 
 
 def test_config_validates_adjacency_penalty():
