@@ -89,8 +89,7 @@ class SketchOrientation:
         config = getattr(result, "config", None)
         if result is None or getattr(config, "orientation", None) != "any":
             return None
-        degrees, mirrored = result.orientation
-        return cls._read(degrees, mirrored)
+        return cls.laid_in(result)
 
     @classmethod
     def found_in_record(cls, record) -> SketchOrientation | None:
@@ -104,14 +103,78 @@ class SketchOrientation:
         (SketchOrientation(angle=90.0, mirrored=False), None)
         """
         try:
-            if record["config"]["orientation"] != "any":
-                return None
+            chosen = record["config"]["orientation"] == "any"
+        except (KeyError, TypeError):
+            return None  # an older file, or one a person or another tool wrote
+        return cls.laid_in(record=record) if chosen else None
+
+    @classmethod
+    def laid_in(cls, result=None, record=None) -> SketchOrientation | None:
+        """The reading an answer laid the sketch in, told or chosen: ``result``'s (a
+        ``MatchResult``), else a file's ``matcher`` record's; None when neither says.
+
+        Examples
+        --------
+        >>> from types import SimpleNamespace as Result
+        >>> SketchOrientation.laid_in(Result(orientation=(90.0, False)))
+        SketchOrientation(angle=90.0, mirrored=False)
+        >>> SketchOrientation.laid_in(record={"orientation": {"degrees": 180.0, "mirrored": True}}).describe()
+        'turned 180° counter-clockwise, mirrored'
+        >>> SketchOrientation.laid_in(record={"orientation": "upright"}) is None
+        True
+        """
+        if result is not None:
+            # A result of a matcher that reads no orientation (a stand-in in tests) has none.
+            orientation = getattr(result, "orientation", None)
+            return cls._read(*orientation) if orientation is not None else None
+        try:
             degrees, mirrored = float(record["orientation"]["degrees"]), record["orientation"]["mirrored"]
         except (KeyError, TypeError, ValueError):
-            return None  # an older file, or one a person or another tool wrote
+            return None
         if not isinstance(mirrored, bool) or not math.isfinite(degrees):
             return None
         return cls._read(degrees, mirrored)
+
+    @classmethod
+    def readings_in(cls, result=None, record=None) -> list[tuple[SketchOrientation, float]]:
+        """Every reading the matcher ranked when it chose the orientation, the one it chose first,
+        each with how much worse it ranked (relative; see
+        ``ursim_core.matching.orientation.ranked_readings``): from ``result`` (a ``MatchResult``),
+        else from a file's ``matcher`` record (its ``readings``, or for a file written before
+        them its ``orientation`` and ``next_reading``). Empty when the matcher was told the
+        orientation or ranked one reading only.
+
+        Examples
+        --------
+        >>> record = {"config": {"orientation": "any"}, "orientation": {"degrees": 0.0, "mirrored": False},
+        ...           "next_reading": {"degrees": 180.0, "mirrored": True, "ranked_worse_by": 0.02}}
+        >>> [(reading.describe(), gap) for reading, gap in SketchOrientation.readings_in(record=record)]
+        [('upright', 0.0), ('turned 180° counter-clockwise, mirrored', 0.02)]
+        >>> record["readings"] = [{"degrees": 0.0, "mirrored": False, "ranked_worse_by": 0.0},
+        ...                       {"degrees": 180.0, "mirrored": True, "ranked_worse_by": 0.02},
+        ...                       {"degrees": 90.0, "mirrored": False, "ranked_worse_by": 0.3}]
+        >>> len(SketchOrientation.readings_in(record=record)), SketchOrientation.readings_in(record={"m": 0.1})
+        (3, [])
+        """
+        if result is not None:
+            if cls.found_in(result) is None:
+                return []
+            from ursim_core.matching.orientation import ranked_readings
+
+            ranked = ranked_readings(result.orientation, getattr(result, "orientation_scan", None) or {})
+            return (
+                [(cls._read(degrees, mirrored), gap) for (degrees, mirrored), gap in ranked] if len(ranked) > 1 else []
+            )
+        found = cls.found_in_record(record)
+        if found is None:
+            return []
+        readings = record.get("readings")
+        if isinstance(readings, list):
+            parsed = [cls._ranked(reading) for reading in readings]
+            if len(parsed) > 1 and None not in parsed and parsed[0][0] == found:
+                return parsed
+        runner_up = cls.runner_up_in(record=record)
+        return [(found, 0.0), runner_up] if runner_up is not None else []
 
     @classmethod
     def runner_up_in(cls, result=None, record=None) -> tuple[SketchOrientation, float] | None:
@@ -129,24 +192,21 @@ class SketchOrientation:
         True
         """
         if result is not None:
-            if cls.found_in(result) is None:
-                return None
-            from ursim_core.matching.orientation import next_reading
-
-            found = next_reading(result.orientation, getattr(result, "orientation_scan", None) or {})
-            if found is None:
-                return None
-            (degrees, mirrored), gap = found
-            return cls._read(degrees, mirrored), gap
+            readings = cls.readings_in(result)
+            return readings[1] if readings else None
         try:
-            runner_up = record["next_reading"]
-            degrees, mirrored, gap = (
-                float(runner_up["degrees"]),
-                runner_up["mirrored"],
-                float(runner_up["ranked_worse_by"]),
-            )
-        except (KeyError, TypeError, ValueError):
+            return cls._ranked(record["next_reading"])
+        except (KeyError, TypeError):
             return None  # an older file, or one a person or another tool wrote
+
+    @classmethod
+    def _ranked(cls, entry) -> tuple[SketchOrientation, float] | None:
+        """A reading of a ``matcher`` record (``{"degrees", "mirrored", "ranked_worse_by"}``) and its
+        gap; None when it is not one (a file a person or another tool wrote)."""
+        try:
+            degrees, mirrored, gap = float(entry["degrees"]), entry["mirrored"], float(entry["ranked_worse_by"])
+        except (KeyError, TypeError, ValueError):
+            return None
         if not isinstance(mirrored, bool) or not math.isfinite(degrees) or not math.isfinite(gap):
             return None
         return cls._read(degrees, mirrored), gap

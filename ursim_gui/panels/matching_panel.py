@@ -135,8 +135,11 @@ class MatchingPanel(QWidget):
     match_requested = Signal(object)
     #: The sketch orientation changed (a :class:`~ursim_gui.model.orientation.SketchOrientation`).
     orientation_changed = Signal(object)
-    #: Whether a runner-up reading is offered may have changed (:meth:`runner_up_offered`).
+    #: Whether a runner-up reading, or readings to compare, are offered may have changed
+    #: (:meth:`runner_up_offered`, :meth:`readings_offered`).
     runner_up_changed = Signal()
+    #: The user asked to compare the readings side by side (:attr:`readings`).
+    readings_requested = Signal()
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -272,6 +275,19 @@ class MatchingPanel(QWidget):
         )
         self.try_runner_up.clicked.connect(self.match_runner_up)
         form.addRow(self.try_runner_up)
+        # Every reading the matcher ranked, kept while the user matches in them one by one (a told
+        # match ranks none), until a match ranks readings again or the orientation leaves them.
+        self.readings: list[tuple[SketchOrientation, float]] = []
+        #: The reading of the answer shown now (the one the last match laid the sketch in).
+        self.answer_reading: SketchOrientation | None = None
+        self.compare_readings = QPushButton("")
+        self.compare_readings.setObjectName("orient_compare_readings")
+        self.compare_readings.setToolTip(
+            "See the sketch turned as each reading the matcher ranked, beside the metric map, and "
+            "match in the one that fits"
+        )
+        self.compare_readings.clicked.connect(self.readings_requested)
+        form.addRow(self.compare_readings)
         self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
         self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
         self.angle.editingFinished.connect(lambda: self.set_orientation(self.orientation.at(self.angle.value())))
@@ -363,18 +379,27 @@ class MatchingPanel(QWidget):
         self.try_runner_up.setVisible(self.runner_up_offered())
         if self.runner_up is not None:
             self.try_runner_up.setText(f"Match as read next best: {self.runner_up.describe()}")
+        self.compare_readings.setVisible(self.readings_offered())
+        self.compare_readings.setText(f"Compare the {len(self.readings)} readings…")
         self.runner_up_changed.emit()
 
     def runner_up_offered(self) -> bool:
         """Whether the last match ranked another reading next, not the orientation set now."""
         return self.runner_up is not None and self.runner_up != self.orientation
 
+    def readings_offered(self) -> bool:
+        """Whether the last match that chose the orientation ranked more than one reading."""
+        return len(self.readings) > 1
+
     def match_runner_up(self) -> None:
         """Tell the matcher the runner-up reading (the view turns to it) and ask for a match;
         nothing when none is offered."""
-        if not self.runner_up_offered():
-            return
-        self.set_orientation(self.runner_up)
+        if self.runner_up_offered():
+            self.match_reading(self.runner_up)
+
+    def match_reading(self, reading: SketchOrientation) -> None:
+        """Tell the matcher ``reading`` (the view turns to it) and ask for a match."""
+        self.set_orientation(reading)
         self.match_requested.emit(self.config())
 
     def set_input_kind(self, kind: str | None) -> None:
@@ -389,6 +414,7 @@ class MatchingPanel(QWidget):
         """Enable Match only when both maps are segmented and no job runs."""
         self.match_button.setEnabled(ready)
         self.try_runner_up.setEnabled(ready)
+        self.compare_readings.setEnabled(ready)
 
     def show_result(self, result, *, automatic_cliques: int = 0, record=None) -> None:
         """Summarise the last match, or the file's (``record``: its ``matcher`` record) without one."""
@@ -397,6 +423,12 @@ class MatchingPanel(QWidget):
         # Offered only beside a reading the matcher chose (as the summary names it).
         runner_up = SketchOrientation.runner_up_in(result, None if result is not None else record)
         self.runner_up = runner_up[0] if runner_up is not None and self.found_orientation is not None else None
+        self.answer_reading = SketchOrientation.laid_in(result, record if automatic_cliques else None)
+        readings = SketchOrientation.readings_in(result, None if result is not None else record)
+        if readings and self.found_orientation is not None:
+            self.readings = readings
+        elif self.answer_reading is None or self.answer_reading not in [reading for reading, _ in self.readings]:
+            self.readings = []
         self._show_orientation()
 
 

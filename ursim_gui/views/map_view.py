@@ -19,12 +19,23 @@ from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
 from ursim_gui.views.map_items import ImageItem, grey_to_qimage
 from ursim_gui.views.region_layers import MIN_ID_REGION_PX, RegionLayers
 
-__all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX"]
+__all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX", "oriented_transform"]
 
 #: Largest zoom factor (3200 %).
 MAX_ZOOM = 32.0
 _PIXMAP_CACHE_KB = 192 * 1024
 _WHEEL_STEP = 1.25
+
+
+def oriented_transform(angle: float, mirrored: bool, factor: float = 1.0) -> QTransform:
+    """The transform that shows a map mirrored (left-right) first, then turned ``angle`` degrees
+    counter-clockwise, at ``factor``: the sketch view's, and the reading tiles'."""
+    transform = QTransform()
+    if angle:
+        transform.rotate(-angle)  # Qt turns clockwise for a positive angle (y down)
+    # Called after rotate, the scale applies to the points first: the mirror comes before the turn.
+    transform.scale(-factor if mirrored else factor, factor)
+    return transform
 
 
 class MapView(QGraphicsView):
@@ -97,6 +108,10 @@ class MapView(QGraphicsView):
 
     def has_image(self) -> bool:
         return not self._base.image().isNull()
+
+    def map_image(self) -> QImage:
+        """The map's own image as opened: no overlay, not turned (null when none is shown)."""
+        return self._base.image()
 
     def set_segmentation(self, labels: np.ndarray | None, graph=None) -> None:
         """Use a label image and region graph (``None`` removes every overlay layer)."""
@@ -188,12 +203,7 @@ class MapView(QGraphicsView):
         self.fit_to_window()
 
     def _oriented(self, factor: float) -> QTransform:
-        angle, mirrored = self.orientation
-        transform = QTransform()
-        if angle:
-            transform.rotate(-angle)  # Qt turns clockwise for a positive angle (y down)
-        transform.scale(-factor if mirrored else factor, factor)
-        return transform
+        return oriented_transform(*self.orientation, factor)
 
     def set_zoom(self, factor: float, anchor: QPointF | None = None) -> None:
         """Zoom to ``factor`` (clamped to [fit / 4, 32]).

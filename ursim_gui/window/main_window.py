@@ -261,6 +261,8 @@ class MainWindow(QMainWindow):
         self.matching_panel.match_requested.connect(self.jobs.match)
         self.actions["match"].triggered.connect(lambda: self.jobs.match(self.matching_panel.config()))
         self.actions["match_runner_up"].triggered.connect(self.matching_panel.match_runner_up)
+        self.actions["compare_readings"].triggered.connect(lambda: self.tools.compare_readings())
+        self.matching_panel.readings_requested.connect(lambda: self.tools.compare_readings())
         self.matching_panel.runner_up_changed.connect(self._update_ready)
         self.matching_panel.orientation_changed.connect(
             lambda o: self.views["sketch"].set_orientation(o.angle or 0.0, o.mirrored)
@@ -355,6 +357,7 @@ class MainWindow(QMainWindow):
         self.matching_panel.set_ready(ready)
         self.actions["match"].setEnabled(ready)
         self.actions["match_runner_up"].setEnabled(ready and self.matching_panel.runner_up_offered())
+        self.actions["compare_readings"].setEnabled(ready and self.matching_panel.readings_offered())
         for side, box in self.segmentation_panel.boxes.items():
             box.segment_button.setEnabled(self.session.map(side) is not None and not self.jobs.busy)
 

@@ -92,6 +92,13 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Tell the matcher the reading it ranked next after the last match and match again (Undo gives the answer back)",
         "Edit",
     ),
+    ActionSpec(
+        "compare_readings",
+        "&Compare the readings…",
+        ("Ctrl+Shift+R",),
+        "See the sketch turned as each reading the last match ranked, beside the metric map, and match in one",
+        "Edit",
+    ),
     ActionSpec("clear_selection", "Clear selection", ("Esc",), "Deselect all regions", "Edit"),
     ActionSpec("fit", "&Fit to window", ("F",), "Fit both maps to their views", "View"),
     ActionSpec("zoom_clique", "&Zoom to clique", ("Z",), "Zoom both views to the selected clique", "View"),

@@ -8,6 +8,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QDialog
 
 from ursim_core.errors import UrsimError
@@ -15,6 +16,7 @@ from ursim_gui.model.example import example_inputs
 from ursim_gui.tools.sketch_canvas import SketchSizeDialog, SketchWindow
 from ursim_gui.views import file_dialogs
 from ursim_gui.views.figure_export import export_figure
+from ursim_gui.views.readings_dialog import ReadingsDialog
 from ursim_gui.window import dialogs
 
 __all__ = ["WindowTools"]
@@ -51,6 +53,22 @@ class WindowTools:
             self.session.set_map("sketch", map_from_array(image))
         except (UrsimError, ValueError) as error:
             dialogs.show_error(self.window, "Cannot use the sketch", str(error))
+
+    # ---- orientation ---------------------------------------------------------------------
+    def compare_readings(self) -> ReadingsDialog | None:
+        """Show the readings the last match ranked side by side (:class:`ReadingsDialog`); the one
+        chosen is told to the matcher, which matches again. None when no readings are offered."""
+        panel = self.window.matching_panel
+        if not panel.readings_offered():
+            return None
+        views = self.window.views
+        dialog = ReadingsDialog(
+            views["sketch"].map_image(), views["metric"].map_image(), panel.readings, panel.answer_reading, self.window
+        )
+        dialog.reading_chosen.connect(panel.match_reading)
+        dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+        dialog.open()
+        return dialog
 
     # ---- segmentation input --------------------------------------------------------------------
     def load_label_image(self, side: str, path: Path | None = None) -> bool:

@@ -176,6 +176,10 @@ def test_apply_match_records_what_produced_the_cliques_and_the_file_keeps_it(tmp
     record = author.correspondences.extra["matcher"]
     assert record == match_record(result.config, result)
     assert SketchOrientation.found_in_record(record) == SketchOrientation.found_in(result) is not None
+    # Every reading ranked, as the result has them (the file's gaps to six decimals).
+    from_file, from_result = SketchOrientation.readings_in(record=record), SketchOrientation.readings_in(result)
+    assert len(from_result) > 1 and [r for r, _ in from_file] == [r for r, _ in from_result]
+    assert [gap for _, gap in from_file] == pytest.approx([gap for _, gap in from_result], abs=1e-6)
     author.undo()
     assert "matcher" not in author.correspondences.extra  # the record is part of the edit
     author.redo()

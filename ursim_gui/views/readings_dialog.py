@@ -1,0 +1,153 @@
+"""The readings dialog: the sketch turned as each reading the matcher ranked, beside the metric map.
+
+A close call between two readings (a half-turned row of rooms, a mirror image) is quicker to settle
+by eye than by turning the sketch view through them: each reading is a tile, ranked, with how much
+worse the matcher found it; choosing one tells the matcher that reading and matches again. Of the
+27 generated partial sketches misread on seeds 0-127, the right reading is the runner-up in 16,
+third in 7 and fourth in 2 (docs/studies.md, round 54).
+
+A thin view: it is given the images and the ranked readings and says which one was chosen
+(:attr:`ReadingsDialog.reading_chosen`); the matching panel tells the matcher.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QSize, Qt, Signal
+from PySide6.QtGui import QIcon, QImage, QKeySequence, QPixmap
+from PySide6.QtWidgets import (
+    QDialog,
+    QDialogButtonBox,
+    QGridLayout,
+    QHBoxLayout,
+    QLabel,
+    QToolButton,
+    QVBoxLayout,
+)
+
+from ursim_gui.views.map_view import oriented_transform
+
+__all__ = ["ReadingsDialog", "reading_caption", "turned_picture", "TILE_SIDE"]
+
+#: The longer side of a reading's tile, pixels.
+TILE_SIDE = 220
+
+
+def reading_caption(rank: int, reading, gap: float, *, read: bool, shown: bool) -> str:
+    """A tile's text: its rank, the reading in words, and how it ranked.
+
+    ``read``: the reading the matcher chose; ``shown``: the reading of the answer shown now.
+
+    Examples
+    --------
+    >>> from ursim_gui.model.orientation import SketchOrientation
+    >>> print(reading_caption(1, SketchOrientation(0.0), 0.0, read=True, shown=True))
+    1. upright
+    read by the matcher · shown now
+    >>> print(reading_caption(2, SketchOrientation(180.0, True), 0.005, read=False, shown=False))
+    2. turned 180° counter-clockwise, mirrored
+    ranked 0.5% worse
+    """
+    if read:
+        how = "read by the matcher"
+    else:
+        how = f"ranked {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}"
+    return f"{rank}. {reading.describe()}\n{how}" + (" · shown now" if shown else "")
+
+
+class ReadingsDialog(QDialog):
+    """The metric map, and a tile per reading with the sketch turned to it, best ranked first.
+
+    Parameters
+    ----------
+    sketch, metric : QImage
+        The two maps as their views show them (not turned).
+    readings : list of (SketchOrientation, float)
+        The readings and their gaps, the matcher's own first
+        (``SketchOrientation.readings_in``).
+    shown : SketchOrientation or None
+        The reading of the answer shown now: its tile cannot be chosen again.
+
+    Signals
+    -------
+    reading_chosen(object) : the :class:`~ursim_gui.model.orientation.SketchOrientation` chosen
+    """
+
+    reading_chosen = Signal(object)
+
+    def __init__(self, sketch: QImage, metric: QImage, readings, shown=None, parent=None):
+        super().__init__(parent)
+        self.setWindowTitle("Compare the readings")
+        self.setObjectName("readings_dialog")
+        explanation = QLabel(
+            "The matcher read the sketch in each of these ways and ranked them, best first. Choose "
+            "the one that turns the sketch like the metric map: the matcher is told it and matches "
+            "again (Undo gives the answer back). Keys 1-9 choose a tile."
+        )
+        explanation.setWordWrap(True)
+        metric_label = QLabel()
+        metric_label.setObjectName("readings_metric")
+        metric_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        metric_label.setPixmap(_fitted(QPixmap.fromImage(metric), int(TILE_SIDE * 1.6)))
+        metric_label.setToolTip("The metric map as opened")
+        metric_box = QVBoxLayout()
+        metric_box.addWidget(QLabel("<b>Metric map</b>"))
+        metric_box.addWidget(metric_label, 1)
+        grid = QGridLayout()
+        self.tiles: list[QToolButton] = []
+        columns = 2 if len(readings) <= 4 else 3
+        for index, (reading, gap) in enumerate(readings):
+            tile = QToolButton()
+            tile.setObjectName(f"reading_{index + 1}")
+            tile.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextUnderIcon)
+            picture = turned_picture(sketch, reading)
+            icon = QIcon(picture)
+            # The answer shown now keeps its picture when its tile is disabled: greyed, it would
+            # not compare.
+            icon.addPixmap(picture, QIcon.Mode.Disabled)
+            tile.setIcon(icon)
+            tile.setIconSize(QSize(TILE_SIDE, TILE_SIDE))
+            is_shown = shown is not None and reading == shown
+            tile.setText(reading_caption(index + 1, reading, gap, read=index == 0, shown=is_shown))
+            tile.setEnabled(not is_shown)
+            tile.setToolTip("The answer shown now" if is_shown else "Match in this reading")
+            if index < 9:
+                tile.setShortcut(QKeySequence(str(index + 1)))
+            tile.clicked.connect(lambda _checked=False, reading=reading: self._choose(reading))
+            grid.addWidget(tile, index // columns, index % columns)
+            self.tiles.append(tile)
+        body = QHBoxLayout()
+        body.addLayout(metric_box)
+        body.addLayout(grid)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close)
+        buttons.rejected.connect(self.reject)
+        layout = QVBoxLayout(self)
+        layout.addWidget(explanation)
+        layout.addLayout(body, 1)
+        layout.addWidget(buttons)
+
+    def _choose(self, reading) -> None:
+        self.reading_chosen.emit(reading)
+        self.accept()
+
+
+def turned_picture(image: QImage, reading, side: int = TILE_SIDE) -> QPixmap:
+    """``image`` mirrored and turned as ``reading`` (a ``SketchOrientation``) says, as the sketch
+    view would show it, fitted to a ``side`` x ``side`` square; the corners a free angle uncovers
+    are transparent. Shrunk before it is turned: a building-sized map would take long at full
+    size, for a tile."""
+    if image.isNull():
+        return QPixmap()
+    shrunk = image.scaled(
+        2 * side, 2 * side, Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation
+    ).convertToFormat(QImage.Format.Format_ARGB32_Premultiplied)
+    turned = shrunk.transformed(
+        oriented_transform(reading.angle or 0.0, reading.mirrored), Qt.TransformationMode.SmoothTransformation
+    )
+    return _fitted(QPixmap.fromImage(turned), side)
+
+
+def _fitted(pixmap: QPixmap, side: int) -> QPixmap:
+    """``pixmap`` scaled to fit a ``side`` x ``side`` square (an empty one stays empty)."""
+    if pixmap.isNull():
+        return pixmap
+    return pixmap.scaled(side, side, Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation)
