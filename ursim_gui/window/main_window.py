@@ -273,6 +273,7 @@ class MainWindow(QMainWindow):
         self.session.segmentation_changed.connect(self._show_summary)
         self.session.map_changed.connect(self._show_map_title)
         self._identities = MapIdentities({side: self._digest_of(side) for side in SIDES})
+        self._record_reads_this_sketch = True
         self.session.map_changed.connect(self._forget_settings_of_another_map)
         self.session.document_opened.connect(self._use_recorded_settings)
         self.session.correspondences_changed.connect(lambda *_: self._show_match_summary())
@@ -374,6 +375,9 @@ class MainWindow(QMainWindow):
         panel = self.matching_panel
         if "orientation" in forget:
             panel.set_orientation(SketchOrientation())
+            # The file's record of how its match read the sketch read another sketch.
+            self._record_reads_this_sketch = False
+            self._show_match_summary()
         if "input_kind" in forget:
             panel.set_input_kind(None)
         if "scale" in forget:
@@ -385,10 +389,15 @@ class MainWindow(QMainWindow):
         if settings:
             self.matching_panel.set_input_kind(settings["input_kind"])
             self.matching_panel.set_scale(settings["scale"])
+        # Its record reads its own sketch (opening it may have put another's away first).
+        self._record_reads_this_sketch = True
+        self._show_match_summary()
 
     def _show_match_summary(self) -> None:
         automatic = sum(1 for clique in self.session.correspondences.cliques if clique.source == "auto")
-        record = self.session.correspondences.extra.get("matcher")
+        if self.session.last_match is not None:
+            self._record_reads_this_sketch = True  # the record is this match's
+        record = self.session.correspondences.extra.get("matcher") if self._record_reads_this_sketch else None
         self.matching_panel.show_result(self.session.last_match, automatic_cliques=automatic, record=record)
 
     def _show_summary(self, side: str) -> None:

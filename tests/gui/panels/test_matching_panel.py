@@ -112,12 +112,15 @@ def test_the_orientation_the_matcher_read_can_be_kept(window, qtbot):
 def test_a_file_opened_again_offers_the_orientation_its_match_read(window, qtbot, tmp_path):
     panel = window.matching_panel
     _match_by(window, qtbot, panel.match_button)
-    offered = panel.keep_found.text()
+    offered, readings = panel.keep_found.text(), [reading for reading, _ in panel.readings]
     window.documents.save_as(tmp_path / "pair.json")
     window.documents.open_correspondences(tmp_path / "pair.json")
     assert window.session.last_match is None  # no result in memory: the file's record speaks
     assert "automatic cliques from the file" in panel.summary.text() and "read the sketch" in panel.summary.text()
     assert panel.keep_found.isVisible() and panel.keep_found.text() == offered
+    # The readings to compare, as the match ranked them, and the one its answer was laid in.
+    assert len(readings) > 1 and [reading for reading, _ in panel.readings] == readings
+    assert panel.answer_reading == readings[0] and window.actions["compare_readings"].isEnabled()
     panel.keep_found.click()
     assert window.views["sketch"].orientation == (panel.orientation.angle, panel.orientation.mirrored)
 
