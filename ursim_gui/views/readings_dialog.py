@@ -87,7 +87,7 @@ class ReadingsDialog(QDialog):
         metric_label = QLabel()
         metric_label.setObjectName("readings_metric")
         metric_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        metric_label.setPixmap(_fitted(QPixmap.fromImage(metric), int(TILE_SIDE * 1.6)))
+        metric_label.setPixmap(QPixmap.fromImage(_fitted(metric, int(TILE_SIDE * 1.6))))
         metric_label.setToolTip("The metric map as opened")
         metric_box = QVBoxLayout()
         metric_box.addWidget(QLabel("<b>Metric map</b>"))
@@ -137,17 +137,16 @@ def turned_picture(image: QImage, reading, side: int = TILE_SIDE) -> QPixmap:
     size, for a tile."""
     if image.isNull():
         return QPixmap()
-    shrunk = image.scaled(
-        2 * side, 2 * side, Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation
-    ).convertToFormat(QImage.Format.Format_ARGB32_Premultiplied)
+    shrunk = _fitted(image, 2 * side).convertToFormat(QImage.Format.Format_ARGB32_Premultiplied)
     turned = shrunk.transformed(
         oriented_transform(reading.angle or 0.0, reading.mirrored), Qt.TransformationMode.SmoothTransformation
     )
-    return _fitted(QPixmap.fromImage(turned), side)
+    return QPixmap.fromImage(_fitted(turned, side))
 
 
-def _fitted(pixmap: QPixmap, side: int) -> QPixmap:
-    """``pixmap`` scaled to fit a ``side`` x ``side`` square (an empty one stays empty)."""
-    if pixmap.isNull():
-        return pixmap
-    return pixmap.scaled(side, side, Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation)
+def _fitted(image: QImage, side: int) -> QImage:
+    """``image`` scaled to fit a ``side`` x ``side`` square (an empty one stays empty); an image,
+    not a pixmap, until then: a building-sized map is not copied whole to the screen's format."""
+    if image.isNull():
+        return image
+    return image.scaled(side, side, Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation)
