@@ -257,37 +257,34 @@ class MatchingPanel(QWidget):
         # The orientation the last match found, offered as the known one: the view turns to it and
         # the next match is told it (shown only while it differs from the orientation set).
         self.found_orientation: SketchOrientation | None = None
-        self.keep_found = QPushButton("")
-        self.keep_found.setObjectName("orient_keep_found")
-        self.keep_found.setToolTip(
-            "Turn the sketch view to the orientation the matcher read and tell the matcher it from now on"
+        self.keep_found = _row_button(
+            form,
+            "orient_keep_found",
+            "Turn the sketch view to the orientation the matcher read and tell the matcher it from now on",
+            lambda: self.set_orientation(self.found_orientation or self.orientation),
         )
-        self.keep_found.clicked.connect(lambda: self.set_orientation(self.found_orientation or self.orientation))
-        form.addRow(self.keep_found)
         # The reading the matcher ranked next, one click away: of the 27 generated partial sketches
         # misread (seeds 0-127), 16 are read right in it (docs/studies.md, round 54).
         self.runner_up: SketchOrientation | None = None
-        self.try_runner_up = QPushButton("")
-        self.try_runner_up.setObjectName("orient_try_runner_up")
-        self.try_runner_up.setToolTip(
+        self.try_runner_up = _row_button(
+            form,
+            "orient_try_runner_up",
             "Tell the matcher the reading it ranked next and match again (Undo gives the last answer "
-            "back; 'unknown' lets the matcher choose the orientation again)"
+            "back; 'unknown' lets the matcher choose the orientation again)",
+            self.match_runner_up,
         )
-        self.try_runner_up.clicked.connect(self.match_runner_up)
-        form.addRow(self.try_runner_up)
         # Every reading the matcher ranked, kept while the user matches in them one by one (a told
         # match ranks none), until a match ranks readings again or the orientation leaves them.
         self.readings: list[tuple[SketchOrientation, float]] = []
         #: The reading of the answer shown now (the one the last match laid the sketch in).
         self.answer_reading: SketchOrientation | None = None
-        self.compare_readings = QPushButton("")
-        self.compare_readings.setObjectName("orient_compare_readings")
-        self.compare_readings.setToolTip(
+        self.compare_readings = _row_button(
+            form,
+            "orient_compare_readings",
             "See the sketch turned as each reading the matcher ranked, beside the metric map, and "
-            "match in the one that fits"
+            "match in the one that fits",
+            self.readings_requested,
         )
-        self.compare_readings.clicked.connect(self.readings_requested)
-        form.addRow(self.compare_readings)
         self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
         self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
         self.angle.editingFinished.connect(lambda: self.set_orientation(self.orientation.at(self.angle.value())))
@@ -430,6 +427,16 @@ class MatchingPanel(QWidget):
         elif self.answer_reading is None or self.answer_reading not in [reading for reading, _ in self.readings]:
             self.readings = []
         self._show_orientation()
+
+
+def _row_button(form: QFormLayout, name: str, tooltip: str, slot) -> QPushButton:
+    """A button of its own row of ``form`` whose text says what it offers (set when it is shown)."""
+    button = QPushButton("")
+    button.setObjectName(name)
+    button.setToolTip(tooltip)
+    button.clicked.connect(slot)
+    form.addRow(button)
+    return button
 
 
 def _combo(name: str, items) -> QComboBox:

@@ -106,23 +106,13 @@ def test_compare_the_readings_then_match_in_one_of_them(window, qtbot):
 
 
 def test_another_sketch_puts_the_readings_away(window, qtbot, tmp_path, map_files):
-    import cv2
-
-    from ursim_core.segmentation import load_label_image
-
     panel = window.matching_panel
     with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
         qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
     assert panel.readings_offered() and panel.found_orientation is not None
-    # Another sketch (here the same rooms, one with a pillar drawn in): the cliques stay, by their
-    # points, but how the last match read the sketch was another sketch's reading.
-    image = cv2.imread(str(map_files["sketch"]), cv2.IMREAD_UNCHANGED)
-    image[25:28, 20:23] = 0
-    cv2.imwrite(str(tmp_path / "other_sketch.png"), image)
-    window.session.load_map("sketch", tmp_path / "other_sketch.png")
-    window.session.set_segmentation(
-        "sketch", load_label_image(map_files["sketch_labels"], shape=window.session.map("sketch").shape)
-    )
+    # Another sketch: the cliques stay, by their points, but how the last match read the sketch
+    # was another sketch's reading.
+    _open_another_sketch(window, tmp_path, map_files)
     assert window.session.correspondences.cliques  # kept, and with them the file's record
     assert panel.readings == [] and panel.found_orientation is None and panel.runner_up is None
     assert not window.actions["compare_readings"].isEnabled() and window.tools.compare_readings() is None
@@ -134,15 +124,25 @@ def test_another_sketch_puts_the_readings_away(window, qtbot, tmp_path, map_file
 
 
 def test_a_file_of_another_sketch_opened_offers_its_own_readings(window, qtbot, tmp_path, map_files):
-    import cv2
-
-    from ursim_core.segmentation import load_label_image
-
     panel = window.matching_panel
     with qtbot.waitSignal(window.session.correspondences_changed, timeout=60_000):
         qtbot.mouseClick(panel.match_button, Qt.MouseButton.LeftButton)
     first = panel.readings
     window.documents.save_as(tmp_path / "first.json")
+    _open_another_sketch(window, tmp_path, map_files)
+    assert panel.readings == []
+    # Opening the first file (another sketch than the one open) offers the readings it recorded.
+    window.documents.open_correspondences(tmp_path / "first.json")
+    assert [reading for reading, _ in panel.readings] == [reading for reading, _ in first]
+    assert panel.found_orientation == first[0][0] and panel.keep_found.text()
+
+
+def _open_another_sketch(window, tmp_path, map_files) -> None:
+    """Open and segment another sketch: the same rooms, one with a pillar drawn in."""
+    import cv2
+
+    from ursim_core.segmentation import load_label_image
+
     image = cv2.imread(str(map_files["sketch"]), cv2.IMREAD_UNCHANGED)
     image[25:28, 20:23] = 0
     cv2.imwrite(str(tmp_path / "other_sketch.png"), image)
@@ -150,8 +150,3 @@ def test_a_file_of_another_sketch_opened_offers_its_own_readings(window, qtbot, 
     window.session.set_segmentation(
         "sketch", load_label_image(map_files["sketch_labels"], shape=window.session.map("sketch").shape)
     )
-    assert panel.readings == []
-    # Opening the first file (another sketch than the one open) offers the readings it recorded.
-    window.documents.open_correspondences(tmp_path / "first.json")
-    assert [reading for reading, _ in panel.readings] == [reading for reading, _ in first]
-    assert panel.found_orientation == first[0][0] and panel.keep_found.text()
