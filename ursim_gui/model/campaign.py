@@ -27,7 +27,8 @@ Statuses
 --------
 Read from a pair's file: "not started" (no file), "automatic" (only matcher output, none
 reviewed), "in review" (some cliques reviewed or edited), "done" (every clique accepted
-or rejected).
+or rejected). Beside it, how the matcher read the pair's sketch (its file's ``matcher`` record)
+and whether that was a close call: a campaign's pairs that want an orientation check stand out.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 from ursim_core.correspondences import Correspondences, load_correspondences
 from ursim_core.errors import FormatError, UrsimError
@@ -48,8 +50,10 @@ __all__ = [
     "Campaign",
     "open_campaign",
     "status_of",
+    "PairSummary",
     "pair_summary",
     "summary_of",
+    "reading_of",
 ]
 
 PAIR_STATUSES = ("not started", "automatic", "in review", "done")
@@ -112,22 +116,34 @@ class Campaign:
 
 def status_of(path: Path) -> str:
     """A pair's status from its correspondence file (see the module docstring)."""
-    return pair_summary(path)[0]
+    return pair_summary(path).status
 
 
-def pair_summary(path: Path) -> tuple[str, int, int]:
-    """(status, cliques, reviewed cliques) of a pair's correspondence file."""
+class PairSummary(NamedTuple):
+    """What the campaign list shows of a pair: its status, its cliques and how many are reviewed,
+    how the matcher read its sketch ("" when it was told, or the file does not say) and whether
+    the reading it ranked next came close (:func:`reading_of`)."""
+
+    status: str
+    cliques: int = 0
+    reviewed: int = 0
+    reading: str = ""
+    close_call: bool = False
+
+
+def pair_summary(path: Path) -> PairSummary:
+    """The :class:`PairSummary` of a pair's correspondence file."""
     if not path.is_file():
-        return "not started", 0, 0
+        return PairSummary("not started")
     try:
         corr = load_correspondences(path)
     except UrsimError:
-        return "in review", 0, 0  # a file the user must look at
+        return PairSummary("in review")  # a file the user must look at
     return summary_of(corr)
 
 
-def summary_of(corr: Correspondences) -> tuple[str, int, int]:
-    """(status, cliques, reviewed cliques) of a correspondence value."""
+def summary_of(corr: Correspondences) -> PairSummary:
+    """The :class:`PairSummary` of a correspondence value."""
     cliques = corr.cliques
     reviewed = sum(clique.status is not None for clique in cliques)
     if cliques and reviewed == len(cliques):
@@ -136,7 +152,37 @@ def summary_of(corr: Correspondences) -> tuple[str, int, int]:
         status = "automatic"
     else:
         status = "in review"
-    return status, len(cliques), reviewed
+    return PairSummary(status, len(cliques), reviewed, *reading_of(corr.extra.get("matcher")))
+
+
+def reading_of(record) -> tuple[str, bool]:
+    """How a file's ``matcher`` record says the matcher read the sketch, in words with the gap to
+    the reading it ranked next, and whether that gap makes it a close call
+    (``ursim_core.matching.orientation.CLOSE_READING``); ``("", False)`` when the record does not
+    say (the orientation was told, or no match made the file).
+
+    Examples
+    --------
+    >>> record = {"config": {"orientation": "any"}, "orientation": {"degrees": 180.0, "mirrored": False},
+    ...           "next_reading": {"degrees": 0.0, "mirrored": True, "ranked_worse_by": 0.004}}
+    >>> reading_of(record)
+    ('turned 180° · next best 0.4% worse', True)
+    >>> reading_of({"config": {"orientation": 90.0}}), reading_of(None)
+    (('', False), ('', False))
+    """
+    from ursim_core.matching.orientation import CLOSE_READING
+    from ursim_gui.model.orientation import SketchOrientation
+
+    found = SketchOrientation.found_in_record(record)
+    if found is None:
+        return "", False
+    # Short, for a column: the panel's words without "counter-clockwise".
+    words = found.describe().replace(" counter-clockwise", "")
+    runner_up = SketchOrientation.runner_up_in(record=record)
+    if runner_up is None:
+        return words, False
+    gap = runner_up[1]
+    return f"{words} · next best {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}", gap < CLOSE_READING
 
 
 def open_campaign(

@@ -1,4 +1,4 @@
-"""Campaign panel: the pairs of a campaign with status and counts, a progress bar, previous / next.
+"""Campaign panel: the pairs of a campaign with status, counts and reading, a progress bar, previous / next.
 
 A thin view: it shows what the campaign controller tells it and asks for a pair by
 index; the statuses are computed in :mod:`ursim_gui.model.campaign`.
@@ -21,7 +21,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-__all__ = ["CampaignPanel", "STATUS_COLOURS"]
+__all__ = ["CampaignPanel", "STATUS_COLOURS", "CLOSE_CALL_COLOUR"]
 
 #: Text colour of each status in the list (readable on light and dark backgrounds).
 STATUS_COLOURS = {
@@ -32,8 +32,13 @@ STATUS_COLOURS = {
 }
 
 
+#: Text colour of a reading the matcher found a close call (a pair to check the orientation of).
+CLOSE_CALL_COLOUR = QColor(210, 130, 0)
+
+
 class CampaignPanel(QWidget):
-    """Pairs list (name, status, reviewed / cliques), progress, Previous / Next.
+    """Pairs list (name, status, reviewed / cliques, how the matcher read the sketch), progress,
+    Previous / Next.
 
     Signals
     -------
@@ -53,14 +58,17 @@ class CampaignPanel(QWidget):
         self.progress = QProgressBar()
         self.progress.setObjectName("campaign_progress")
         self.progress.setFormat("%v / %m done")
-        self.table = QTableWidget(0, 3)
+        self.table = QTableWidget(0, 4)
         self.table.setObjectName("campaign_pairs")
-        self.table.setHorizontalHeaderLabels(["Pair", "Status", "Reviewed"])
+        self.table.setHorizontalHeaderLabels(["Pair", "Status", "Reviewed", "Reading"])
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.verticalHeader().setVisible(False)
-        self.table.horizontalHeader().setSectionResizeMode(1, QHeaderView.ResizeMode.Stretch)
+        header = self.table.horizontalHeader()
+        for column in (0, 1, 2):
+            header.setSectionResizeMode(column, QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(3, QHeaderView.ResizeMode.Stretch)
         self.previous_button = QPushButton("◀ Previous (A)")
         self.previous_button.setObjectName("campaign_previous")
         self.next_button = QPushButton("Next (D) ▶")
@@ -89,17 +97,24 @@ class CampaignPanel(QWidget):
         self.table.setRowCount(len(names))
         for row, pair in enumerate(names):
             self.table.setItem(row, 0, QTableWidgetItem(pair))
-            self.table.setItem(row, 1, QTableWidgetItem(""))
-            self.table.setItem(row, 2, QTableWidgetItem(""))
+            for column in (1, 2, 3):
+                self.table.setItem(row, column, QTableWidgetItem(""))
         self.progress.setRange(0, max(1, len(names)))
         self.set_enabled(True)
 
-    def show_pair(self, row: int, status: str, cliques: int, reviewed: int) -> None:
-        """One pair's status and counts."""
+    def show_pair(self, row: int, summary) -> None:
+        """One pair's status, counts and reading (a :class:`~ursim_gui.model.campaign.PairSummary`)."""
         item = self.table.item(row, 1)
-        item.setText(status)
-        item.setForeground(STATUS_COLOURS.get(status, QColor(128, 128, 128)))
-        self.table.item(row, 2).setText(f"{reviewed} / {cliques}" if cliques else "–")
+        item.setText(summary.status)
+        item.setForeground(STATUS_COLOURS.get(summary.status, QColor(128, 128, 128)))
+        self.table.item(row, 2).setText(f"{summary.reviewed} / {summary.cliques}" if summary.cliques else "–")
+        reading = self.table.item(row, 3)
+        reading.setText(summary.reading)
+        # A close call stands out: the pair to open and compare the readings of.
+        reading.setForeground(CLOSE_CALL_COLOUR if summary.close_call else self.palette().text().color())
+        reading.setToolTip(
+            "A close call: check the orientation (Edit > Compare the readings)" if summary.close_call else ""
+        )
 
     def show_progress(self, done: int, total: int) -> None:
         self.progress.setRange(0, max(1, total))
@@ -119,3 +134,6 @@ class CampaignPanel(QWidget):
 
     def status_text(self, row: int) -> str:
         return self.table.item(row, 1).text()
+
+    def reading_text(self, row: int) -> str:
+        return self.table.item(row, 3).text()

@@ -74,7 +74,7 @@ class CampaignController(QObject):
         self.campaign = campaign
         self.panel.show_campaign(campaign.name, [pair.name for pair in campaign.pairs], str(campaign.output_dir))
         for row, pair in enumerate(campaign.pairs):
-            self.panel.show_pair(row, *pair_summary(pair.output))
+            self.panel.show_pair(row, pair_summary(pair.output))
         self._show_progress()
         self.window.docks["campaign"].show()
         self.window.docks["campaign"].raise_()
@@ -190,14 +190,14 @@ class CampaignController(QObject):
             self.pair_ready.emit(campaign.current)
 
     def _show_row(self, row: int) -> None:
-        self.panel.show_pair(row, *pair_summary(self.campaign.pairs[row].output))
+        self.panel.show_pair(row, pair_summary(self.campaign.pairs[row].output))
         self._show_progress()
 
     def _show_current_counts(self, *_args) -> None:
         campaign = self.campaign
         if campaign is None or not self._is_open(campaign.current):
             return
-        self.panel.show_pair(campaign.current, *summary_of(self.session.correspondences))
+        self.panel.show_pair(campaign.current, summary_of(self.session.correspondences))
 
     def _show_progress(self) -> None:
         rows = range(self.panel.table.rowCount())

@@ -25,3 +25,38 @@ def test_plain_folder_and_manifest_campaigns(plain_campaign, tmp_path):
     (plain_campaign / "metric.png").rename(plain_campaign / "other.png")
     with pytest.raises(FormatError, match="exactly one metric map"):
         open_campaign(plain_campaign, data_dir=tmp_path / "data")
+
+
+def _record(gap: float | None, orientation="any") -> dict:
+    record = {"config": {"orientation": orientation}, "orientation": {"degrees": 90.0, "mirrored": True}}
+    if gap is not None:
+        record["next_reading"] = {"degrees": 270.0, "mirrored": True, "ranked_worse_by": gap}
+    return record
+
+
+def test_a_pair_says_how_its_sketch_was_read_and_whether_that_was_a_close_call():
+    from ursim_core.correspondences import Correspondences
+    from ursim_core.matching.orientation import CLOSE_READING
+    from ursim_gui.model.campaign import PairSummary, summary_of
+
+    def summary(record) -> PairSummary:
+        return summary_of(Correspondences(extra={} if record is None else {"matcher": record}))
+
+    assert summary(_record(0.25)) == PairSummary("automatic", 0, 0, "turned 90°, mirrored · next best 25.0% worse")
+    close = summary(_record(CLOSE_READING / 2))
+    assert close.close_call and close.reading.endswith(f"next best {CLOSE_READING / 2:.1%} worse")
+    assert not summary(_record(CLOSE_READING)).close_call
+    assert summary(_record(-0.01)).close_call  # a vote chose a reading another one outranked
+    assert summary(_record(None)) == PairSummary("automatic", 0, 0, "turned 90°, mirrored")  # no runner-up
+    # Told the orientation, or no match made the file: nothing to say.
+    assert summary(_record(0.001, orientation=90.0)).reading == summary(None).reading == ""
+
+
+def test_a_pairs_file_says_its_reading(tmp_path):
+    from ursim_core.correspondences import Correspondences, save_correspondences
+    from ursim_gui.model.campaign import pair_summary
+
+    path = tmp_path / "pair.json"
+    save_correspondences(Correspondences(extra={"matcher": _record(0.001)}), path)
+    assert pair_summary(path).close_call and pair_summary(path).reading.startswith("turned 90°, mirrored")
+    assert pair_summary(tmp_path / "none.json").reading == ""

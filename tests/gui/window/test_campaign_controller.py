@@ -97,3 +97,23 @@ def test_a_campaign_of_robot_maps_is_matched_as_robot_maps(qtbot, tmp_path):
     assert window.matching_panel.config().input_kind == "metric"
     assert window.session.last_match.config.resolved().matcher == "overlay"
     window.close()
+
+
+def test_the_pairs_list_says_how_each_sketch_was_read_and_marks_close_calls(plain_campaign, qtbot, tmp_path):
+    from ursim_gui.model.campaign import PairSummary, reading_of
+    from ursim_gui.panels.campaign_panel import CLOSE_CALL_COLOUR
+
+    out = tmp_path / "out"
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=out)
+    panel = window.campaign_panel
+    record = load_correspondences(out / "s1.json").extra["matcher"]
+    assert panel.reading_text(0) == reading_of(record)[0] != ""  # matched with the orientation unknown
+    assert panel.reading_text(1) == panel.reading_text(2) == ""  # not matched yet
+    # A close call stands out in the list, and says what to do.
+    panel.show_pair(1, PairSummary("automatic", 3, 0, "turned 180° · next best 0.4% worse", close_call=True))
+    item = panel.table.item(1, 3)
+    assert item.text() == "turned 180° · next best 0.4% worse" and item.foreground().color() == CLOSE_CALL_COLOUR
+    assert "Compare the readings" in item.toolTip()
+    window.close()
