@@ -257,18 +257,20 @@ def misplaced_doors(pairs, sketch_graph: nx.Graph, metric_graph: nx.Graph) -> fl
     return float(np.mean(distances))
 
 
-def describe_gap(gap: float) -> str:
-    """How much worse the runner-up reading ranked (:func:`next_reading`), in words, with the hint
-    to check the orientation when the call was close (:data:`CLOSE_READING`); what ``ursim match``
-    prints and the app shows.
+def describe_gap(gap: float, *, hint: bool = True) -> str:
+    """How much worse a reading ranked than the one taken (:func:`ranked_readings`), in words, with
+    the hint to check the orientation when the call was close (:data:`CLOSE_READING`; not with
+    ``hint=False``); what ``ursim match`` prints and the app shows.
 
     Examples
     --------
     >>> describe_gap(0.25), describe_gap(0.004)
     ('ranked 25.0% worse', 'ranked 0.4% worse: a close call, check the orientation')
+    >>> describe_gap(-0.01, hint=False)
+    'ranked 1.0% better'
     """
     text = f"ranked {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}"
-    return text + (": a close call, check the orientation" if gap < CLOSE_READING else "")
+    return text + (": a close call, check the orientation" if hint and gap < CLOSE_READING else "")
 
 
 #: Wall-angle differences below this many degrees are taken as none: the candidates are then the

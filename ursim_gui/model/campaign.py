@@ -166,11 +166,11 @@ def reading_of(record) -> tuple[str, bool]:
     >>> record = {"config": {"orientation": "any"}, "orientation": {"degrees": 180.0, "mirrored": False},
     ...           "next_reading": {"degrees": 0.0, "mirrored": True, "ranked_worse_by": 0.004}}
     >>> reading_of(record)
-    ('turned 180° · next best 0.4% worse', True)
+    ('turned 180° · next ranked 0.4% worse', True)
     >>> reading_of({"config": {"orientation": 90.0}}), reading_of(None)
     (('', False), ('', False))
     """
-    from ursim_core.matching.orientation import CLOSE_READING
+    from ursim_core.matching.orientation import CLOSE_READING, describe_gap
     from ursim_gui.model.orientation import SketchOrientation
 
     found = SketchOrientation.found_in_record(record)
@@ -182,7 +182,7 @@ def reading_of(record) -> tuple[str, bool]:
     if runner_up is None:
         return words, False
     gap = runner_up[1]
-    return f"{words} · next best {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}", gap < CLOSE_READING
+    return f"{words} · next {describe_gap(gap, hint=False)}", gap < CLOSE_READING
 
 
 def open_campaign(

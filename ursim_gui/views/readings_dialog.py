@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from ursim_core.matching.orientation import describe_gap
 from ursim_gui.views.map_view import oriented_transform
 
 __all__ = ["ReadingsDialog", "reading_caption", "turned_picture", "TILE_SIDE"]
@@ -47,10 +48,7 @@ def reading_caption(rank: int, reading, gap: float, *, read: bool, shown: bool) 
     2. turned 180° counter-clockwise, mirrored
     ranked 0.5% worse
     """
-    if read:
-        how = "read by the matcher"
-    else:
-        how = f"ranked {abs(gap):.1%} {'worse' if gap >= 0 else 'better'}"
+    how = "read by the matcher" if read else describe_gap(gap, hint=False)
     return f"{rank}. {reading.describe()}\n{how}" + (" · shown now" if shown else "")
 
 

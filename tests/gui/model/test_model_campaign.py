@@ -42,9 +42,9 @@ def test_a_pair_says_how_its_sketch_was_read_and_whether_that_was_a_close_call()
     def summary(record) -> PairSummary:
         return summary_of(Correspondences(extra={} if record is None else {"matcher": record}))
 
-    assert summary(_record(0.25)) == PairSummary("automatic", 0, 0, "turned 90°, mirrored · next best 25.0% worse")
+    assert summary(_record(0.25)) == PairSummary("automatic", 0, 0, "turned 90°, mirrored · next ranked 25.0% worse")
     close = summary(_record(CLOSE_READING / 2))
-    assert close.close_call and close.reading.endswith(f"next best {CLOSE_READING / 2:.1%} worse")
+    assert close.close_call and close.reading.endswith(f"next ranked {CLOSE_READING / 2:.1%} worse")
     assert not summary(_record(CLOSE_READING)).close_call
     assert summary(_record(-0.01)).close_call  # a vote chose a reading another one outranked
     assert summary(_record(None)) == PairSummary("automatic", 0, 0, "turned 90°, mirrored")  # no runner-up

@@ -112,8 +112,8 @@ def test_the_pairs_list_says_how_each_sketch_was_read_and_marks_close_calls(plai
     assert panel.reading_text(0) == reading_of(record)[0] != ""  # matched with the orientation unknown
     assert panel.reading_text(1) == panel.reading_text(2) == ""  # not matched yet
     # A close call stands out in the list, and says what to do.
-    panel.show_pair(1, PairSummary("automatic", 3, 0, "turned 180° · next best 0.4% worse", close_call=True))
+    panel.show_pair(1, PairSummary("automatic", 3, 0, "turned 180° · next ranked 0.4% worse", close_call=True))
     item = panel.table.item(1, 3)
-    assert item.text() == "turned 180° · next best 0.4% worse" and item.foreground().color() == CLOSE_CALL_COLOUR
+    assert item.text() == "turned 180° · next ranked 0.4% worse" and item.foreground().color() == CLOSE_CALL_COLOUR
     assert "Compare the readings" in item.toolTip()
     window.close()
