@@ -12,7 +12,7 @@ A thin view: it is given the images and the ranked readings and says which one w
 
 from __future__ import annotations
 
-from PySide6.QtCore import QSize, Qt, Signal
+from PySide6.QtCore import QRect, QSize, Qt, Signal
 from PySide6.QtGui import QIcon, QImage, QKeySequence, QPixmap
 from PySide6.QtWidgets import (
     QDialog,
@@ -27,7 +27,7 @@ from PySide6.QtWidgets import (
 from ursim_core.matching.orientation import describe_gap
 from ursim_gui.views.map_view import oriented_transform
 
-__all__ = ["ReadingsDialog", "reading_caption", "turned_picture", "TILE_SIDE"]
+__all__ = ["ReadingsDialog", "reading_caption", "turned_picture", "drawn_part", "TILE_SIDE"]
 
 #: The longer side of a reading's tile, pixels.
 TILE_SIDE = 220
@@ -140,6 +140,29 @@ def turned_picture(image: QImage, reading, side: int = TILE_SIDE) -> QPixmap:
         oriented_transform(reading.angle or 0.0, reading.mirrored), Qt.TransformationMode.SmoothTransformation
     )
     return QPixmap.fromImage(_fitted(turned, side))
+
+
+def drawn_part(image: QImage, box) -> QImage:
+    """The part of ``image`` inside ``box`` (``(first row, end row, first col, end col)``, the free
+    space's box, as ``ursim_core.matching.template.free_box`` gives it) with a margin of 2 % of its
+    longer side, within the image: a sketch drawn small on a large sheet fills its tile. The whole
+    image when ``box`` is None.
+
+    Examples
+    --------
+    >>> image = QImage(100, 50, QImage.Format.Format_Grayscale8)
+    >>> part = drawn_part(image, (10, 20, 30, 70))
+    >>> part.width(), part.height()
+    (42, 12)
+    """
+    if box is None or image.isNull():
+        return image
+    first_row, end_row, first_col, end_col = box
+    margin = max(1, round(0.02 * max(end_row - first_row, end_col - first_col)))
+    area = QRect(
+        first_col - margin, first_row - margin, end_col - first_col + 2 * margin, end_row - first_row + 2 * margin
+    )
+    return image.copy(area.intersected(image.rect()))
 
 
 def _fitted(image: QImage, side: int) -> QImage:

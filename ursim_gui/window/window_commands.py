@@ -16,7 +16,7 @@ from ursim_gui.model.example import example_inputs
 from ursim_gui.tools.sketch_canvas import SketchSizeDialog, SketchWindow
 from ursim_gui.views import file_dialogs
 from ursim_gui.views.figure_export import export_figure
-from ursim_gui.views.readings_dialog import ReadingsDialog
+from ursim_gui.views.readings_dialog import ReadingsDialog, drawn_part
 from ursim_gui.window import dialogs
 
 __all__ = ["WindowTools"]
@@ -61,10 +61,14 @@ class WindowTools:
         panel = self.window.matching_panel
         if not panel.readings_offered():
             return None
-        views = self.window.views
-        dialog = ReadingsDialog(
-            views["sketch"].map_image(), views["metric"].map_image(), panel.readings, panel.answer_reading, self.window
+        from ursim_core.matching.template import free_box
+
+        # Each map's drawn part: a sketch drawn small on a large sheet would be a speck in its tile.
+        sketch, metric = (
+            drawn_part(self.window.views[side].map_image(), free_box(self.session.map(side).free))
+            for side in ("sketch", "metric")
         )
+        dialog = ReadingsDialog(sketch, metric, panel.readings, panel.answer_reading, self.window)
         dialog.reading_chosen.connect(panel.match_reading)
         dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
         dialog.open()

@@ -7,7 +7,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor, QIcon, QImage
 
 from ursim_gui.model.orientation import SketchOrientation
-from ursim_gui.views.readings_dialog import ReadingsDialog, turned_picture
+from ursim_gui.views.readings_dialog import ReadingsDialog, drawn_part, turned_picture
 
 READINGS = [
     (SketchOrientation(0.0, False), 0.0),
@@ -48,6 +48,22 @@ def test_each_tile_shows_the_sketch_as_its_reading_turns_it(qapp):  # pixmaps ne
     free = _pixels(turned_picture(_marked_image(), SketchOrientation(30.0), side=80))
     assert free[0, 0, 3] == 0 and free[free.shape[0] // 2, free.shape[1] // 2, 3] == 255
     assert turned_picture(QImage(), SketchOrientation(0.0)).isNull()
+
+
+def test_a_sketch_drawn_small_on_a_large_sheet_fills_its_tile(qapp):
+    sheet = QImage(400, 300, QImage.Format.Format_ARGB32)
+    sheet.fill(QColor("black"))
+    for row in range(100, 150):
+        for col in range(200, 300):
+            sheet.setPixelColor(col, row, QColor("white"))
+    part = drawn_part(sheet, (100, 150, 200, 300))  # rows 100-149, columns 200-299: 2 px of margin
+    assert (part.width(), part.height()) == (104, 54)
+    tile = _pixels(turned_picture(part, SketchOrientation(0.0), side=104))
+    assert tile[27, 52, :3].min() > 200 and tile[0, 0, :3].max() < 50  # the block fills it; the margin stays dark
+    # Near the image's edge the margin stops at it; no box (no free space) is the whole image.
+    corner = drawn_part(sheet, (0, 10, 390, 400))  # a margin of 1 px, cut at the top and the right
+    assert (corner.width(), corner.height()) == (11, 11)
+    assert drawn_part(sheet, None).size() == sheet.size()
 
 
 def test_the_tiles_rank_the_readings_and_choosing_one_says_which(qtbot):
