@@ -58,7 +58,7 @@ class ReadingsDialog(QDialog):
     Parameters
     ----------
     sketch, metric : QImage
-        The two maps as their views show them (not turned).
+        The two maps, not turned (the app gives each map's drawn part, :func:`drawn_part`).
     readings : list of (SketchOrientation, float)
         The readings and their gaps, the matcher's own first
         (``SketchOrientation.readings_in``).
@@ -86,7 +86,7 @@ class ReadingsDialog(QDialog):
         metric_label.setObjectName("readings_metric")
         metric_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
         metric_label.setPixmap(QPixmap.fromImage(_fitted(metric, int(TILE_SIDE * 1.6))))
-        metric_label.setToolTip("The metric map as opened")
+        metric_label.setToolTip("The metric map, not turned")
         metric_box = QVBoxLayout()
         metric_box.addWidget(QLabel("<b>Metric map</b>"))
         metric_box.addWidget(metric_label, 1)
