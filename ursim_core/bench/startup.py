@@ -24,6 +24,7 @@ STARTUP_TARGETS: dict[str, float | None] = {
     "python -c pass": None,
     "ursim --help": 0.15,
     "ursim match (KTH 00 vs model)": 0.5,
+    "ursim match (KTH 00 turned 30 deg)": None,
     "ursim segment (KTH model)": 1.04,
 }
 _TARGET_NOTES = {
@@ -72,6 +73,12 @@ def bench_startup(kth: Path | None, *, repeats: int = 5) -> list[dict]:
             cases.append(
                 ("ursim match (KTH 00 vs model)", [*ursim, "match", str(sketch), str(model), "-o", str(out / "m")])
             )
+            # A sketch drawn at an angle: segmented in six resamplings, which the matcher votes over.
+            turned = out / "00_turned_30.png"
+            _write_turned(sketch, turned, 30.0)
+            cases.append(
+                ("ursim match (KTH 00 turned 30 deg)", [*ursim, "match", str(turned), str(model), "-o", str(out / "t")])
+            )
             cases.append(
                 (
                     "ursim segment (KTH model)",
@@ -95,8 +102,20 @@ def bench_startup(kth: Path | None, *, repeats: int = 5) -> list[dict]:
         shutil.rmtree(out, ignore_errors=True)
 
 
+def _write_turned(source: Path, target: Path, degrees: float) -> None:
+    """The map image ``source`` turned by ``degrees`` on a canvas that holds it, as a PNG at ``target``."""
+    import cv2
+
+    from ursim_core.evaluation.augment import Orientation, transform_image
+    from ursim_core.io.maps import load_map
+
+    free = transform_image(load_map(source).free, Orientation(degrees))
+    if not cv2.imwrite(str(target), free.astype("uint8") * 255):
+        raise OSError(f"{target}: could not write the turned sketch")
+
+
 def print_startup(rows: list[dict]) -> None:
-    print(f"{'case':<32} {'median s':>9} {'min s':>7} {'target s':>9}  verdict")
+    print(f"{'case':<36} {'median s':>9} {'min s':>7} {'target s':>9}  verdict")
     for row in rows:
         target = row["target_s"]
         if target is None:
@@ -106,7 +125,7 @@ def print_startup(rows: list[dict]) -> None:
             target_text = f"{target:.2f}"
             if row["case"] in _TARGET_NOTES:
                 verdict += f" ({_TARGET_NOTES[row['case']]})"
-        print(f"{row['case']:<32} {row['median_s']:>9.3f} {row['min_s']:>7.3f} {target_text:>9}  {verdict}")
+        print(f"{row['case']:<36} {row['median_s']:>9.3f} {row['min_s']:>7.3f} {target_text:>9}  {verdict}")
     print(f"(median of {rows[0]['n'] if rows else 0} fresh processes after one warm-up run)")
 
 

@@ -262,10 +262,25 @@ def canonical_pose(free: np.ndarray) -> tuple[int, bool]:
 
 
 def _renumber(labels: np.ndarray) -> np.ndarray:
-    """Region ids made consecutive (1..N) in their old order; 0 stays 0."""
-    ids, inverse = np.unique(labels, return_inverse=True)
-    offset = 0 if ids[0] == 0 else 1
-    return (np.arange(ids.size, dtype=np.int32) + offset)[inverse].reshape(labels.shape)
+    """Region ids (non-negative) made consecutive (1..N) in their old order; 0 stays 0.
+
+    By a table indexed by id, not :func:`numpy.unique`: its sort of every pixel took 0.6 of the
+    0.7 s of each of the six segmentations of a KTH sketch turned by 30 degrees (its canvas of 3.4
+    million pixels, round 57); the table takes milliseconds and gives the same ids.
+
+    Examples
+    --------
+    >>> _renumber(np.array([[0, 7, 7], [3, 0, 9]])).tolist()
+    [[0, 2, 2], [1, 0, 3]]
+    """
+    labels = np.asarray(labels)
+    if labels.size == 0:
+        return labels.astype(np.int32)
+    present = np.bincount(labels.ravel()) > 0
+    table = np.cumsum(present, dtype=np.int32)  # the rank among the ids present, from 1
+    if present[0]:
+        table -= 1  # 0 is present: it keeps 0 and the others count from 1
+    return table[labels]
 
 
 def turn_on_canvas(shape: tuple[int, int], degrees: float) -> tuple[np.ndarray, tuple[int, int]]:

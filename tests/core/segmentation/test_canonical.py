@@ -18,6 +18,7 @@ from ursim_core.segmentation import (
 )
 from ursim_core.segmentation.canonical import (
     RESAMPLING_OFFSETS,
+    _renumber,
     _turned,
     _voted_angle,
     canonical_labels,
@@ -239,3 +240,16 @@ def test_a_turned_map_is_smoothed_once_on_its_axes_before_it_is_segmented():
     seen.clear()
     canonical_labels(plan.free, record)
     assert np.array_equal(seen[0], dihedral(plan.free, *canonical_pose(plan.free)))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_renumbering_keeps_the_order_of_the_ids_and_zero(seed):
+    # The table by id gives what the sort of every pixel gave (numpy.unique), zero present or not.
+    rng = np.random.default_rng(seed)
+    for low in (0, 1):
+        labels = rng.choice(rng.integers(low, 5000, 40), size=(37, 53)).astype(np.int32)
+        ids, inverse = np.unique(labels, return_inverse=True)
+        expected = (np.arange(ids.size) + (0 if ids[0] == 0 else 1))[inverse].reshape(labels.shape)
+        renumbered = _renumber(labels)
+        assert renumbered.dtype == np.int32
+        assert np.array_equal(renumbered, expected)
