@@ -19,10 +19,12 @@ from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
 from ursim_gui.views.map_items import ImageItem, grey_to_qimage
 from ursim_gui.views.region_layers import MIN_ID_REGION_PX, RegionLayers
 
-__all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX", "oriented_transform"]
+__all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX", "DRAWN_MARGIN", "drawn_area", "oriented_transform"]
 
 #: Largest zoom factor (3200 %).
 MAX_ZOOM = 32.0
+#: Around a map's drawn part, the view fits this share of its longer side as a margin.
+DRAWN_MARGIN = 0.05
 _PIXMAP_CACHE_KB = 192 * 1024
 _WHEEL_STEP = 1.25
 
@@ -36,6 +38,21 @@ def oriented_transform(angle: float, mirrored: bool, factor: float = 1.0) -> QTr
     # Called after rotate, the scale applies to the points first: the mirror comes before the turn.
     transform.scale(-factor if mirrored else factor, factor)
     return transform
+
+
+def drawn_area(box, margin: float) -> QRectF:
+    """The scene rectangle of a drawn part ``box`` (``(first row, end row, first col, end col)``, as
+    ``ursim_core.matching.template.free_box`` gives the free space's) with ``margin`` times its
+    longer side (at least a pixel) on every side; not clipped to the image.
+
+    Examples
+    --------
+    >>> drawn_area((10, 20, 30, 70), 0.02).getRect()
+    (29.0, 9.0, 42.0, 12.0)
+    """
+    first_row, end_row, first_col, end_col = box
+    pad = max(1, round(margin * max(end_row - first_row, end_col - first_col)))
+    return QRectF(first_col - pad, first_row - pad, end_col - first_col + 2 * pad, end_row - first_row + 2 * pad)
 
 
 class MapView(QGraphicsView):
@@ -83,6 +100,8 @@ class MapView(QGraphicsView):
         self.layers = RegionLayers(self.scene())
         self._hovered = 0
         self._fitted = False
+        #: The scene rectangle a fit shows: the drawn part and its margin (the whole map when null).
+        self._drawn = QRectF()
         self._press_pos = None
         self._panning = False
         self._stroke: list[tuple[int, int]] | None = None
@@ -94,15 +113,22 @@ class MapView(QGraphicsView):
         self.verticalScrollBar().valueChanged.connect(self.viewport_changed)
 
     # ---- content -----------------------------------------------------------------
-    def set_image(self, grey: np.ndarray | None) -> None:
-        """Show a grey map image (``None`` clears the view) and fit it to the window."""
+    def set_image(self, grey: np.ndarray | None, drawn=None) -> None:
+        """Show a grey map image (``None`` clears the view) and fit its drawn part to the window.
+
+        ``drawn``: the box of the drawn part, ``(first row, end row, first col, end col)`` (the free
+        space's, ``ursim_core.matching.template.free_box``): a fit shows it with a margin of
+        :data:`DRAWN_MARGIN`, so a sketch drawn small on a large sheet fills the view. None: the whole map.
+        """
         self.set_segmentation(None, None)
         if grey is None:
             self._base.set_image(QImage())
             self.scene().setSceneRect(QRectF())
+            self._drawn = QRectF()
         else:
             self._base.set_image(*grey_to_qimage(grey))
             self.scene().setSceneRect(QRectF(0, 0, grey.shape[1], grey.shape[0]))
+            self._drawn = QRectF() if drawn is None else drawn_area(drawn, DRAWN_MARGIN) & self.sceneRect()
             self.fit_to_window()
         self.viewport().update()
 
@@ -228,10 +254,13 @@ class MapView(QGraphicsView):
         self.viewport_changed.emit()
 
     def fit_to_window(self) -> None:
-        """Show the whole map; it stays fitted when the view is resized until a zoom."""
+        """Show the map's drawn part (the whole map when none was given, see :meth:`set_image`); it
+        stays fitted when the view is resized until a zoom."""
         if self.has_image():
             self._fitted = True
-            self.fitInView(self.sceneRect(), Qt.AspectRatioMode.KeepAspectRatio)
+            self.fitInView(
+                self.sceneRect() if self._drawn.isEmpty() else self._drawn, Qt.AspectRatioMode.KeepAspectRatio
+            )
             self.layers.cull_ids(self.zoom_factor())
             self.zoom_changed.emit(self.zoom_factor())
             self.viewport_changed.emit()

@@ -12,7 +12,7 @@ A thin view: it is given the images and the ranked readings and says which one w
 
 from __future__ import annotations
 
-from PySide6.QtCore import QRect, QSize, Qt, Signal
+from PySide6.QtCore import QSize, Qt, Signal
 from PySide6.QtGui import QIcon, QImage, QKeySequence, QPixmap
 from PySide6.QtWidgets import (
     QDialog,
@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
 )
 
 from ursim_core.matching.orientation import describe_gap
-from ursim_gui.views.map_view import oriented_transform
+from ursim_gui.views.map_view import drawn_area, oriented_transform
 
 __all__ = ["ReadingsDialog", "reading_caption", "turned_picture", "drawn_part", "TILE_SIDE"]
 
@@ -157,12 +157,7 @@ def drawn_part(image: QImage, box) -> QImage:
     """
     if box is None or image.isNull():
         return image
-    first_row, end_row, first_col, end_col = box
-    margin = max(1, round(0.02 * max(end_row - first_row, end_col - first_col)))
-    area = QRect(
-        first_col - margin, first_row - margin, end_col - first_col + 2 * margin, end_row - first_row + 2 * margin
-    )
-    return image.copy(area.intersected(image.rect()))
+    return image.copy(drawn_area(box, 0.02).toRect().intersected(image.rect()))
 
 
 def _fitted(image: QImage, side: int) -> QImage:

@@ -13,6 +13,7 @@ import functools
 import numpy as np
 from PySide6.QtGui import QColor
 
+from ursim_core.matching.template import free_box
 from ursim_gui.model.view_state import eval_badges, first_regions, laid_sketch_of, side_colour_table
 
 __all__ = ["ViewBinding", "SIDES"]
@@ -93,7 +94,7 @@ class ViewBinding:
             view.set_image(None)
             return
         grey = map_.image if map_.image is not None else np.where(map_.free, 255, 0).astype(np.uint8)
-        view.set_image(grey)
+        view.set_image(grey, drawn=free_box(map_.free))
         self._segmentation_changed(side)
 
     def _segmentation_changed(self, side: str) -> None:

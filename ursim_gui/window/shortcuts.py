@@ -100,7 +100,9 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Edit",
     ),
     ActionSpec("clear_selection", "Clear selection", ("Esc",), "Deselect all regions", "Edit"),
-    ActionSpec("fit", "&Fit to window", ("F",), "Fit both maps to their views", "View"),
+    ActionSpec(
+        "fit", "&Fit to window", ("F",), "Fit each map's drawn part (its free space and a margin) to its view", "View"
+    ),
     ActionSpec("zoom_clique", "&Zoom to clique", ("Z",), "Zoom both views to the selected clique", "View"),
     ActionSpec("zoom_in", "Zoom &in", ("Ctrl++", "Ctrl+="), "Zoom both views in", "View"),
     ActionSpec("zoom_out", "Zoom &out", ("Ctrl+-",), "Zoom both views out", "View"),

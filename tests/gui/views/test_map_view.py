@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import hover, region_point
-from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtCore import QPoint, QPointF, QRectF, Qt
 from PySide6.QtGui import QPainter, QWheelEvent
 from PySide6.QtWidgets import QApplication
 
@@ -159,3 +159,23 @@ def test_turning_the_sketch_keeps_points_in_the_image_frame(window, qtbot):
     )
     qtbot.keyClick(sketch, Qt.Key.Key_L)
     assert session.correspondences.cliques[0].sketch_points == (interior,)  # original pixel frame
+
+
+def test_a_map_drawn_small_on_a_large_sheet_is_fitted_to_its_drawn_part(qtbot):
+    view = MapView("sketch")
+    qtbot.addWidget(view)
+    view.resize(600, 300)
+    view.show()
+    qtbot.waitExposed(view)
+    grey = np.zeros((1000, 2000), np.uint8)
+    grey[400:500, 900:1100] = 255  # a drawing of 100 x 200 px in the middle of the sheet
+    view.set_image(grey, drawn=(400, 500, 900, 1100))
+    visible = view.mapToScene(view.viewport().rect()).boundingRect()
+    assert visible.contains(QRectF(900, 400, 200, 100))
+    assert visible.width() < 300 and visible.height() < 300  # the drawing and its margin, not the sheet
+    view.set_zoom(view.zoom_factor() / 16)  # a wheel may still zoom out to the whole sheet
+    assert view.mapToScene(view.viewport().rect()).boundingRect().contains(view.sceneRect())
+    view.fit_to_window()
+    assert view.mapToScene(view.viewport().rect()).boundingRect().width() < 300
+    view.set_image(grey)  # no drawn part given: the whole map
+    assert view.mapToScene(view.viewport().rect()).boundingRect().contains(view.sceneRect().adjusted(1, 1, -1, -1))
