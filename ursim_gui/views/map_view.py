@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QPainter, QPalette, QPixmapCache, QTransform
-from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView
+from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView, QStyle
 
 from ursim_gui.views.map_items import ImageItem, grey_to_qimage
 from ursim_gui.views.region_layers import MIN_ID_REGION_PX, RegionLayers
@@ -25,6 +25,8 @@ __all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX", "DRAWN_MARGIN", "drawn_are
 MAX_ZOOM = 32.0
 #: Around a map's drawn part, the view fits this share of its longer side as a margin.
 DRAWN_MARGIN = 0.05
+# Pixels left free around a fitted map on each axis (QGraphicsView.fitInView leaves 4).
+_FIT_PADDING = 4
 _PIXMAP_CACHE_KB = 192 * 1024
 _WHEEL_STEP = 1.25
 
@@ -256,14 +258,25 @@ class MapView(QGraphicsView):
     def fit_to_window(self) -> None:
         """Show the map's drawn part (the whole map when none was given, see :meth:`set_image`); it
         stays fitted when the view is resized until a zoom."""
-        if self.has_image():
-            self._fitted = True
-            self.fitInView(
-                self.sceneRect() if self._drawn.isEmpty() else self._drawn, Qt.AspectRatioMode.KeepAspectRatio
-            )
-            self.layers.cull_ids(self.zoom_factor())
-            self.zoom_changed.emit(self.zoom_factor())
-            self.viewport_changed.emit()
+        if not self.has_image():
+            return
+        self._fitted = True
+        shown = self.sceneRect() if self._drawn.isEmpty() else self._drawn
+        # Fitted to the viewport as it is with both scroll bars shown, whether they are or not. A
+        # drawn part smaller than the sheet brings the bars, which shrink the viewport; fitted to
+        # the viewport as it was (QGraphicsView.fitInView), each resize that followed fitted it
+        # again at the other zoom, without end (a KTH campaign hung on sketch 20, round 57).
+        available = self.maximumViewportSize()
+        bar = self.style().pixelMetric(QStyle.PixelMetric.PM_ScrollBarExtent, None, self)
+        width, height = available.width() - bar - _FIT_PADDING, available.height() - bar - _FIT_PADDING
+        turned = self._oriented(1.0).mapRect(shown)
+        if width > 0 and height > 0 and not turned.isEmpty():
+            factor = min(MAX_ZOOM, width / turned.width(), height / turned.height())
+            self.setTransform(self._oriented(factor))
+            self.centerOn(shown.center())
+        self.layers.cull_ids(self.zoom_factor())
+        self.zoom_changed.emit(self.zoom_factor())
+        self.viewport_changed.emit()
 
     def zoom_to_regions(self, regions, *, margin: float = 0.25) -> bool:
         """Zoom onto the bounding box of ``regions`` (graph ``bbox`` attributes), with a margin.

@@ -179,3 +179,21 @@ def test_a_map_drawn_small_on_a_large_sheet_is_fitted_to_its_drawn_part(qtbot):
     assert view.mapToScene(view.viewport().rect()).boundingRect().width() < 300
     view.set_image(grey)  # no drawn part given: the whole map
     assert view.mapToScene(view.viewport().rect()).boundingRect().contains(view.sceneRect().adjusted(1, 1, -1, -1))
+
+
+@pytest.mark.parametrize("cols", [820, 830, 840, 850, 900])
+def test_a_fit_that_brings_scroll_bars_settles(qtbot, cols):
+    # The drawn part smaller than the sheet: fitted, the sheet overflows and the bars come; a fit
+    # to the viewport as it then is went back and forth between two zooms without end (round 57).
+    view = MapView("sketch")
+    qtbot.addWidget(view)
+    view.resize(600, 300)
+    view.show()
+    qtbot.waitExposed(view)
+    zooms = []
+    view.zoom_changed.connect(zooms.append)
+    view.set_image(np.full((400, cols), 255, np.uint8), drawn=(4, 396, 60, cols - 60))
+    qtbot.wait(200)
+    assert len(zooms) < 6
+    visible = view.mapToScene(view.viewport().rect()).boundingRect()
+    assert visible.contains(QRectF(60, 4, cols - 120, 392))  # the drawn part whole, bars or not
