@@ -203,6 +203,10 @@ def _learned(free: np.ndarray, **params: Any) -> np.ndarray:
 
 #: Segmenters by name: ``callable(free, **params) -> int32 label image``.
 SEGMENTERS: dict[str, Any] = {"maoris": _maoris, "watershed": _watershed, "learned": _learned}
+#: The segmenters that label only the box of a mask's free pixels (and a pixel around it), alike
+#: wherever that box lies: a canonical segmentation gives them only that part of its canvas
+#: (:func:`~ursim_core.segmentation.canonical.canonical_labels`, ``free_box_only``).
+SEGMENTERS_OF_THE_FREE_BOX = frozenset({"maoris"})
 
 #: The segmenter and preset to use by kind of map, ``(method, preset)``: the best
 #: cross-validated on ``maoris_segmentation`` (:mod:`ursim_core.segmentation.presets_cv`):
@@ -353,6 +357,7 @@ def segment(
             free,
             lambda pose: SEGMENTERS[method](pose, **settings),
             turn_offset=resolved.get("canonical_turn_offset", 0.0),
+            free_box_only=method in SEGMENTERS_OF_THE_FREE_BOX,
         )
     else:
         labels = np.asarray(SEGMENTERS[method](free, **settings), dtype=np.int32)

@@ -217,6 +217,17 @@ def _pca_shape_of_padded(padded: np.ndarray) -> float:
 
 def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Runs of equal non-zero labels along the rows: ``(label, row, col_start, col_stop)``."""
+    # Found in the box of the non-zero labels (the same runs: 0 lies on every side of it): a
+    # sketch turned by 30 degrees has 3.6 million pixels for 0.3 million labelled, and the
+    # passes below took 10 ms of its region table's 24 against 3 in the box.
+    nonzero_rows = np.flatnonzero(labels.any(axis=1))
+    if nonzero_rows.size:
+        top, bottom = int(nonzero_rows[0]), int(nonzero_rows[-1]) + 1
+        nonzero_cols = np.flatnonzero(labels[top:bottom].any(axis=0))
+        left, right = int(nonzero_cols[0]), int(nonzero_cols[-1]) + 1
+        if (top, left, bottom, right) != (0, 0, *labels.shape):
+            run_labels, run_rows, run_cols, stops = _runs(labels[top:bottom, left:right])
+            return run_labels, run_rows + top, run_cols + left, stops + left
     cols = labels.shape[1]
     # In bands of rows, as adjacent_pairs: a full-size mask was 64 MB of fresh memory at 8000 px.
     found_rows, found_cols = [np.zeros(0, np.intp)], [np.zeros(0, np.intp)]

@@ -253,3 +253,53 @@ def test_renumbering_keeps_the_order_of_the_ids_and_zero(seed):
         renumbered = _renumber(labels)
         assert renumbered.dtype == np.int32
         assert np.array_equal(renumbered, expected)
+
+
+def test_renumbering_in_a_window_is_renumbering_the_whole_image():
+    rng = np.random.default_rng(7)
+    for zero_inside in (False, True):
+        labels = np.zeros((60, 70), np.int32)
+        labels[12:40, 9:51] = rng.choice(rng.integers(1 - zero_inside, 900, 12), size=(28, 42))
+        window = (slice(12, 40), slice(9, 51))
+        assert np.array_equal(_renumber(labels.copy(), window), _renumber(labels))
+    whole = (slice(0, 60), slice(0, 70))  # the window is the image: 0 is there only if a label is 0
+    labels = rng.integers(3, 9, (60, 70)).astype(np.int32)
+    assert np.array_equal(_renumber(labels.copy(), whole), _renumber(labels))
+    assert _renumber(labels.copy(), whole).min() == 1
+
+
+def _maoris_default(free):
+    from ursim_core.segmentation.maoris import PRESETS, maoris_labels
+
+    return maoris_labels(free, PRESETS["default"])
+
+
+@pytest.mark.parametrize("degrees", [0.0, 17.0, 30.0, 134.0])
+def test_maoris_given_only_the_free_box_labels_as_on_the_whole_canvas(degrees):
+    # The canonical image's canvas is mostly empty; MAORIS works on the box of its free pixels
+    # and a pixel around it, so it is given only that: the same labels, bit for bit, for every
+    # resampling, for free space on the image's edges, mirrored, and for a map with none.
+    _, sketch = make_pair(seed=5)
+    free = sketch.free if degrees == 0 else _turned(sketch.free, degrees)[0]
+    maps = [free, free[:, ::-1], free[40:, : free.shape[1] - 35], np.zeros((30, 40), bool)]
+    for image in maps:
+        for offset in (0.0, None, *RESAMPLING_OFFSETS[:2]):
+            _voted_angle.cache_clear()
+            expected = canonical_labels(image, _maoris_default, turn_offset=offset)
+            got = canonical_labels(image, _maoris_default, turn_offset=offset, free_box_only=True)
+            assert got.dtype == expected.dtype == np.int32
+            assert np.array_equal(got, expected), (degrees, offset, image.shape)
+
+
+def test_the_pose_from_the_free_box_is_the_pose_from_the_whole_image():
+    from ursim_core.segmentation.canonical import _moments, free_window
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        free = np.zeros(tuple(rng.integers(20, 90, 2)), bool)
+        rows, cols = free.shape
+        free[rng.integers(0, rows // 2) : rng.integers(rows // 2, rows + 1), rng.integers(0, cols // 2) : cols] = True
+        free &= rng.random(free.shape) < 0.8
+        window = free_window(free, int(rng.integers(0, 3)))
+        assert _moments(free, window) == _moments(free)  # bit for bit
+        assert canonical_pose(free, window=window) == canonical_pose(free)

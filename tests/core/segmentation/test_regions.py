@@ -208,3 +208,16 @@ def test_region_graph_boxes_are_those_of_scipy_find_objects():
         for index, box in enumerate(ndimage.find_objects(labels), start=1):
             if box is not None:
                 assert tuple(boxes[index]) == (box[0].start, box[1].start, box[0].stop, box[1].stop)
+
+
+@pytest.mark.parametrize("pad", [((0, 0), (0, 0)), ((5, 0), (0, 9)), ((0, 7), (11, 0)), ((13, 4), (6, 21))])
+def test_the_table_of_labels_in_a_larger_empty_image_is_theirs_moved(pad):
+    # The runs are found in the box of the non-zero labels: the same table as the pixels give,
+    # labels on the image's edges or not.
+    rng = np.random.default_rng(sum(map(sum, pad)))
+    labels = cv2_resize_nearest(rng.integers(0, 6, (4, 5)), (37, 45)).astype(np.int32)
+    labels[rng.random(labels.shape) < 0.03] = 3
+    padded = np.pad(labels, pad)
+    table = region_table(padded)
+    nodes, edges, _ = _direct_table(padded)
+    assert table.nodes == nodes and table.edges == edges
