@@ -116,12 +116,33 @@ def _main(argv: list[str]) -> int:
     except UrsimError as error:
         print(f"error: {error}", file=sys.stderr)
         return 1
+    except BrokenPipeError as error:
+        if not _output_gone():
+            print(f"error: {os_error_text(error)}", file=sys.stderr)
+            return 1
+        # The reader of the output left (``ursim match ... | head -1``): the outputs are written
+        # before anything is printed, so end quietly, as other commands do when their pipe
+        # closes (128 + SIGPIPE). Standard output goes to devnull: the flush at exit would fail again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except OSError as error:
         print(f"error: {os_error_text(error)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+
+
+def _output_gone() -> bool:
+    """Whether standard output is a pipe whose reader has closed it (poll reports an error on it)."""
+    try:
+        import select
+
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(event & select.POLLERR for _, event in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), no file descriptor
+        return False
 
 
 def os_error_text(error: OSError) -> str:

@@ -180,3 +180,32 @@ def test_openblas_threads_are_told_to_sleep_unless_the_user_said_otherwise():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=environment)
     assert result.stdout.strip().splitlines()[-1] == '"4"'
     assert run_python(code, OPENBLAS_THREAD_TIMEOUT="12") == "12"
+
+
+def test_a_reader_that_leaves_early_ends_the_command_quietly(files):
+    # `ursim match ... | head -1`: the outputs are written, the command ends as a pipe's writer
+    # does when its reader leaves (141), without a traceback or an error line.
+    out = files["tmp"] / "piped"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ursim_core.cli", "match", str(files["rooms"]), str(files["rooms"]), "-o", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    process.stdout.close()  # before the child prints anything: it takes a while to start
+    stderr = process.stderr.read().decode()
+    assert process.wait() == 141, stderr
+    assert stderr == ""
+    assert (out / "correspondences.json").is_file() and (out / "matches.png").is_file()
+
+
+def test_a_broken_pipe_that_is_not_the_output_is_an_error(monkeypatch, files, capsys):
+    # A pipe or socket the command itself writes to (a scheduler's, say) is reported as any
+    # other file-system error.
+    from ursim_core.cli import segment as segment_cli
+
+    def broken(args):
+        raise BrokenPipeError(32, "Broken pipe", "tcp://scheduler")
+
+    monkeypatch.setattr(segment_cli, "run", broken)
+    assert main(["segment", str(files["rooms"]), "-o", str(files["tmp"] / "o")]) == 1
+    assert capsys.readouterr().err == "error: tcp://scheduler: Broken pipe\n"
