@@ -99,8 +99,9 @@ def references_of(instances: list[Instance], segmentations) -> tuple[list[dict[s
     notes: list[str] = []
     for instance in instances:
         experiment = instance.experiment
-        sketch_seg = segmentations[instance.sketch_job.key]
-        metric_seg = segmentations[instance.metric_job.key]
+        # Read once: a turned sketch's labels are unpacked at each read (evaluation.packing).
+        sketch_labels = segmentations[instance.sketch_job.key].labels
+        metric_labels = segmentations[instance.metric_job.key].labels
         per_annotator = {}
         for annotator, gt_path in experiment.ground_truth.items():
             if gt_path not in loaded:
@@ -109,7 +110,7 @@ def references_of(instances: list[Instance], segmentations) -> tuple[list[dict[s
             if instance.orientation is not None:
                 shape = segmentations[instance.upright_job.key].labels.shape
                 corr = transform_correspondences(corr, shape, instance.orientation)
-            assigned = assign_regions(corr, sketch_seg.labels, metric_seg.labels, tolerance=10)
+            assigned = assign_regions(corr, sketch_labels, metric_labels, tolerance=10)
             per_annotator[annotator] = Reference(
                 regions=tuple((tuple(c.sketch_regions), tuple(c.metric_regions)) for c in assigned.cliques),
                 points=tuple((tuple(c.sketch_points), tuple(c.metric_points)) for c in corr.cliques),
@@ -117,8 +118,8 @@ def references_of(instances: list[Instance], segmentations) -> tuple[list[dict[s
             dropped = sum(
                 regions_at_points(labels, points, tolerance=10).count(0)
                 for labels, points in (
-                    (sketch_seg.labels, [p for c in corr.cliques for p in c.sketch_points]),
-                    (metric_seg.labels, [p for c in corr.cliques for p in c.metric_points]),
+                    (sketch_labels, [p for c in corr.cliques for p in c.sketch_points]),
+                    (metric_labels, [p for c in corr.cliques for p in c.metric_points]),
                 )
             )
             if dropped:

@@ -48,9 +48,14 @@ def turned_sketch():
 
 def test_the_resamplings_come_back_as_they_were(turned_sketch):
     alone, packed = packed_apart(turned_sketch)
-    assert alone.resampled == () and alone.labels is turned_sketch.labels
+    # The first segmentation is packed too, and reads as it was.
+    assert alone.resampled == () and alone.packed_labels.nbytes < turned_sketch.labels.nbytes / 10
+    assert np.array_equal(alone.labels, turned_sketch.labels) and alone.labels.dtype == turned_sketch.labels.dtype
+    assert alone.n_regions == turned_sketch.n_regions and alone.regions is turned_sketch.regions
     assert packed.nbytes < sum(o.labels.nbytes for o in turned_sketch.resampled) / 10
     again = with_unpacked(alone, packed)
+    assert np.array_equal(again.labels, turned_sketch.labels) and again.n_regions == turned_sketch.n_regions
+    assert (again.method, again.params, again.source) == (turned_sketch.method, turned_sketch.params, None)
     assert len(again.resampled) == len(turned_sketch.resampled) == 5
     for got, want in zip(again.resampled, turned_sketch.resampled, strict=True):
         assert np.array_equal(got.labels, want.labels) and got.labels.dtype == want.labels.dtype
@@ -59,6 +64,8 @@ def test_the_resamplings_come_back_as_they_were(turned_sketch):
     # Nothing to pack: the same object, and back again.
     plain = segment_canonical(make_pair(seed=5)[1].free, preset="default", resampled=True)
     assert packed_apart(plain) == (plain, None) and with_unpacked(plain, None) is plain
+    # A packed segmentation comes back whole without resamplings to add, as the Dask tasks ask.
+    assert np.array_equal(with_unpacked(alone, None).labels, turned_sketch.labels)
 
 
 def test_segment_all_keeps_the_resamplings_packed_and_the_caches_whole(tmp_path, turned_sketch, monkeypatch):
