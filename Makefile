@@ -31,7 +31,14 @@ $(VENV)/.kernels: $(shell find ursim_core/segmentation/maoris ursim_core/matchin
 	$(BIN)/python -c "from ursim_core.matching.kernels import build; print(build())"
 	touch $@
 
-run: $(VENV)/.installed-gui $(VENV)/.kernels
+# The sources byte-compiled: where PYTHONDONTWRITEBYTECODE is set (many container images, this
+# project's own machines) Python would compile every module again in each process it starts,
+# 0.05-0.15 s of each `ursim match` (round 58). compileall rewrites only what changed.
+$(VENV)/.bytecode: $(shell find ursim_core ursim_gui -name '*.py') | $(BIN)/python
+	$(BIN)/python -m compileall -q ursim_core ursim_gui > /dev/null
+	touch $@
+
+run: $(VENV)/.installed-gui $(VENV)/.kernels $(VENV)/.bytecode
 	$(BIN)/ursim-gui $(ARGS)
 
 # Lint, format and the import contracts of pyproject.toml first: they take seconds and say most.
@@ -40,10 +47,10 @@ lint: $(VENV)/.installed-dev
 	$(BIN)/ruff format --check .
 	$(BIN)/lint-imports
 
-test: lint $(VENV)/.kernels
+test: lint $(VENV)/.kernels $(VENV)/.bytecode
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -n 2 -q
 
-bench: $(VENV)/.installed-dev $(VENV)/.kernels
+bench: $(VENV)/.installed-dev $(VENV)/.kernels $(VENV)/.bytecode
 	$(BIN)/ursim bench all
 
 clean:
