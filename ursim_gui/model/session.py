@@ -30,6 +30,7 @@ from ursim_core.correspondences import Clique, Correspondences, MapRef, utc_time
 from ursim_core.correspondences.exporters import clique_label
 from ursim_core.errors import SegmentationError
 from ursim_gui.model.history import History
+from ursim_gui.model.read_ahead import MapReadAhead
 from ursim_gui.model.session_documents import DocumentOperations
 from ursim_gui.model.session_edits import EditOperations
 from ursim_gui.model.session_evaluation import EvaluationOperations
@@ -119,6 +120,8 @@ class AnnotationSession(
         #: Annotator of the documents :meth:`new_document` starts.
         self.annotator = annotator
         self._maps: dict[str, Any] = {side: None for side in SIDES}
+        #: Map files read ahead on a thread (a campaign's next pairs); every map is read through it.
+        self.read_ahead = MapReadAhead()
         self._segmentations: dict[str, Any] = {side: None for side in SIDES}
         self._no_region_reasons: dict[str, tuple[Any, str]] = {}  # side -> (segmentation, reason)
         self._presets = dict(DEFAULT_PRESETS)
@@ -286,10 +289,9 @@ class AnnotationSession(
 
     # ------------------------------------------------------------------ maps and segmentations
     def load_map(self, side: str, path: str | os.PathLike) -> None:
-        """Load a map file for ``side`` (raises ``UrsimError``; the session is unchanged then)."""
-        from ursim_core.io.maps import load_map
-
-        self.set_map(side, load_map(_absolute(path)))
+        """Load a map file for ``side`` (raises ``UrsimError``; the session is unchanged then);
+        the map read ahead when it was (:attr:`read_ahead`)."""
+        self.set_map(side, self.read_ahead.read(_absolute(path)))
 
     def set_map(self, side: str, map_) -> None:
         """Show ``map_`` on ``side``; its segmentation is dropped (it belonged to the old map).

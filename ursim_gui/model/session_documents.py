@@ -195,7 +195,9 @@ class DocumentOperations:
         """Load the maps and segmentations ``corr`` names into temporaries, then swap them in."""
         maps, segmentations, warnings = {}, {}, []
         for side in SIDES:
-            maps[side], segmentations[side] = self._load_side(side, getattr(corr, side), path, warnings)
+            maps[side], segmentations[side] = self._load_side(
+                side, getattr(corr, side), path, warnings, read=self.read_ahead.read
+            )
         current = corr
         for side in SIDES:
             if segmentations[side] is not None:
@@ -233,8 +235,9 @@ class DocumentOperations:
             self.error.emit(warning)
 
     @staticmethod
-    def _load_side(side: str, ref: MapRef, document: Path | None, warnings: list[str]):
-        """(map, segmentation) of one side of a document; raises UrsimError naming both files."""
+    def _load_side(side: str, ref: MapRef, document: Path | None, warnings: list[str], *, read=None):
+        """(map, segmentation) of one side of a document; raises UrsimError naming both files.
+        ``read(path) -> Map`` reads the map file (:func:`~ursim_core.io.maps.load_map` by default)."""
         from ursim_core.io.maps import load_map
         from ursim_core.segmentation import SEGMENTERS, load_label_image, segment, with_resamplings
 
@@ -242,7 +245,7 @@ class DocumentOperations:
             return None, None
         where = f" (the {side} map of {document.name})" if document is not None else f" (the {side} map)"
         try:
-            map_ = load_map(ref.path)
+            map_ = (read or load_map)(ref.path)
             if ref.size is not None and tuple(ref.size) != tuple(map_.shape):
                 raise _size_mismatch_error(ref, map_, side)
             if ref.labels_path is not None and ref.labels_path.is_file():

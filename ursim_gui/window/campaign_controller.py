@@ -161,6 +161,7 @@ class CampaignController(QObject):
         except _FAILURES as error:
             dialogs.show_error(window, f"Cannot open pair {pair.name}", str(error))
             return False
+        self._read_neighbours_ahead(index)
         # What the source says the input map is (the Halmstad robot maps), for every match of the
         # pair: set once its maps are in, since opening another map forgets the last pair's settings.
         if pair.input_kind is not None:
@@ -179,6 +180,20 @@ class CampaignController(QObject):
                 jobs.segment(side, box.preset.currentText(), box.overrides())
         jobs.match(window.matching_panel.config())
         return True
+
+    def _read_neighbours_ahead(self, index: int) -> None:
+        """Have the next and the previous pair's map files read on a thread while this pair is
+        worked on (:class:`~ursim_gui.model.read_ahead.MapReadAhead`): moving to them then
+        decodes nothing on the GUI thread."""
+        pairs, session = self.campaign.pairs, self.session
+        shown = {getattr(session.map(side), "path", None) for side in ("sketch", "metric")}
+        files = [
+            path.absolute()
+            for neighbour in (index + 1, index - 1)
+            if 0 <= neighbour < len(pairs)
+            for path in (pairs[neighbour].sketch, pairs[neighbour].metric)
+        ]
+        session.read_ahead.prefetch(path for path in files if path not in shown)
 
     def _job_applied(self, job) -> None:
         campaign = self.campaign

@@ -458,5 +458,6 @@ class MainWindow(QMainWindow):
         self.preferences.save_window(self, {name: self.actions[name].isChecked() for name in _TOGGLE_DEFAULTS})
         self.jobs.cancel()
         self.jobs.runner.shutdown()
+        self.session.read_ahead.close()
         self.documents.close_document()
         event.accept()

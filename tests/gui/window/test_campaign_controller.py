@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 from conftest import new_window
 from PySide6.QtCore import Qt
@@ -117,3 +119,34 @@ def test_the_pairs_list_says_how_each_sketch_was_read_and_marks_close_calls(plai
     assert item.text() == "turned 180° · next ranked 0.4% worse" and item.foreground().color() == CLOSE_CALL_COLOUR
     assert "Compare the readings" in item.toolTip()
     window.close()
+
+
+def test_the_next_pair_s_sketch_is_read_ahead_while_a_pair_is_worked_on(plain_campaign, qtbot, tmp_path, monkeypatch):
+    # Decoding a map on the GUI thread was the longest gap of the event loop on Next pair.
+    import threading
+
+    import ursim_core.io.maps as maps
+
+    read_on: dict = {}
+    load = maps.load_map
+
+    def recording(path, *args, **kwargs):
+        read_on.setdefault(os.path.basename(path), []).append(threading.current_thread().name)
+        return load(path, *args, **kwargs)
+
+    monkeypatch.setattr(maps, "load_map", recording)
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=tmp_path / "out")
+    assert window.session.read_ahead.pending == ((plain_campaign / "s2.png").absolute(),)
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        qtbot.keyClick(window.views["sketch"], Qt.Key.Key_D)
+    assert window.session.map("sketch").path == (plain_campaign / "s2.png").absolute()
+    assert [name.startswith("ursim-read-ahead") for name in read_on["s2.png"]] == [True]
+    # From s2 both neighbours are read ahead; the metric map, shown already, is not read again.
+    assert set(window.session.read_ahead.pending) == {
+        (plain_campaign / name).absolute() for name in ("s1.png", "s3.png")
+    }
+    assert len(read_on["metric.png"]) == 1
+    window.close()
+    assert window.session.read_ahead.pending == ()
