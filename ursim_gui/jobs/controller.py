@@ -15,7 +15,7 @@ from PySide6.QtCore import QObject, Signal
 
 from ursim_core.errors import UrsimError
 from ursim_gui.jobs.runner import JobRunner
-from ursim_gui.model.jobs import MatchJob, SegmentJob, compiling_note
+from ursim_gui.model.jobs import LaidMatch, MatchJob, SegmentJob, compiling_note
 from ursim_gui.views.messages import show_error
 
 __all__ = ["JobController", "MatchRequest"]
@@ -146,7 +146,13 @@ class JobController(QObject):
         from ursim_core.matching import CONSTRAINED_MATCHERS, MatchConfig
 
         steered = (config or MatchConfig()).resolved().matcher in CONSTRAINED_MATCHERS
-        return MatchJob(sketch, metric, config, constraints=self._session.review_constraints() if steered else None)
+        return MatchJob(
+            sketch,
+            metric,
+            config,
+            constraints=self._session.review_constraints() if steered else None,
+            laid_sketch=True,
+        )
 
     def submit(self, job) -> None:
         """Queue any other job (``run(progress, cancelled)``); its result comes as ``result_ready``."""
@@ -176,7 +182,11 @@ class JobController(QObject):
             else:
                 self._status.showMessage(f"{job.side.capitalize()}: {result.n_regions} regions", 5000)
         elif isinstance(job, MatchJob):
-            self._session.apply_match(result)
+            if isinstance(result, LaidMatch):
+                self._session.apply_match(result.result, laid=result.laid)
+                result = result.result
+            else:
+                self._session.apply_match(result)
             kept = ""
             if job.constraints is not None:
                 reviewed = len(job.constraints.fixed) + len(job.constraints.forbidden)

@@ -16,12 +16,13 @@ then discarded instead of being applied.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, NamedTuple
 
 __all__ = [
     "JobCancelled",
     "SegmentJob",
     "MatchJob",
+    "LaidMatch",
     "ProgressCallback",
     "CancelledCallback",
     "COMPILING_NOTE",
@@ -169,13 +170,26 @@ class MatchJob:
     constraints : ursim_core.matching.MatchConstraints, optional
         What the person has reviewed (``AnnotationSession.review_constraints``): the answer
         contains their pairs and avoids the rejected ones.
+    laid_sketch : bool, keyword-only
+        Also make the match's laid sketch (:func:`~ursim_gui.model.view_state.laid_sketch_of`)
+        and return both as a :class:`LaidMatch`: the worker does the laying's flow, not the
+        GUI thread that shows it.
     """
 
-    def __init__(self, sketch_seg: Any, metric_seg: Any, config: Any = None, constraints: Any = None) -> None:
+    def __init__(
+        self,
+        sketch_seg: Any,
+        metric_seg: Any,
+        config: Any = None,
+        constraints: Any = None,
+        *,
+        laid_sketch: bool = False,
+    ) -> None:
         self.sketch_seg = sketch_seg
         self.metric_seg = metric_seg
         self.config = config
         self.constraints = constraints
+        self.laid_sketch = laid_sketch
 
     @property
     def description(self) -> str:
@@ -217,5 +231,19 @@ class MatchJob:
 
         result = match_prepared(prepared, progress=sweep_progress)
         _check(cancelled, "matching")
+        if self.laid_sketch:
+            from ursim_gui.model.view_state import laid_sketch_of
+
+            laid = laid_sketch_of(result, self.sketch_seg.labels, self.metric_seg.labels)
+            progress(1.0, f"{len(result.pairs)} pairs")
+            return LaidMatch(result, laid)
         progress(1.0, f"{len(result.pairs)} pairs")
         return result
+
+
+class LaidMatch(NamedTuple):
+    """What :class:`MatchJob` returns with ``laid_sketch=True``: the ``MatchResult`` and its
+    laid sketch (None when the match did not lay the sketch)."""
+
+    result: Any
+    laid: Any

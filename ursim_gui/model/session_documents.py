@@ -219,6 +219,7 @@ class DocumentOperations:
         self._focus = None
         self._label_versions = {}
         self._last_match = None
+        self._laid = None
         self._anchors = []
         self._recompute_reference()
         self._evaluate()

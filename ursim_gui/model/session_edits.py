@@ -16,6 +16,8 @@ from ursim_gui.model.session_values import REFERENCE_TOLERANCE, SIDES, _check_si
 __all__ = ["EditOperations"]
 
 _STATUS_VERBS = {"accepted": "Accept", "rejected": "Reject", "pending": "Mark pending"}
+# apply_match without a laid sketch: the session makes it when a view asks (None is a laid sketch: none).
+_NOT_GIVEN = object()
 
 
 class EditOperations:
@@ -226,7 +228,7 @@ class EditOperations:
         )
         return constraints or None
 
-    def apply_match(self, result) -> None:
+    def apply_match(self, result, *, laid=_NOT_GIVEN) -> None:
         """Replace the pending automatic cliques by one clique per new pair of ``result`` (one undo step).
 
         Every clique a person made or reviewed is kept: manual, accepted and rejected ones. A
@@ -236,7 +238,8 @@ class EditOperations:
         regions' interior points, scored with the matcher's ``c`` value of the pair when
         available. The file's ``matcher`` record says what produced them
         (:func:`ursim_core.matching.results.match_record`). ``anchors`` and ``last_match`` are
-        updated (they are not part of the undo history).
+        updated (they are not part of the undo history). ``laid``: the result's laid sketch, made
+        with the current segmentations (:meth:`laid_sketch` then returns it without computing).
 
         Raises
         ------
@@ -262,6 +265,10 @@ class EditOperations:
             first_id=self._corr.next_clique_id(),
         )
         self._last_match = result
+        self._laid = None
+        if laid is not _NOT_GIVEN:
+            made_of = (result, self._segmentations["sketch"].labels, self._segmentations["metric"].labels)
+            self._laid = (made_of, laid)
         self._anchors = [(int(sketch), int(metric)) for sketch, metric in getattr(result, "anchors", [])]
         value = self._corr.with_cliques([*kept, *cliques])
         if getattr(result, "config", None) is not None:

@@ -14,7 +14,7 @@ import numpy as np
 from PySide6.QtGui import QColor
 
 from ursim_core.matching.template import free_box
-from ursim_gui.model.view_state import eval_badges, first_regions, laid_sketch_of, side_colour_table
+from ursim_gui.model.view_state import eval_badges, first_regions, side_colour_table
 
 __all__ = ["ViewBinding", "SIDES"]
 
@@ -42,8 +42,6 @@ class ViewBinding:
         self._hovered: tuple[str, int] = ("sketch", 0)
         # The laid sketch of the last match, made once per match and segmentations (about 15 ms).
         self._laid_visible = False
-        self._laid_of: tuple = (None, None, None)
-        self._laid: np.ndarray | None = None
         # The sketch's colour table as last painted: the laid sketch is drawn in it too.
         self._sketch_colours: np.ndarray | None = None
         session.map_changed.connect(self._map_changed)
@@ -152,15 +150,8 @@ class ViewBinding:
 
     def _show_laid(self) -> None:
         view = self.views["metric"]
-        sketch, metric = self.session.segmentation("sketch"), self.session.segmentation("metric")
-        result = self.session.last_match
-        if not self._laid_visible or sketch is None or metric is None or result is None:
-            view.set_laid_sketch(None)
-            return
-        made_of = (result, sketch.labels, metric.labels)
-        if any(a is not b for a, b in zip(self._laid_of, made_of)):
-            self._laid_of, self._laid = made_of, laid_sketch_of(result, sketch.labels, metric.labels)
-        if self._laid is None or self._sketch_colours is None:
+        laid = self.session.laid_sketch() if self._laid_visible else None
+        if laid is None or self._sketch_colours is None:
             view.set_laid_sketch(None)
             return
         # In the sketch's clique colours as painted (each laid region shows whose partner it
@@ -168,7 +159,7 @@ class ViewBinding:
         # would vanish.
         table = self._sketch_colours.copy()
         table[:, :3] = table[:, :3] * 0.45
-        view.set_laid_sketch(self._laid, table)
+        view.set_laid_sketch(laid, table)
 
     def _update_links(self) -> None:
         self.connectors.set_links(

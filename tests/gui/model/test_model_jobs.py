@@ -98,3 +98,26 @@ def test_match_job_with_automatic_m_reports_each_m_and_cancels_between_them(sess
     assert len(steps) == len(config.m_grid)
 
     assert _cancelled_during_the_sweep(session, config) == 6
+
+
+def test_the_laid_sketch_is_made_in_the_match_job_and_not_again_by_the_session(session, monkeypatch):
+    # The laying's flow ran on the GUI thread when the match was shown (20-30 ms a KTH pair).
+    import ursim_gui.model.session as session_module
+    from ursim_core.matching import MatchConfig
+    from ursim_gui.model.jobs import LaidMatch
+    from ursim_gui.model.view_state import laid_sketch_of
+
+    sketch, metric = session.segmentation("sketch"), session.segmentation("metric")
+    outcome = MatchJob(sketch, metric, MatchConfig(), laid_sketch=True).run(lambda *a: None, lambda: False)
+    assert isinstance(outcome, LaidMatch) and outcome.result.laid
+    expected = laid_sketch_of(outcome.result, sketch.labels, metric.labels)
+    assert outcome.laid is not None and np.array_equal(outcome.laid, expected)
+    made = []
+    monkeypatch.setattr(session_module, "laid_sketch_of", lambda *args: made.append(args) or laid_sketch_of(*args))
+    session.apply_match(outcome.result, laid=outcome.laid)
+    assert session.laid_sketch() is outcome.laid and not made
+    # A match applied without its laid sketch: the session makes it once, when asked.
+    session.apply_match(outcome.result)
+    assert not made
+    laid = session.laid_sketch()
+    assert len(made) == 1 and np.array_equal(laid, expected) and session.laid_sketch() is laid
