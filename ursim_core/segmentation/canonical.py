@@ -301,7 +301,8 @@ def _renumber(labels: np.ndarray, window: tuple[slice, slice] | None = None) -> 
 
 def free_window(free: np.ndarray, margin: int = 0) -> tuple[slice, slice] | None:
     """The box of ``free``'s free pixels grown by ``margin`` on every side (clipped to the
-    image), as a pair of slices; None when it has no free pixel.
+    image), as a pair of slices; None when it has no free pixel. MAORIS works in
+    ``free_window(free, 1)`` (:func:`~ursim_core.segmentation.maoris.maoris_labels`).
 
     Examples
     --------

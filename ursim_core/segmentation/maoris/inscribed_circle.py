@@ -14,6 +14,7 @@ import cv2
 import numpy as np
 
 from ursim_core.errors import ParameterError, SegmentationError
+from ursim_core.segmentation.canonical import free_window
 from ursim_core.segmentation.maoris.compiled import kernels
 
 __all__ = ["inscribed_circle_radii", "inscribed_circle_image", "quantize"]
@@ -64,7 +65,7 @@ def inscribed_circle_radii(free: np.ndarray, *, max_radius: int = 500) -> np.nda
     free = _as_free_mask(free)
     if int(max_radius) < 1:
         raise ParameterError(f"must be >= 1, got {max_radius!r}", field="max_radius")
-    window = _free_bbox(free, margin=1)
+    window = free_window(free, 1)
     if window is None:
         return np.zeros(free.shape, np.int32)
     inner = _inscribed_radii_in_window(free[window], int(max_radius))
@@ -73,18 +74,6 @@ def inscribed_circle_radii(free: np.ndarray, *, max_radius: int = 500) -> np.nda
     out = np.zeros(free.shape, np.int32)
     out[window] = inner
     return out
-
-
-def _free_bbox(free: np.ndarray, *, margin: int) -> tuple[slice, slice] | None:
-    """Bounding box of the free pixels grown by ``margin`` (clipped), or None."""
-    rows = np.flatnonzero(free.any(axis=1))
-    if len(rows) == 0:
-        return None
-    cols = np.flatnonzero(free.any(axis=0))
-    return (
-        slice(max(rows[0] - margin, 0), min(rows[-1] + 1 + margin, free.shape[0])),
-        slice(max(cols[0] - margin, 0), min(cols[-1] + 1 + margin, free.shape[1])),
-    )
 
 
 def _inscribed_radii_in_window(free: np.ndarray, max_radius: int) -> np.ndarray:

@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 from ursim_core.errors import ParameterError
+from ursim_core.segmentation.canonical import free_window
 from ursim_core.segmentation.maoris.compiled import kernels
 from ursim_core.segmentation.maoris.inscribed_circle import (
     _as_free_mask,
-    _free_bbox,
     _quantization_table,
     _radii_in_storage,
 )
@@ -71,7 +71,7 @@ def maoris_labels(free: np.ndarray, params: MaorisParams = PRESETS["default"]) -
     free = _as_free_mask(free)
     shape = free.shape
     # Everything outside the free pixels' bounding box is obstacle: work on the box.
-    window = _free_bbox(free, margin=1)
+    window = free_window(free, 1)
     if window is None:
         return np.zeros(shape, np.int32)
     free = free[window]
