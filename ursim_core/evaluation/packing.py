@@ -8,9 +8,8 @@ each) and made again, identical, in the worker that matches the sketch.
 
 The first segmentation of such a sketch is packed too (:class:`PackedSegmentation`): the main
 process reads its labels only to map the ground truth onto its regions, once per sketch, and its
-label image is mostly the empty canvas of the turn. The evaluation hands every segmentation to
-each worker, so what is packed is also what is not copied there: at 24 angles, 4.6 GB in the main
-process and in each of its two workers before (round 58).
+label image is mostly the empty canvas of the turn: at 24 angles the main process held 4.6 GB of
+them once the segmentation had ended (round 58).
 """
 
 from __future__ import annotations
@@ -87,7 +86,8 @@ class PackedSegmentation:
     method: str
     params: dict
     source: Any
-    resampled: tuple = ()
+    #: Its resamplings are packed apart (:class:`PackedResamplings`).
+    resampled = ()
 
     @classmethod
     def of(cls, segmentation: Any) -> PackedSegmentation:
