@@ -20,6 +20,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ursim_core.segmentation.canonical import free_window
+
 __all__ = [
     "COARSE_SIDE",
     "WINDOW_CLIP",
@@ -106,10 +108,11 @@ def free_box(free: np.ndarray) -> tuple[int, int, int, int] | None:
     >>> free_box(free), free_box(np.zeros((2, 2), bool))
     ((1, 3, 2, 5), None)
     """
-    rows, cols = np.flatnonzero(free.any(axis=1)), np.flatnonzero(free.any(axis=0))
-    if not len(rows):
+    window = free_window(free)
+    if window is None:
         return None
-    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+    rows, cols = window
+    return rows.start, rows.stop, cols.start, cols.stop
 
 
 def best_window(
