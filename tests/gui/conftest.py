@@ -248,10 +248,13 @@ METRIC_LABELS = grid_labels(room=30)
 
 
 @pytest.fixture
-def session():
+def session(tmp_path_factory):
+    # Maps from files, as the app opens them: a map with no file is a drawing, the user's work.
+    folder = tmp_path_factory.mktemp("maps")
     session = AnnotationSession(annotator="tester", timestamp=lambda: NOW)
-    session.set_map("sketch", map_of(SKETCH_LABELS))
-    session.set_map("metric", map_of(METRIC_LABELS))
+    for side, labels in (("sketch", SKETCH_LABELS), ("metric", METRIC_LABELS)):
+        cv2.imwrite(str(folder / f"{side}.png"), np.where(labels > 0, 255, 0).astype(np.uint8))
+        session.load_map(side, folder / f"{side}.png")
     session.set_segmentation("sketch", seg_of(SKETCH_LABELS))
     session.set_segmentation("metric", seg_of(METRIC_LABELS))
     return session

@@ -16,6 +16,7 @@ from PySide6.QtCore import QObject, Signal
 from ursim_core.errors import UrsimError
 from ursim_gui.jobs.runner import JobRunner
 from ursim_gui.model.jobs import LaidMatch, MatchJob, SegmentJob, compiling_note
+from ursim_gui.model.wording import counted
 from ursim_gui.views.messages import show_error
 
 __all__ = ["JobController", "MatchRequest"]
@@ -79,6 +80,13 @@ class JobController(QObject):
         self.runner.cancel()
         self._status.cancel_button.setEnabled(False)
         self._status.showMessage("Cancelling…")
+
+    def drop_all(self) -> None:
+        """Drop every job, queued or running, without a word: the document they were for is
+        gone (a campaign moved to another pair). Jobs queued afterwards run as usual."""
+        if self.busy:
+            self._queue.clear()
+            self.runner.cancel()
 
     def run_now(self, job) -> bool:
         """Run a job in the calling thread and apply its result (scripted use: --screenshot).
@@ -190,8 +198,8 @@ class JobController(QObject):
             kept = ""
             if job.constraints is not None:
                 reviewed = len(job.constraints.fixed) + len(job.constraints.forbidden)
-                kept = f" (building on {reviewed} reviewed pair{'s' if reviewed != 1 else ''})"
-            self._status.showMessage(f"Matched: {len(result.pairs)} pairs{kept}", 5000)
+                kept = f" (building on {counted(reviewed, 'reviewed pair')})"
+            self._status.showMessage(f"Matched: {counted(len(result.pairs), 'pair')}{kept}", 5000)
         else:
             self._status.showMessage(f"{job.description}: done", 5000)
             self.result_ready.emit(job, result)
@@ -219,8 +227,8 @@ class JobController(QObject):
         show_error(self._parent, "Job failed", f"{job.description} failed:\n{message}")
 
     def _cancelled(self, job) -> None:
+        # The queue was emptied when the cancel was asked for; what is queued now came after it.
         _log.info("%s cancelled", job.description)
-        self._queue.clear()
         self._start_next()
         self._status.showMessage(f"{job.description} cancelled", 5000)
 

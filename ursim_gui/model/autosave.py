@@ -285,7 +285,8 @@ class Autosaver:
         # ``now`` keeps the document's own timestamps: the copy must be the value in the
         # session, not a re-stamped one.
         # Edited segmentations go along as label images beside the copy, or a crash would lose them.
-        copy = self.session.edited_labels_beside(dataclasses.replace(corr, extra=extra), target)
+        copy, _drawn = self.session.drawn_maps_beside(dataclasses.replace(corr, extra=extra), target)
+        copy = self.session.edited_labels_beside(copy, target)
         save_correspondences(copy, target, now=corr.modified)
         if self._written is not None and self._written != target:
             discard(self._written)

@@ -10,7 +10,8 @@ Sources
 - A dataset folder in a layout :func:`ursim_core.evaluation.layouts.discover` knows
   (``ursim_kth_sketches``, the Halmstad robot maps): one pair per experiment, named like it.
 - A plain folder of sketches with one metric map: the metric map is the one file named
-  ``metric.*`` (or the one ROS ``.yaml``); every other image is a sketch.
+  ``metric.*`` (else the one named ``model*.*``, as the datasets name their floor plans, else
+  the one ROS ``.yaml``); every other image is a sketch.
 - A manifest ``*.json``: ``{"metric": PATH, "sketches": [PATH, ...], "annotator": NAME,
   "output": FOLDER, "references": {SKETCH_STEM: PATH}}``; relative paths are relative to
   the manifest; only ``metric`` and ``sketches`` are required.
@@ -146,7 +147,10 @@ def summary_of(corr: Correspondences) -> PairSummary:
     """The :class:`PairSummary` of a correspondence value."""
     cliques = corr.cliques
     reviewed = sum(clique.status is not None for clique in cliques)
-    if cliques and reviewed == len(cliques):
+    if not cliques and "matcher" not in corr.extra:
+        # Not matched yet (the pair just opened, its match queued): nothing to review.
+        status = "not started"
+    elif cliques and reviewed == len(cliques):
         status = "done"
     elif all(clique.source == "auto" and clique.status is None and not clique.note for clique in cliques):
         status = "automatic"
@@ -328,13 +332,16 @@ def _folder_pairs(folder: Path):
     files = sorted(
         p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in _IMAGE_SUFFIXES | {".yaml", ".yml"}
     )
-    metrics = [p for p in files if p.stem.lower() == "metric"] or [
-        p for p in files if p.suffix.lower() in (".yaml", ".yml")
-    ]
+    # The datasets name their floor plan model*.png (the Halmstad KT folder: model_simple.png).
+    metrics = (
+        [p for p in files if p.stem.lower() == "metric"]
+        or [p for p in files if p.stem.lower().startswith("model")]
+        or [p for p in files if p.suffix.lower() in (".yaml", ".yml")]
+    )
     if len(metrics) != 1:
         raise FormatError(
             "not a dataset layout, and not a plain campaign folder: it needs exactly one metric map "
-            f"(named metric.* or one ROS .yaml), found {len(metrics)}",
+            f"(named metric.* or model*.*, or one ROS .yaml), found {len(metrics)}",
             path=folder,
         )
     metric = metrics[0]

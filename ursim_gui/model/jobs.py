@@ -18,6 +18,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, NamedTuple
 
+from ursim_gui.model.wording import counted
+
 __all__ = [
     "JobCancelled",
     "SegmentJob",
@@ -235,9 +237,9 @@ class MatchJob:
             from ursim_gui.model.view_state import laid_sketch_of
 
             laid = laid_sketch_of(result, self.sketch_seg.labels, self.metric_seg.labels)
-            progress(1.0, f"{len(result.pairs)} pairs")
+            progress(1.0, counted(len(result.pairs), "pair"))
             return LaidMatch(result, laid)
-        progress(1.0, f"{len(result.pairs)} pairs")
+        progress(1.0, counted(len(result.pairs), "pair"))
         return result
 
 

@@ -34,7 +34,7 @@ from ursim_gui.model.read_ahead import MapReadAhead
 from ursim_gui.model.session_documents import DocumentOperations
 from ursim_gui.model.session_edits import EditOperations
 from ursim_gui.model.session_evaluation import EvaluationOperations
-from ursim_gui.model.session_label_edits import LabelEditOperations
+from ursim_gui.model.session_label_edits import EDITED_METHOD, LabelEditOperations
 from ursim_gui.model.session_selection import SelectionOperations
 from ursim_gui.model.session_values import (
     APP_TITLE,
@@ -134,6 +134,7 @@ class AnnotationSession(
         self._selected_clique: int | None = None
         self._focus: tuple[str, int] | None = None
         self._reference_corr: Correspondences | None = None
+        self._reference_path: Path | None = None
         self._reference: list[tuple[frozenset[int], frozenset[int]]] | None = None
         self._evaluation = None
         self._clique_marks: dict[int, str] = {}
@@ -195,10 +196,17 @@ class AnnotationSession(
         """True when closing would lose work: the correspondences differ from the saved ones.
 
         An untitled document whose cliques are all untouched matcher output (automatic,
-        never reviewed, no note) is never dirty: it holds nothing that re-opening and
-        re-matching the two maps would not restore, so quitting it need not ask.
+        never reviewed, no note), whose segmentations are not hand-edited and whose maps all have
+        files is never dirty: it holds nothing that re-opening and re-matching the two maps would
+        not restore, so quitting it need not ask. A merged, split or painted segmentation and a
+        sketch drawn in the app are the user's work.
         """
-        if self._path is None and all(_untouched_automatic(clique) for clique in self._corr.cliques):
+        if (
+            self._path is None
+            and not any(getattr(self._corr, side).segmentation_method == EDITED_METHOD for side in SIDES)
+            and not any(map_ is not None and map_.path is None for map_ in self._maps.values())
+            and all(_untouched_automatic(clique) for clique in self._corr.cliques)
+        ):
             return False
         return self._corr != self._saved
 
@@ -249,6 +257,11 @@ class AnnotationSession(
     def reference_correspondences(self) -> Correspondences | None:
         """The reference as loaded (points and file regions)."""
         return self._reference_corr
+
+    @property
+    def reference_path(self) -> Path | None:
+        """The file the reference was loaded from, or None when none is loaded."""
+        return self._reference_path
 
     @property
     def evaluation(self):
@@ -310,7 +323,12 @@ class AnnotationSession(
     def load_map(self, side: str, path: str | os.PathLike) -> None:
         """Load a map file for ``side`` (raises ``UrsimError``; the session is unchanged then);
         the map read ahead when it was (:attr:`read_ahead`)."""
-        self.set_map(side, self.read_ahead.read(_absolute(path)))
+        self.set_map(side, self.read_map(path))
+
+    def read_map(self, path: str | os.PathLike):
+        """The map of ``path``, read (or taken from :attr:`read_ahead`) without showing it: a
+        command that replaces the document reads first, so a file that fails leaves the work."""
+        return self.read_ahead.read(_absolute(path))
 
     def set_map(self, side: str, map_) -> None:
         """Show ``map_`` on ``side``; its segmentation is dropped (it belonged to the old map).
@@ -383,6 +401,14 @@ class AnnotationSession(
             return _with_side_regions(dataclasses.replace(value, **{side: new_ref}), side, labels)
 
         was_dirty = self.dirty
+        if (
+            self._path is not None
+            and self._saved is not None
+            and getattr(self._saved, side).segmentation_method is None
+        ):
+            # The file records no segmentation of this map (ground truth clicked on another
+            # tool's regions, say): any segmentation agrees with it, and segmenting is no edit.
+            self._saved = rebase(self._saved)
         self._segmentations[side] = segmentation
         self._no_region_reasons.pop(side, None)
         # The last match's anchors and pairs name regions of the old segmentation.

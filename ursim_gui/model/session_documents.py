@@ -22,7 +22,31 @@ from ursim_core.correspondences import (
 from ursim_core.errors import UrsimError
 from ursim_gui.model.session_values import AUTOSAVE_ORIGIN_KEY, SIDES, _absolute, _check_side, _with_side_regions
 
-__all__ = ["DocumentOperations"]
+__all__ = ["DocumentOperations", "drawn_map_path_for", "write_map_png"]
+
+
+def drawn_map_path_for(document: Path, side: str) -> Path:
+    """Where a drawn ``side`` map goes when the document is saved to ``document``."""
+    return document.with_name(f"{document.stem}.{side}.png")
+
+
+def write_map_png(map_, path: Path) -> str:
+    """Write ``map_``'s grey image (its free space white when it has none) as a PNG, atomically;
+    returns the file's SHA-256, as :func:`ursim_core.io.maps.load_map` records it."""
+    import hashlib
+
+    import cv2
+    import numpy as np
+
+    from ursim_core.io.atomic import atomic_write_bytes
+
+    grey = map_.image if map_.image is not None else np.where(map_.free, 255, 0).astype(np.uint8)
+    ok, encoded = cv2.imencode(".png", np.ascontiguousarray(grey))
+    if not ok:
+        raise OSError(f"{path}: could not encode the {map_.name} map as PNG")
+    data = encoded.tobytes()
+    atomic_write_bytes(path, data)
+    return hashlib.sha256(data).hexdigest()
 
 
 class DocumentOperations:
@@ -64,6 +88,7 @@ class DocumentOperations:
         self._label_versions = {}
         self._forget_match()
         self._reference_corr = None
+        self._reference_path = None
         self._recompute_reference()
         self._evaluate()
         for side in SIDES:
@@ -151,11 +176,16 @@ class DocumentOperations:
         moment = self._timestamp()
         created = self._corr.created or moment
         stamped = dataclasses.replace(self._corr, created=created, modified=moment)
+        # A map drawn in the app has no file: it is written beside the document, or reopening
+        # the document would give its cliques without their sketch.
+        stamped, drawn = self.drawn_maps_beside(stamped, target)
         # An edited segmentation is saved beside the file and referenced in it.
         stamped = self._write_edited_labels(stamped, target)
         same_file = self._path is not None and target == self._path
         expected = getattr(self, "_disk_sha256", None) if same_file and not overwrite_changed else None
         self._disk_sha256 = save_correspondences(stamped, target, now=moment, expected_sha256=expected)
+        for side, map_ in drawn.items():
+            self._adopt_drawn_file(side, map_)
 
         was_dirty = self.dirty
         # The timestamps describe the document, not one edit: every history value gets
@@ -169,6 +199,54 @@ class DocumentOperations:
         if self.dirty != was_dirty:
             self.dirty_changed.emit(self.dirty)
         self.history_changed.emit()
+
+    def file_is_current(self) -> bool:
+        """True when the document has a file and it holds what this session last read or wrote
+        there (its SHA-256), and the document has no unsaved changes: saving would change nothing."""
+        from ursim_core.correspondences.files import sha256_of_file
+
+        if self._path is None or self.dirty:
+            return False
+        expected = getattr(self, "_disk_sha256", None)
+        return expected is not None and sha256_of_file(self._path) == expected
+
+    def drawn_maps_beside(self, corr: Correspondences, target: Path) -> tuple[Correspondences, dict]:
+        """``corr`` referencing PNG files, written beside ``target``, of the maps that have none.
+
+        A sketch drawn in the app (:mod:`ursim_gui.tools.sketch_canvas`) has no file until the
+        document is saved: it goes to ``<target stem>.<side>.png``, whose grey image loads back
+        as the same map. Returns the new value and ``{side: map with its new file}``; the
+        session itself is not changed (:meth:`save` adopts the files once the document is
+        written; the autosave copy only references them).
+        """
+        drawn = {}
+        for side in SIDES:
+            map_ = self._maps[side]
+            if map_ is None or map_.path is not None:
+                continue
+            path = drawn_map_path_for(target, side)
+            sha256 = write_map_png(map_, path)
+            drawn[side] = dataclasses.replace(map_, path=path, sha256=sha256)
+            ref = getattr(corr, side)
+            if ref.path is None:
+                corr = dataclasses.replace(corr, **{side: dataclasses.replace(ref, path=path, sha256=sha256)})
+        return corr, drawn
+
+    def _adopt_drawn_file(self, side: str, map_) -> None:
+        """The drawn map of ``side`` now has the file ``map_.path``: the map and every value of
+        the history name it, so the saved value and the current one agree."""
+
+        def with_file(value: Correspondences) -> Correspondences:
+            ref = getattr(value, side)
+            if ref.path is not None:
+                return value
+            return dataclasses.replace(value, **{side: dataclasses.replace(ref, path=map_.path, sha256=map_.sha256)})
+
+        # No map_changed: the pixels are the same, and a changed map would reset what the views
+        # and the matching settings hold for it. The window's titles follow path_changed.
+        self._maps[side] = map_
+        self._history.map_values(with_file)
+        self._corr = with_file(self._corr)
 
     def import_dat(self, path: str | os.PathLike) -> None:
         """Replace the cliques by those of a ``.dat`` file (one undoable step).

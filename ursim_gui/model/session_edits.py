@@ -12,6 +12,7 @@ from collections.abc import Iterable
 from ursim_core.correspondences import STATUSES, Clique, from_pairs, regions_at_points
 from ursim_core.matching.constraints import pairs_beside_review
 from ursim_gui.model.session_values import REFERENCE_TOLERANCE, SIDES, _check_side, _regions_text
+from ursim_gui.model.wording import counted
 
 __all__ = ["EditOperations"]
 
@@ -153,7 +154,7 @@ class EditOperations:
         cliques = [
             dataclasses.replace(clique, status=status) if clique.id in ids else clique for clique in self._corr.cliques
         ]
-        self._commit(f"{_STATUS_VERBS[status]} {len(ids)} cliques", self._corr.with_cliques(cliques))
+        self._commit(f"{_STATUS_VERBS[status]} {counted(len(ids), 'clique')}", self._corr.with_cliques(cliques))
 
     def relink(self, clique_id: int, side: str, regions: Iterable[int]) -> None:
         """Replace one side of a clique by ``regions`` (one undo step): fixes a wrong match.

@@ -28,6 +28,7 @@ class EvaluationOperations:
         path = _absolute(path)
         reference = load_dat(path) if path.suffix.lower() == ".dat" else load_correspondences(path)
         self._reference_corr = reference
+        self._reference_path = path
         self._recompute_reference()
         self._evaluate()
         self.reference_changed.emit()
@@ -37,6 +38,7 @@ class EvaluationOperations:
         if self._reference_corr is None:
             return
         self._reference_corr = None
+        self._reference_path = None
         self._recompute_reference()
         self._evaluate()
         self.reference_changed.emit()

@@ -52,6 +52,11 @@ class SketchDocument:
         self._stroke_start: np.ndarray | None = None
         self._last_point: tuple[int, int] | None = None
         self._anchor: tuple[int, int] | None = None
+        # The drawing as last saved to ``saved_path`` and as last used as the session's sketch:
+        # what a closing window would lose is a drawing that is neither.
+        self.saved_path: Path | None = None
+        self._saved_image: np.ndarray | None = None
+        self._used_image: np.ndarray | None = None
 
     # ---- strokes: begin, extend, end form one undo step --------------------------------
     def begin(self, row: int, col: int) -> None:
@@ -154,6 +159,39 @@ class SketchDocument:
         if not ok:
             raise OSError(f"{path}: could not encode the sketch as PNG")
         atomic_write_bytes(Path(path), encoded.tobytes())
+        self.saved_path = Path(path).absolute()
+        self._saved_image = self.image.copy()
+
+    @property
+    def file_of_drawing(self) -> Path | None:
+        """The PNG last saved, while the drawing is still what was saved there; else None."""
+        return (
+            self.saved_path if self._saved_image is not None and np.array_equal(self.image, self._saved_image) else None
+        )
+
+    def mark_used(self) -> None:
+        """The drawing as it is now was handed to the session as its sketch."""
+        self._used_image = self.image.copy()
+
+    @property
+    def unkept(self) -> bool:
+        """True when closing would lose drawing: not blank, and neither saved nor used as it is.
+
+        >>> document = SketchDocument(10, 10)
+        >>> document.unkept
+        False
+        >>> document.begin(2, 2); document.end(2, 8)
+        >>> document.unkept
+        True
+        >>> document.mark_used()
+        >>> document.unkept
+        False
+        """
+        if not (self.image != PAPER).any():
+            return False
+        return not any(
+            kept is not None and np.array_equal(self.image, kept) for kept in (self._saved_image, self._used_image)
+        )
 
     # ---- drawing -------------------------------------------------------------------------------
     def _colour(self) -> int:

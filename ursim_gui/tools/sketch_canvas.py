@@ -22,7 +22,7 @@ from PySide6.QtWidgets import (
 from ursim_gui.model.sketch_document import TOOLS, SketchDocument
 from ursim_gui.views import file_dialogs
 from ursim_gui.views.map_items import grey_to_qimage
-from ursim_gui.views.messages import show_error
+from ursim_gui.views.messages import ask_keep_drawing, show_error
 
 __all__ = ["SketchSizeDialog", "SketchCanvas", "SketchWindow"]
 
@@ -101,10 +101,11 @@ class SketchWindow(QMainWindow):
 
     Signals
     -------
-    use_as_sketch(object) : the drawn image (uint8, walls black) to set as the session's sketch
+    use_as_sketch(object, object) : the drawn image (uint8, walls black) to set as the session's
+        sketch, and the PNG it was last saved to while it is still the drawing (else None)
     """
 
-    use_as_sketch = Signal(object)
+    use_as_sketch = Signal(object, object)
 
     def __init__(self, rows: int, cols: int, parent=None):
         super().__init__(parent)
@@ -176,10 +177,10 @@ class SketchWindow(QMainWindow):
         self.undo_action.setEnabled(self.document.can_undo)
         self.redo_action.setEnabled(self.document.can_redo)
 
-    def save_dialog(self) -> None:
+    def save_dialog(self) -> bool:
+        """Ask for a PNG and save the drawing there. True when it was saved."""
         path = file_dialogs.ask_save_path(self, "Save sketch", "sketch.png", "PNG image (*.png)")
-        if path is not None:
-            self.save_to(str(path))
+        return path is not None and self.save_to(str(path))
 
     def save_to(self, path: str) -> bool:
         """Save the PNG; a failure is shown in a dialog and logged. True on success."""
@@ -189,7 +190,18 @@ class SketchWindow(QMainWindow):
             show_error(self, "Save failed", f"The sketch was not saved:\n{error}")
             return False
         self.statusBar().showMessage(f"Saved {path}", 4000)
+        self.setWindowTitle(f"Sketch — {self.document.saved_path.name}")
         return True
 
     def _use_as_sketch(self) -> None:
-        self.use_as_sketch.emit(self.document.map_image())
+        self.use_as_sketch.emit(self.document.map_image(), self.document.file_of_drawing)
+        self.document.mark_used()
+
+    def closeEvent(self, event) -> None:
+        """A drawing neither saved nor used as the sketch is not closed without asking."""
+        if self.document.unkept:
+            answer = ask_keep_drawing(self)
+            if answer == "cancel" or (answer == "save" and not self.save_dialog()):
+                event.ignore()
+                return
+        super().closeEvent(event)

@@ -1,7 +1,8 @@
-"""Error messages of the app: logged, and shown in a non-blocking window-modal box.
+"""Error messages of the app: logged, and shown in a non-blocking window-modal box; and the
+question a drawing window asks before its drawing is lost.
 
-Non-blocking so a failing background job never stacks nested event loops. Every layer
-above the model may show errors, so this lives at the bottom of the Qt layers.
+Errors are non-blocking so a failing background job never stacks nested event loops. Every
+layer above the model may show errors, so this lives at the bottom of the Qt layers.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import logging
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QMessageBox, QWidget
 
-__all__ = ["show_error"]
+__all__ = ["show_error", "ask_keep_drawing"]
 
 _log = logging.getLogger("ursim_gui")
 #: Parentless error boxes are kept here while shown; Python would otherwise delete them.
@@ -29,3 +30,20 @@ def show_error(parent: QWidget | None, title: str, message: str) -> QMessageBox:
         box.finished.connect(lambda _result: _open_boxes.discard(box))
     box.open()
     return box
+
+
+def ask_keep_drawing(parent: QWidget | None) -> str:
+    """Ask what to do with a drawing neither saved nor used: 'save', 'discard' or 'cancel'."""
+    box = QMessageBox(parent)
+    box.setObjectName("unkept_drawing_box")
+    box.setIcon(QMessageBox.Icon.Warning)
+    box.setWindowTitle("Unsaved drawing")
+    box.setText("The drawing has not been saved or used as the sketch. Save it before closing?")
+    box.setStandardButtons(
+        QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel
+    )
+    box.setDefaultButton(QMessageBox.StandardButton.Save)
+    answer = box.exec()
+    return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
+        QMessageBox.StandardButton(answer), "cancel"
+    )

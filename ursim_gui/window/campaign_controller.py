@@ -123,28 +123,35 @@ class CampaignController(QObject):
 
     # ---- internals ---------------------------------------------------------------------------
     def _is_open(self, index: int) -> bool:
-        pair = self.campaign.pairs[index]
-        current = self.session.map("sketch")
-        return current is not None and current.path == pair.sketch.absolute()
+        """True when the session holds pair ``index``'s document: its two maps, and its file or
+        none yet. Another file opened over the same sketch (another annotator's, say) is not the
+        pair's, and the pair's file is never written from it."""
+        pair, session = self.campaign.pairs[index], self.session
+        sketch, metric = session.map("sketch"), session.map("metric")
+        return (
+            sketch is not None
+            and sketch.path == pair.sketch.absolute()
+            and metric is not None
+            and metric.path == pair.metric.absolute()
+            and session.path in (None, pair.output.absolute())
+        )
 
     def _leave_current(self) -> bool:
-        if self.campaign is not None:
+        if self.campaign is not None and self._is_open(self.campaign.current):
             return self.save_current()
-        return self.window.documents.confirm_discard("opening the campaign")
+        what = "opening the campaign" if self.campaign is None else "going to another pair"
+        return self.window.documents.confirm_discard(what)
 
     def _open_pair(self, index: int) -> bool:
+        """Open pair ``index`` (the current one was saved or left). Its maps are read before
+        anything changes; a pair that cannot be opened is shown as an empty document at its place
+        in the list, so the panel never names one pair while the maps show another."""
         campaign, session, window = self.campaign, self.session, self.window
         pair = campaign.pairs[index]
-        campaign.current = index
-        self.panel.show_current(index)
-        try:
-            campaign.save_state()
-        except OSError as error:
-            _log.warning("campaign state not written: %s", error)
         self._awaiting_match = None
         try:
             if pair.output.is_file():
-                session.open(pair.output)
+                session.open(pair.output)  # all at once or not at all
             else:
                 metric = session.map("metric")
                 keep = (
@@ -154,13 +161,21 @@ class CampaignController(QObject):
                     and session.segmentation("metric") is not None
                     else []
                 )
+                sketch_map = session.read_map(pair.sketch)
+                metric_map = None if keep else session.read_map(pair.metric)
                 session.new_document(keep=keep)
-                session.load_map("sketch", pair.sketch)
-                if not keep:
-                    session.load_map("metric", pair.metric)
+                session.set_map("sketch", sketch_map)
+                if metric_map is not None:
+                    session.set_map("metric", metric_map)
         except _FAILURES as error:
+            window.jobs.drop_all()
+            session.new_document()
+            self._show_position(index)
             dialogs.show_error(window, f"Cannot open pair {pair.name}", str(error))
             return False
+        # What was queued or running for the pair left would fail or clear the queue.
+        window.jobs.drop_all()
+        self._show_position(index)
         self._read_neighbours_ahead(index)
         # What the source says the input map is (the Halmstad robot maps), for every match of the
         # pair: set once its maps are in, since opening another map forgets the last pair's settings.
@@ -204,6 +219,15 @@ class CampaignController(QObject):
         if self.save_current():
             self.pair_ready.emit(campaign.current)
 
+    def _show_position(self, index: int) -> None:
+        campaign = self.campaign
+        campaign.current = index
+        self.panel.show_current(index)
+        try:
+            campaign.save_state()
+        except OSError as error:
+            _log.warning("campaign state not written: %s", error)
+
     def _show_row(self, row: int) -> None:
         self.panel.show_pair(row, pair_summary(self.campaign.pairs[row].output))
         self._show_progress()
@@ -213,6 +237,7 @@ class CampaignController(QObject):
         if campaign is None or not self._is_open(campaign.current):
             return
         self.panel.show_pair(campaign.current, summary_of(self.session.correspondences))
+        self._show_progress()
 
     def _show_progress(self) -> None:
         rows = range(self.panel.table.rowCount())

@@ -83,18 +83,35 @@ class DocumentController(QObject):
         A map that is not the one the document names starts a new, untitled document
         that keeps the other side's map (after asking about unsaved changes): the old
         cliques, reference and file belong to the old pair, and saving must never write
-        them under the new map's name.
+        them under the new map's name. The file is read first: one that cannot be read
+        leaves the document as it was.
         """
         path = path or self._ask_open(f"Open {side} map", MAP_FILTER)
         if path is None:
             return False
         session = self.session
-        if not session.is_document_map(side, path):
-            if not self.confirm_discard(f"opening another {side} map"):
+        try:
+            map_ = session.read_map(path)
+        except _FAILURES as error:
+            dialogs.show_error(self.window, f"Cannot open the {side} map", str(error))
+            return False
+        return self.show_map(side, map_, f"opening another {side} map")
+
+    def show_map(self, side: str, map_, what: str) -> bool:
+        """Put a map already read (or drawn) on ``side``, by the rule of :meth:`open_map`: a map
+        that is not the document's starts a new document, after asking about unsaved changes."""
+        session = self.session
+        # A drawing (no file) replaces only a drawing: a document naming a file is another pair.
+        if map_.path is None:
+            same = getattr(session.correspondences, side).path is None
+        else:
+            same = session.is_document_map(side, map_.path)
+        if not same:
+            if not self.confirm_discard(what):
                 return False
             other = "metric" if side == "sketch" else "sketch"
             session.new_document(keep=[other])
-        return self._try(f"Cannot open the {side} map", session.load_map, side, path)
+        return self._try(f"Cannot open the {side} map", session.set_map, side, map_)
 
     def open_correspondences(self, path: Path | None = None) -> bool:
         """Open a correspondence JSON (and its maps), after offering to save changes."""
@@ -104,7 +121,20 @@ class DocumentController(QObject):
         if path is None or not self._try("Cannot open the correspondences", self.session.open, path):
             return False
         self._remember(path)
+        self._segment_what_the_file_does_not_say()
         return True
+
+    def _segment_what_the_file_does_not_say(self) -> None:
+        """A file that records no segmentation of a map (ground truth clicked elsewhere, a
+        generated example) gets it from the segmentation panel's preset, as a campaign's new pair
+        does: without regions its clicked points show as nothing and it cannot be matched."""
+        panel, jobs = getattr(self.window, "segmentation_panel", None), getattr(self.window, "jobs", None)
+        if panel is None or jobs is None:
+            return
+        for side in ("sketch", "metric"):
+            if self.session.map(side) is not None and self.session.segmentation(side) is None:
+                box = panel.boxes[side]
+                jobs.segment(side, box.preset.currentText(), box.overrides())
 
     def open_dropped(self, side: str, paths: list[Path]) -> None:
         """Files dropped on a view: a .json opens correspondences, anything else a map."""
@@ -127,6 +157,11 @@ class DocumentController(QObject):
         """Save to the current file, or ask for one. True when the file was written."""
         if self.session.path is None:
             return self.save_as()
+        if self.session.file_is_current():
+            # Rewriting an unchanged file would only move its ``modified`` stamp (and its
+            # modification time, which makes it look edited to others and to version control).
+            self.window.statusBar().showMessage(f"No changes to save: {self.session.path} is up to date", 4000)
+            return True
         return self._save_to(None)
 
     def save_as(self, path: Path | None = None) -> bool:

@@ -46,13 +46,21 @@ class WindowTools:
         sketch.show()
         return sketch
 
-    def use_as_sketch(self, image) -> None:
+    def use_as_sketch(self, image, saved_path=None) -> bool:
+        """The drawing window's image becomes the sketch, by the rule of opening a map: another
+        sketch than the document's starts a new document, after asking about unsaved changes.
+        A drawing still as saved is opened from its PNG; one never saved has no file until the
+        document is saved, which writes it beside the document."""
         from ursim_core.io.maps import map_from_array
 
+        if saved_path is not None:
+            return self.window.documents.open_map("sketch", saved_path)
         try:
-            self.session.set_map("sketch", map_from_array(image))
+            map_ = map_from_array(image)
         except (UrsimError, ValueError) as error:
             dialogs.show_error(self.window, "Cannot use the sketch", str(error))
+            return False
+        return self.window.documents.show_map("sketch", map_, "using the drawn sketch")
 
     # ---- orientation ---------------------------------------------------------------------
     def compare_readings(self) -> ReadingsDialog | None:

@@ -51,3 +51,44 @@ def test_an_edited_segmentation_survives_a_crash_through_the_autosave_copy(windo
     discard(copy)
     assert not copy.exists() and not labels_copy.exists()
     saver.close()
+
+
+def test_a_segmentation_edit_of_an_untitled_matched_pair_is_unsaved_work(session):
+    # Untouched matcher output alone is not worth a question on closing (matching again gives
+    # it back), but a merge is the person's work: it makes the document dirty, so it is asked
+    # about and autosaved.
+    from conftest import fake_match
+
+    session.apply_match(fake_match([(1, 1), (2, 2)]))
+    assert session.path is None and not session.dirty
+    dirty = []
+    session.dirty_changed.connect(dirty.append)
+    assert session.merge_regions("sketch", 1, 2)
+    assert session.dirty and dirty == [True]
+    session.undo()
+    assert not session.dirty
+
+
+def test_a_drawn_sketch_is_saved_beside_the_document_and_reopens_with_it(session, tmp_path):
+    from ursim_core.io.maps import load_map, map_from_array
+
+    drawn = np.full((60, 80), 255, np.uint8)
+    drawn[:, 40] = 0  # a wall: two rooms
+    drawn[0, :] = drawn[-1, :] = drawn[:, 0] = drawn[:, -1] = 0
+    session.new_document(keep=["metric"])
+    session.set_map("sketch", map_from_array(drawn))
+    # A drawing has no file: until the document is saved it exists only in the session.
+    assert session.dirty
+
+    document = tmp_path / "drawn.json"
+    session.save(document)
+    beside = tmp_path / "drawn.sketch.png"
+    assert beside.is_file() and not session.dirty
+    assert session.map("sketch").path == beside and session.correspondences.sketch.path == beside
+    assert np.array_equal(load_map(beside).free, session.map("sketch").free)
+
+    reopened = AnnotationSession()
+    reopened.open(document)
+    assert reopened.map("sketch").path == beside and not reopened.dirty
+    assert np.array_equal(reopened.map("sketch").free, session.map("sketch").free)
+    assert reopened.map("sketch").sha256 == session.map("sketch").sha256

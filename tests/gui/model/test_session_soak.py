@@ -8,11 +8,11 @@ model's state, and undo/redo availability and dirtiness must agree.
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
 from ursim_core.correspondences import load_correspondences
-from ursim_core.io.maps import map_from_array
 from ursim_core.segmentation import Segmentation
 from ursim_core.segmentation.graph import region_graph
 from ursim_gui.model.session import AnnotationSession
@@ -132,7 +132,9 @@ def test_random_edits_match_an_independent_replay(seed, tmp_path):
     interiors = {}
     for side, labels in (("sketch", sketch_labels), ("metric", metric_labels)):
         segmentation = Segmentation(labels=labels, graph=region_graph(labels), method="label-image")
-        session.set_map(side, map_from_array(labels > 0))
+        # From a file, as the app opens maps (a map with no file is a drawing: unsaved work).
+        cv2.imwrite(str(tmp_path / f"{side}.png"), np.where(labels > 0, 255, 0).astype(np.uint8))
+        session.load_map(side, tmp_path / f"{side}.png")
         session.set_segmentation(side, segmentation)
         interiors[side] = {region: segmentation.graph.nodes[region]["interior"] for region in segmentation.graph}
     model = ReferenceModel(interiors)

@@ -89,3 +89,84 @@ def test_failed_sketch_save_shows_an_error(qtbot, tmp_path):
     from PySide6.QtWidgets import QMessageBox
 
     assert sketch.findChildren(QMessageBox)
+
+
+def test_closing_a_drawing_neither_saved_nor_used_asks_first(qtbot, monkeypatch, tmp_path):
+    import ursim_gui.tools.sketch_canvas as sketch_canvas
+
+    sketch = SketchWindow(60, 80)
+    qtbot.addWidget(sketch)
+    sketch.show()
+    asked = []
+    monkeypatch.setattr(sketch_canvas, "ask_keep_drawing", lambda parent: asked.append(1) or answer)
+    answer = "cancel"
+    assert sketch.close()  # blank paper: nothing to lose, no question
+    assert not asked
+
+    sketch = SketchWindow(60, 80)
+    qtbot.addWidget(sketch)
+    sketch.show()
+    sketch.document.begin(10, 10)
+    sketch.document.end(10, 70)
+    assert not sketch.close() and sketch.isVisible() and asked == [1]  # cancel keeps it open
+    sketch._use_as_sketch()
+    assert sketch.close() and asked == [1]  # used as the sketch: kept in the document
+
+    sketch = SketchWindow(60, 80)
+    qtbot.addWidget(sketch)
+    sketch.show()
+    sketch.document.begin(10, 10)
+    sketch.document.end(10, 70)
+    assert sketch.save_to(str(tmp_path / "s.png"))
+    assert sketch.close() and asked == [1]  # saved
+    sketch = SketchWindow(60, 80)
+    qtbot.addWidget(sketch)
+    sketch.show()
+    sketch.document.begin(10, 10)
+    sketch.document.end(10, 70)
+    answer = "discard"
+    assert sketch.close() and asked == [1, 1]
+
+
+def test_using_a_drawing_over_a_saved_document_starts_a_new_one_and_saves_the_drawing_beside_it(
+    window, qtbot, tmp_path, monkeypatch
+):
+    from conftest import answer_file_dialogs, link_by_clicks
+
+    link_by_clicks(qtbot, window, 1, 1)
+    document = tmp_path / "pair.json"
+    answer_file_dialogs(monkeypatch, document)
+    window.actions["save"].trigger()
+    saved = document.read_bytes()
+
+    sketch = window.tools.new_sketch((60, 150))
+    qtbot.addWidget(sketch)
+    sketch.document.begin(30, 5)
+    sketch.document.end(30, 145)
+    sketch._use_as_sketch()
+    session = window.session
+    assert session.path is None and session.correspondences.cliques == ()
+    assert session.map("sketch").path is None and session.map("metric") is not None
+    assert session.dirty and window.windowTitle().endswith("*")  # the drawing is unsaved work
+
+    drawn_document = tmp_path / "drawn.json"
+    answer_file_dialogs(monkeypatch, drawn_document)
+    window.actions["save"].trigger()
+    assert document.read_bytes() == saved  # the old pair's file untouched
+    assert (tmp_path / "drawn.sketch.png").is_file() and not session.dirty
+    assert session.map("sketch").path == tmp_path / "drawn.sketch.png"
+    assert "map" not in window.view_titles["sketch"].text()
+    sketch.close()
+
+
+def test_closing_the_app_asks_about_an_open_drawing(window, qtbot, monkeypatch):
+    import ursim_gui.tools.sketch_canvas as sketch_canvas
+
+    sketch = window.tools.new_sketch((60, 80))
+    qtbot.addWidget(sketch)
+    sketch.document.begin(10, 10)
+    sketch.document.end(10, 70)
+    monkeypatch.setattr(sketch_canvas, "ask_keep_drawing", lambda parent: "cancel")
+    assert not window.close() and window.isVisible() and sketch.isVisible()
+    monkeypatch.setattr(sketch_canvas, "ask_keep_drawing", lambda parent: "discard")
+    assert window.close() and not sketch.isVisible()

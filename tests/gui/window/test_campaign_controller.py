@@ -150,3 +150,107 @@ def test_the_next_pair_s_sketch_is_read_ahead_while_a_pair_is_worked_on(plain_ca
     assert len(read_on["metric.png"]) == 1
     window.close()
     assert window.session.read_ahead.pending == ()
+
+
+def test_another_file_opened_over_a_pair_never_overwrites_the_pair_s_file(plain_campaign, qtbot, tmp_path, monkeypatch):
+    # Another annotator's file of the same sketch, or another metric map, is not the pair's
+    # document: leaving it must not write it under the pair's name.
+    import dataclasses
+
+    from ursim_core.correspondences import save_correspondences
+    from ursim_gui.window import dialogs
+
+    out = tmp_path / "out"
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=out)
+    window.actions["accept_all"].trigger()
+    assert window.campaigns.save_current()
+    mine = (out / "s1.json").read_bytes()
+
+    theirs = tmp_path / "theirs.json"
+    save_correspondences(dataclasses.replace(load_correspondences(out / "s1.json"), annotator="vasiliki"), theirs)
+    assert window.documents.open_correspondences(theirs)
+    asked = []
+    monkeypatch.setattr(dialogs, "ask_unsaved_changes", lambda parent, what: asked.append(what) or "discard")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        qtbot.keyClick(window.views["sketch"], Qt.Key.Key_D)
+    assert (out / "s1.json").read_bytes() == mine and not asked
+
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        qtbot.keyClick(window.views["sketch"], Qt.Key.Key_A)  # s1 reopened from its file
+    assert window.session.path == (out / "s1.json").absolute()
+    assert window.documents.open_map("metric", plain_campaign / "s3.png")  # another metric map
+    qtbot.waitUntil(lambda: not window.jobs.busy, timeout=60_000)
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        qtbot.keyClick(window.views["sketch"], Qt.Key.Key_D)
+    assert (out / "s1.json").read_bytes() == mine
+    window.close()
+
+
+def test_a_pair_that_cannot_be_opened_is_shown_empty_at_its_place(plain_campaign, qtbot, tmp_path, monkeypatch):
+    # The panel must never name one pair while the maps show another: edits made then would be
+    # saved nowhere.
+    from conftest import error_boxes
+
+    out = tmp_path / "out"
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=out)
+    session, campaigns = window.session, window.campaigns
+    session.set_status(session.correspondences.cliques[0].id, "rejected")
+    (out / "s2.json").write_text("{ not json")  # the next pair's file, damaged
+    assert not campaigns.next()
+    assert error_boxes(window) and "s2" in error_boxes(window)[0].text()
+    assert load_correspondences(out / "s1.json").cliques[0].status == "rejected"  # saved on leaving
+    assert campaigns.campaign.current == 1 and window.campaign_panel.table.currentRow() == 1
+    assert session.map("sketch") is None and session.correspondences.cliques == ()
+    with qtbot.waitSignal(campaigns.pair_ready, timeout=180_000):
+        assert campaigns.next()  # past the broken pair
+    assert session.map("sketch").path == (plain_campaign / "s3.png").absolute()
+    window.close()
+
+
+def test_paging_faster_than_the_matcher_leaves_the_pair_landed_on_matched(plain_campaign, qtbot, tmp_path):
+    # The pairs left had jobs queued; they are dropped, not run against the next pair's maps
+    # (where a stale match request cleared the new pair's jobs).
+    from conftest import error_boxes
+
+    out = tmp_path / "out"
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=out)
+    campaigns = window.campaigns
+    assert campaigns.next()
+    assert campaigns.next()  # s2's segmentation and match still queued
+    with qtbot.waitSignal(campaigns.pair_ready, timeout=180_000):
+        pass
+    assert campaigns.campaign.current == 2 and not error_boxes(window)
+    assert window.session.correspondences.cliques and (out / "s3.json").is_file()
+    assert not (out / "s2.json").exists()
+    assert window.campaign_panel.status_text(1) == "not started"
+    window.close()
+
+
+def test_the_progress_bar_counts_a_pair_as_done_as_soon_as_it_is(plain_campaign, qtbot, tmp_path):
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        window.campaigns.open(plain_campaign, output_dir=tmp_path / "out")
+    assert window.campaign_panel.progress.value() == 0
+    window.actions["accept_all"].trigger()
+    assert window.campaign_panel.status_text(0) == "done" and window.campaign_panel.progress.value() == 1
+    window.close()
+
+
+def test_a_plain_folder_with_a_model_map_is_a_campaign(tmp_path, labels3):
+    # The Halmstad KT folder: four robot maps and model_simple.png.
+    import cv2
+    import numpy as np
+
+    folder = tmp_path / "KT"
+    folder.mkdir()
+    for name in ("KPT4A_01", "KPT4A_02", "model_simple"):
+        cv2.imwrite(str(folder / f"{name}.png"), np.where(labels3 > 0, 255, 0).astype(np.uint8))
+    campaign = open_campaign(folder, output_dir=tmp_path / "out")
+    assert [pair.name for pair in campaign.pairs] == ["KPT4A_01", "KPT4A_02"]
+    assert {pair.metric.name for pair in campaign.pairs} == {"model_simple.png"}

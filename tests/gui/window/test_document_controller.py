@@ -73,6 +73,28 @@ def test_unreadable_map_shows_an_error_and_changes_nothing(empty_window, tmp_pat
     assert any("broken.png" in record.getMessage() and record.levelname == "ERROR" for record in caplog.records)
 
 
+@pytest.mark.parametrize("side", ["sketch", "metric"])
+@pytest.mark.parametrize("content", [b"", b"not an image at all", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00"])
+def test_a_map_that_cannot_be_read_leaves_the_pair_as_it_was(window, qtbot, tmp_path, monkeypatch, side, content):
+    # The file is read before the document is replaced: no question, nothing lost, undo kept.
+    link_by_clicks(qtbot, window, 1, 1)
+    session = window.session
+    before = session.correspondences
+    maps = {name: session.map(name) for name in ("sketch", "metric")}
+    segmentations = {name: session.segmentation(name) for name in ("sketch", "metric")}
+    asked = []
+    monkeypatch.setattr(dialogs, "ask_unsaved_changes", lambda parent, what: asked.append(what) or "discard")
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(content)
+    choose_file(monkeypatch, bad)
+    assert not window.documents.open_map(side)
+    assert error_boxes(window) and "bad.png" in error_boxes(window)[0].text()
+    assert not asked
+    assert session.correspondences == before and session.can_undo
+    assert {name: session.map(name) for name in maps} == maps
+    assert {name: session.segmentation(name) for name in segmentations} == segmentations
+
+
 def test_open_correspondences_loads_the_maps_it_names(window, tmp_path, monkeypatch):
     window.session.link([1], [1])
     saved = tmp_path / "corr.json"
@@ -162,6 +184,10 @@ def test_ctrl_s_saves_and_the_title_tracks_dirty(window, qtbot, tmp_path, monkey
     assert window.windowTitle().endswith("out.json*")
     qtbot.keyClick(window.views["sketch"], Qt.Key.Key_S, Qt.KeyboardModifier.ControlModifier)  # no dialog now
     assert len(load_correspondences(target).cliques) == 2 and not window.session.dirty
+    written = target.read_bytes(), target.stat().st_mtime_ns
+    qtbot.keyClick(window.views["sketch"], Qt.Key.Key_S, Qt.KeyboardModifier.ControlModifier)  # nothing changed
+    assert (target.read_bytes(), target.stat().st_mtime_ns) == written
+    assert "No changes to save" in window.statusBar().currentMessage()
     other = tmp_path / "copy.json"
     save_to(monkeypatch, other)
     qtbot.keyClick(
@@ -368,3 +394,14 @@ def test_a_clean_close_removes_the_lock(window):
     assert lock.read_text().split()[0].isdigit()
     window.documents.close_document()
     assert not lock.exists()
+
+
+def test_a_file_that_records_no_segmentation_gets_its_maps_segmented(empty_window, qtbot):
+    # The bundled example's ground truth names its maps and points only: it opens with regions.
+    example = Path(__file__).resolve().parents[3] / "resources" / "example" / "ground_truth.json"
+    session = empty_window.session
+    assert empty_window.documents.open_correspondences(example)
+    qtbot.waitUntil(lambda: not empty_window.jobs.busy, timeout=120_000)
+    assert session.segmentation("sketch") is not None and session.segmentation("metric") is not None
+    assert all(clique.sketch_regions and clique.metric_regions for clique in session.correspondences.cliques)
+    assert not session.dirty and session.path == example
