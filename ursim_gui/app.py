@@ -105,8 +105,10 @@ def main(argv: list[str] | None = None) -> int:
     from ursim_gui.window.main_window import MainWindow
 
     app = QApplication.instance() or QApplication([sys.argv[0] if sys.argv else "ursim-gui"])
+    # No application display name: Qt appends it to every window title on X11 and Windows, and the
+    # window's title already starts with "URSIM Studio" (the session's window_title), so the
+    # title bar said it twice ("URSIM Studio — untitled* — URSIM Studio").
     app.setApplicationName(APP_NAME)
-    app.setApplicationDisplayName("URSIM Studio")
     window = MainWindow(data_dir=folder)
     install_excepthook(lambda: window)
     _log.info("URSIM Studio started; log file %s", log_path)

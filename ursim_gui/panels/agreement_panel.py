@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (
 )
 
 from ursim_gui.model.agreement import COMPARISONS, pooled
+from ursim_gui.model.wording import counted
 
 __all__ = ["AgreementPanel", "FOLDER_CHOICE"]
 
@@ -116,7 +117,7 @@ class AgreementPanel(QWidget):
         elif name:
             self.second.insertItem(self.second.count() - 1, name)
             self.second.setCurrentIndex(self.second.count() - 2)
-        suffix = "" if pairs is None else f": {pairs} pairs compared"
+        suffix = "" if pairs is None else f": {counted(pairs, 'pair')} compared"
         self.note.setText(
             f"A = your files, B = {name or '(none)'}{suffix}. On the maps: FP = A's clique B does not share, FN = B's clique A misses."
         )

@@ -1,4 +1,9 @@
-"""Anchors of the last match: a list of (sketch region, metric region); click selects both."""
+"""Anchors of the last match: a list of (sketch region, metric region); click selects both.
+
+The anchors are the heat sources of the region descriptors: unique regions paired before the
+matching. The answer may pair them otherwise (the matcher corrects a wrong anchor, or the
+sketch laid on the map gives other partners), so each entry says whether the answer agrees.
+"""
 
 from __future__ import annotations
 
@@ -16,7 +21,10 @@ class AnchorsList(QWidget):
         self._session = session
         self.list = QListWidget()
         self.list.setObjectName("anchors_list")
-        self.hint = QLabel("Unique regions matched first; drawn with a dashed outline.")
+        self.hint = QLabel(
+            "Unique regions paired before matching, the sources of the region descriptors; drawn with "
+            "a dashed outline. The answer may pair them otherwise."
+        )
         self.hint.setWordWrap(True)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -28,8 +36,16 @@ class AnchorsList(QWidget):
 
     def refresh(self, *_args) -> None:
         self.list.clear()
-        for sketch, metric in self._session.anchors:
-            item = QListWidgetItem(f"sketch {sketch}  ↔  metric {metric}")
+        session = self._session
+        for sketch, metric in session.anchors:
+            kept = int(metric) in session.partners("sketch", int(sketch))
+            verdict = "in the answer" if kept else "not in the answer"
+            item = QListWidgetItem(f"sketch {sketch}  ↔  metric {metric}   ({verdict})")
+            item.setToolTip(
+                "The answer pairs these two regions too."
+                if kept
+                else "The answer does not pair these two regions: the matcher found other partners."
+            )
             item.setData(Qt.ItemDataRole.UserRole, (int(sketch), int(metric)))
             self.list.addItem(item)
 

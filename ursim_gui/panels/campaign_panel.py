@@ -21,6 +21,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from ursim_gui.model.wording import counted
+
 __all__ = ["CampaignPanel", "STATUS_COLOURS", "CLOSE_CALL_COLOUR"]
 
 #: Text colour of each status in the list (readable on light and dark backgrounds).
@@ -92,7 +94,7 @@ class CampaignPanel(QWidget):
 
     def show_campaign(self, name: str, names: list[str], output: str) -> None:
         """A new campaign: its name, pair names and output folder."""
-        self.title.setText(f"Campaign {name}: {len(names)} pairs")
+        self.title.setText(f"Campaign {name}: {counted(len(names), 'pair')}")
         self.output.setText(f"Files: {output}/<pair>.json")
         self.table.setRowCount(len(names))
         for row, pair in enumerate(names):

@@ -15,10 +15,23 @@ from ursim_core.correspondences.exporters import clique_label
 
 __all__ = ["CorrespondenceTableModel", "CorrespondenceTable", "COLUMNS"]
 
-COLUMNS = ("Clique", "Sketch regions", "Metric regions", "Source", "Score", "Status", "Eval", "Label", "Note")
+COLUMNS = ("Clique", "Sketch", "Metric", "Source", "Score", "Status", "Eval", "Label", "Note")
+#: What the terse headers stand for (the header's tooltip).
+_HEADER_TIPS = {
+    "Sketch": "The clique's regions on the sketch",
+    "Metric": "The clique's regions on the metric map",
+    "Source": "auto: the matcher's pair; manual: linked by hand",
+    "Status": "pending, accepted (Y) or rejected (R)",
+    "Eval": "TP or FP against the reference loaded in the Evaluation panel",
+    "Label": "Room name or type (double-click a cell to edit)",
+    "Note": "Free note (double-click a cell to edit)",
+}
 _NOTE_COLUMN = COLUMNS.index("Note")
 _LABEL_COLUMN = COLUMNS.index("Label")
 _EDITABLE = (_NOTE_COLUMN, _LABEL_COLUMN)
+#: Columns of free text: they share the width left and elide; the others are sized to their values.
+FREE_TEXT_COLUMNS = _EDITABLE
+_STATUSES = ("pending", "accepted", "rejected")
 _MARK_COLOURS = {"TP": QColor(30, 140, 60), "FP": QColor(200, 40, 40)}
 _STATUS_COLOURS = {"accepted": QColor(30, 120, 60), "rejected": QColor(170, 40, 40), "pending": QColor(120, 120, 120)}
 
@@ -70,6 +83,8 @@ class CorrespondenceTableModel(QAbstractTableModel):
     def headerData(self, section: int, orientation, role=Qt.ItemDataRole.DisplayRole):
         if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.DisplayRole:
             return COLUMNS[section]
+        if orientation == Qt.Orientation.Horizontal and role == Qt.ItemDataRole.ToolTipRole:
+            return _HEADER_TIPS.get(COLUMNS[section])
         return None
 
     def data(self, index: QModelIndex, role=Qt.ItemDataRole.DisplayRole):
@@ -89,7 +104,10 @@ class CorrespondenceTableModel(QAbstractTableModel):
         if role == Qt.ItemDataRole.UserRole:
             return clique.id
         if role == Qt.ItemDataRole.ToolTipRole and column == _LABEL_COLUMN:
-            return "Room name or type (double-click to edit); saved in the JSON and carried into the exports"
+            # The cell may be elided: the tooltip gives the label in full.
+            label = clique_label(clique)
+            hint = "Room name or type (double-click to edit); saved in the JSON and carried into the exports"
+            return f"{label}\n\n{hint}" if label else hint
         if role == Qt.ItemDataRole.ToolTipRole and clique.note:
             return clique.note
         return None
@@ -167,7 +185,10 @@ class CorrespondenceTable(QWidget):
         header = self.view.horizontalHeader()
         # Measured once per reset, not on every change (ResizeToContents re-reads every row).
         header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
-        header.setStretchLastSection(True)
+        # The free text takes what is left, elided, so the short values never need a scroll bar.
+        for column in FREE_TEXT_COLUMNS:
+            header.setSectionResizeMode(column, QHeaderView.ResizeMode.Stretch)
+        self.view.setTextElideMode(Qt.TextElideMode.ElideRight)
         self.model.modelReset.connect(self._fit_columns)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -181,7 +202,7 @@ class CorrespondenceTable(QWidget):
         self.view.resizeColumnsToContents()
         # A status can change without a reset; leave room for the widest one.
         status_column = COLUMNS.index("Status")
-        widest = self.view.fontMetrics().horizontalAdvance("accepted") + 24
+        widest = max(self.view.fontMetrics().horizontalAdvance(status) for status in _STATUSES) + 24
         if self.view.columnWidth(status_column) < widest:
             self.view.setColumnWidth(status_column, widest)
 

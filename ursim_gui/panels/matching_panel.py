@@ -1,4 +1,5 @@
-"""Matching panel: m (auto or a value), descriptor variant, matcher, sketch orientation, Match; last result.
+"""Matching panel: Match, the sketch's orientation, the last result, then the matcher's settings (m, variant,
+matcher, scale, input kind, where a sketch's pairs come from and where it is laid).
 
 The orientation buttons turn (90-degree steps or a free angle) and mirror the sketch
 view and tell the matcher the orientation is known (when the core's ``MatchConfig`` has
@@ -20,6 +21,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QPushButton,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
@@ -27,6 +29,8 @@ from PySide6.QtWidgets import (
 from ursim_core.matching.orientation import describe_gap
 from ursim_gui.model.orientation import SketchOrientation
 from ursim_gui.model.pair_settings import MAX_SCALE
+from ursim_gui.model.wording import counted
+from ursim_gui.views.orientation_bar import ORIENTATION_TIPS
 
 __all__ = ["MatchingPanel", "VARIANTS", "MATCHERS", "INPUT_KINDS", "PAIRS_FROM", "describe_result"]
 
@@ -66,6 +70,8 @@ LAYINGS = (
     ("window_or_answer", "the window or where the graph answer puts it (slowest)"),
     ("boxes_or_window", "box onto box or the part of the map it resembles, whichever fits (slower)"),
 )
+#: Characters a settings list shows when the panel is at its narrowest.
+_COMBO_CHARACTERS = 18
 #: The matchers that use a known scale; those whose pairs may come from the laid sketch.
 _SCALED_MATCHERS = ("auto", "overlay")
 _ELASTIC_MATCHERS = ("auto", "planar")
@@ -94,14 +100,14 @@ def describe_result(result, *, automatic_cliques: int = 0, record=None) -> str:
     if result is None:
         if not automatic_cliques:
             return "not matched yet"
-        text = f"{automatic_cliques} automatic cliques from the file (press Match to run the matcher again)"
+        text = f"{counted(automatic_cliques, 'automatic clique')} from the file (press Match to run the matcher again)"
     else:
-        text = f"{len(result.pairs)} pairs, {len(result.anchors)} anchors, m = {result.m:.3f}"
+        text = f"{counted(len(result.pairs), 'pair')}, {counted(len(result.anchors), 'anchor')}, m = {result.m:.3f}"
         if math.isfinite(result.cost):
             text += f", cost {result.cost:.3g}"
         if getattr(result, "resampling_votes", 0):
             # The pairs are a vote; m and the cost are the first segmentation's answer's.
-            text += f"\nvoted over {result.resampling_votes} resamplings of the turned sketch"
+            text += f"\nvoted over {counted(result.resampling_votes, 'resampling')} of the turned sketch"
         if getattr(result, "laid", False):
             # m and the cost are the planar matcher's, which read the orientation.
             text += "\npairs from the sketch laid and bent onto the map"
@@ -143,8 +149,23 @@ class MatchingPanel(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        box = QGroupBox("Matching")
-        form = QFormLayout(box)
+        # Match and the sketch's orientation come first: the dock is short and scrolls, and a
+        # review comes back to them after every few edits; the settings below are set once a pair.
+        self.match_button = QPushButton("Match")
+        self.match_button.setObjectName("match_button")
+        self.match_button.setStyleSheet("font-weight: 600;")
+        self.match_button.setToolTip(
+            "Run the matcher (Ctrl+M). Cliques you linked, accepted or rejected are kept: the answer contains "
+            "your pairs and never proposes a rejected one again; pending automatic cliques are replaced."
+        )
+        self.match_button.clicked.connect(lambda: self.match_requested.emit(self.config()))
+        self.summary = QLabel(describe_result(None))
+        self.summary.setObjectName("match_summary")
+        self.summary.setWordWrap(True)
+        orientation_box = QGroupBox("Sketch orientation")
+        orientation_form = QFormLayout(orientation_box)
+        settings_box = QGroupBox("Matcher settings")
+        form = QFormLayout(settings_box)
         self.m_auto = QCheckBox("auto")
         self.m_auto.setObjectName("match_m_auto")
         self.m_auto.setChecked(True)
@@ -230,11 +251,10 @@ class MatchingPanel(QWidget):
         )
         self.partial.toggled.connect(self._lay_partial)
         self.orientation = SketchOrientation()
-        self.turn_left = QPushButton("⟲ 90°")
-        self.turn_left.setObjectName("orient_left")
-        self.turn_left.setToolTip("Turn the sketch 90° counter-clockwise")
-        self.turn_right = QPushButton("⟳ 90°")
-        self.turn_right.setObjectName("orient_right")
+        # Tool buttons, not push buttons: the style's minimum push-button width would make this
+        # row, and so the whole right column, wider than the rest of the panel.
+        self.turn_left = _tool_button("⟲ 90°", "orient_left", ORIENTATION_TIPS["left"])
+        self.turn_right = _tool_button("⟳ 90°", "orient_right", ORIENTATION_TIPS["right"])
         self.angle = QDoubleSpinBox()
         self.angle.setObjectName("orient_angle")
         self.angle.setRange(0.0, 359.9)
@@ -244,21 +264,22 @@ class MatchingPanel(QWidget):
         self.angle.setToolTip("Free angle, counter-clockwise")
         self.mirror = QCheckBox("mirror")
         self.mirror.setObjectName("orient_mirror")
-        self.unknown = QPushButton("unknown")
-        self.unknown.setObjectName("orient_unknown")
-        self.unknown.setToolTip("Let the matcher try every orientation")
+        self.mirror.setToolTip(ORIENTATION_TIPS["mirror"])
+        self.unknown = _tool_button("unknown", "orient_unknown", "Let the matcher try every orientation")
         orient_row = QHBoxLayout()
         for widget in (self.turn_left, self.turn_right, self.angle, self.mirror, self.unknown):
             orient_row.addWidget(widget)
-        form.addRow("Sketch", orient_row)
+        orient_row.addStretch(1)
+        orientation_form.addRow(orient_row)
         self.orientation_label = QLabel("")
         self.orientation_label.setObjectName("orient_summary")
-        form.addRow(self.orientation_label)
+        self.orientation_label.setWordWrap(True)
+        orientation_form.addRow(self.orientation_label)
         # The orientation the last match found, offered as the known one: the view turns to it and
         # the next match is told it (shown only while it differs from the orientation set).
         self.found_orientation: SketchOrientation | None = None
         self.keep_found = _row_button(
-            form,
+            orientation_form,
             "orient_keep_found",
             "Turn the sketch view to the orientation the matcher read and tell the matcher it from now on",
             lambda: self.set_orientation(self.found_orientation or self.orientation),
@@ -267,7 +288,7 @@ class MatchingPanel(QWidget):
         # misread (seeds 0-127), 16 are read right in it (docs/studies.md, round 54).
         self.runner_up: SketchOrientation | None = None
         self.try_runner_up = _row_button(
-            form,
+            orientation_form,
             "orient_try_runner_up",
             "Tell the matcher the reading it ranked next and match again (Undo gives the last answer "
             "back; 'unknown' lets the matcher choose the orientation again)",
@@ -279,32 +300,21 @@ class MatchingPanel(QWidget):
         #: The reading of the answer shown now (the one the last match laid the sketch in).
         self.answer_reading: SketchOrientation | None = None
         self.compare_readings = _row_button(
-            form,
+            orientation_form,
             "orient_compare_readings",
             "See the sketch turned as each reading the matcher ranked, beside the metric map, and "
             "match in the one that fits",
             self.readings_requested,
         )
-        self.turn_left.clicked.connect(lambda: self.set_orientation(self.orientation.turned(90)))
-        self.turn_right.clicked.connect(lambda: self.set_orientation(self.orientation.turned(-90)))
+        self.turn_left.clicked.connect(lambda: self.turn(90))
+        self.turn_right.clicked.connect(lambda: self.turn(-90))
         self.angle.editingFinished.connect(lambda: self.set_orientation(self.orientation.at(self.angle.value())))
-        self.mirror.clicked.connect(lambda on: self.set_orientation(self.orientation.with_mirror(on)))
+        self.mirror.clicked.connect(self.set_mirrored)
         self.unknown.clicked.connect(lambda: self.set_orientation(SketchOrientation()))
         self._show_orientation()
-        self.match_button = QPushButton("Match")
-        self.match_button.setObjectName("match_button")
-        self.match_button.setToolTip(
-            "Run the matcher. Cliques you linked, accepted or rejected are kept: the answer contains "
-            "your pairs and never proposes a rejected one again; pending automatic cliques are replaced."
-        )
-        self.match_button.clicked.connect(lambda: self.match_requested.emit(self.config()))
-        form.addRow(self.match_button)
-        self.summary = QLabel(describe_result(None))
-        self.summary.setObjectName("match_summary")
-        self.summary.setWordWrap(True)
-        form.addRow(self.summary)
         layout = QVBoxLayout(self)
-        layout.addWidget(box)
+        for widget in (self.match_button, orientation_box, self.summary, settings_box):
+            layout.addWidget(widget)
         layout.addStretch(1)
 
     def _add_option(self, form: QFormLayout, label: str, widget: QWidget, matchers, tooltip: str) -> None:
@@ -351,6 +361,15 @@ class MatchingPanel(QWidget):
             **extra,
         )
 
+    def turn(self, degrees: float) -> None:
+        """Turn the sketch ``degrees`` counter-clockwise from the orientation set (the panel's
+        buttons and the sketch view's)."""
+        self.set_orientation(self.orientation.turned(degrees))
+
+    def set_mirrored(self, mirrored: bool) -> None:
+        """Mirror the sketch left-right, or not (the panel's box and the sketch view's button)."""
+        self.set_orientation(self.orientation.with_mirror(bool(mirrored)))
+
     def set_orientation(self, orientation: SketchOrientation) -> None:
         """Show and announce a new sketch orientation."""
         if orientation == self.orientation:
@@ -372,10 +391,11 @@ class MatchingPanel(QWidget):
         found = self.found_orientation
         self.keep_found.setVisible(found is not None and found != orientation)
         if found is not None:
-            self.keep_found.setText(f"Keep the orientation read: {found.describe()}")
+            # Two lines: a reading on the same line made the panel, and its dock, 100 px wider.
+            self.keep_found.setText(f"Keep the orientation read:\n{found.describe()}")
         self.try_runner_up.setVisible(self.runner_up_offered())
         if self.runner_up is not None:
-            self.try_runner_up.setText(f"Match as read next best: {self.runner_up.describe()}")
+            self.try_runner_up.setText(f"Match as read next best:\n{self.runner_up.describe()}")
         self.compare_readings.setVisible(self.readings_offered())
         self.compare_readings.setText(f"Compare the {len(self.readings)} readings…")
         self.runner_up_changed.emit()
@@ -439,9 +459,21 @@ def _row_button(form: QFormLayout, name: str, tooltip: str, slot) -> QPushButton
     return button
 
 
+def _tool_button(text: str, name: str, tooltip: str) -> QToolButton:
+    button = QToolButton()
+    button.setText(text)
+    button.setObjectName(name)
+    button.setToolTip(tooltip)
+    return button
+
+
 def _combo(name: str, items) -> QComboBox:
     combo = QComboBox()
     combo.setObjectName(name)
+    # As narrow as a few words, not as the longest choice (which sized the whole right column):
+    # the list that opens shows every choice in full.
+    combo.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+    combo.setMinimumContentsLength(_COMBO_CHARACTERS)
     for value, text in items:
         combo.addItem(text, value)
     return combo

@@ -13,6 +13,7 @@ from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QFont, QFontMetricsF, QImage, QPainter, QPen
 
 from ursim_core.io.atomic import atomic_write_bytes
+from ursim_gui.model.wording import counted
 
 __all__ = ["render_figure", "export_figure"]
 
@@ -46,9 +47,9 @@ def _legend_lines(session) -> list[tuple[QColor | None, str]]:
 
 
 def _summary(session) -> str:
-    parts = [f"{len(session.correspondences.cliques)} cliques"]
+    parts = [counted(len(session.correspondences.cliques), "clique")]
     if session.anchors:
-        parts.append(f"{len(session.anchors)} anchors (dashed)")
+        parts.append(f"{counted(len(session.anchors), 'anchor')} (dashed)")
     score = session.evaluation
     if score is not None:
         parts.append(f"precision {score.precision:.3f}  recall {score.recall:.3f}  F1 {score.f1:.3f}")

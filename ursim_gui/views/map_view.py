@@ -17,9 +17,17 @@ from PySide6.QtGui import QColor, QImage, QPainter, QPalette, QPixmapCache, QTra
 from PySide6.QtWidgets import QApplication, QGraphicsScene, QGraphicsView, QStyle
 
 from ursim_gui.views.map_items import ImageItem, grey_to_qimage
+from ursim_gui.views.orientation_bar import OrientationBar
 from ursim_gui.views.region_layers import MIN_ID_REGION_PX, RegionLayers
 
-__all__ = ["MapView", "MAX_ZOOM", "MIN_ID_REGION_PX", "DRAWN_MARGIN", "drawn_area", "oriented_transform"]
+__all__ = [
+    "MapView",
+    "MAX_ZOOM",
+    "MIN_ID_REGION_PX",
+    "DRAWN_MARGIN",
+    "drawn_area",
+    "oriented_transform",
+]
 
 #: Largest zoom factor (3200 %).
 MAX_ZOOM = 32.0
@@ -29,6 +37,7 @@ DRAWN_MARGIN = 0.05
 _FIT_PADDING = 4
 _PIXMAP_CACHE_KB = 192 * 1024
 _WHEEL_STEP = 1.25
+_BUTTONS_FROM_CORNER_PX = 6
 
 
 def oriented_transform(angle: float, mirrored: bool, factor: float = 1.0) -> QTransform:
@@ -68,6 +77,9 @@ class MapView(QGraphicsView):
     zoom_changed(float) : new zoom factor (1.0 = 100 %)
     viewport_changed() : zoom or scroll changed (for connector lines)
     files_dropped(list) : paths dropped onto the view
+    turn_requested(float), mirror_requested(bool) : the sketch view's turn (degrees counter-clockwise)
+        and mirror buttons, in its top left corner; they only ask: the holder of the orientation
+        answers with :meth:`set_orientation`
     """
 
     region_hovered = Signal(int)
@@ -78,6 +90,8 @@ class MapView(QGraphicsView):
     files_dropped = Signal(list)
     #: A left-button stroke in stroke mode: list of (row, col) map pixels, press to release.
     stroke_drawn = Signal(list)
+    turn_requested = Signal(float)
+    mirror_requested = Signal(bool)
 
     def __init__(self, side: str, parent=None):
         super().__init__(parent)
@@ -113,6 +127,15 @@ class MapView(QGraphicsView):
         self.placeholder = "Drop a map here or use the File menu"
         self.horizontalScrollBar().valueChanged.connect(self.viewport_changed)
         self.verticalScrollBar().valueChanged.connect(self.viewport_changed)
+        #: The orientation buttons (:class:`~ursim_gui.views.orientation_bar.OrientationBar`) by key; none on the metric view.
+        self.orientation_actions = {}
+        self.orientation_bar = None
+        if side == "sketch":
+            # A child of the view, not of the viewport: Qt scrolls the viewport's children with the map.
+            self.orientation_bar = OrientationBar(self, f"{side}_orientation_buttons")
+            self.orientation_bar.turn_requested.connect(self.turn_requested)
+            self.orientation_bar.mirror_requested.connect(self.mirror_requested)
+            self.orientation_actions = self.orientation_bar.actions_by_key
 
     # ---- content -----------------------------------------------------------------
     def set_image(self, grey: np.ndarray | None, drawn=None) -> None:
@@ -132,6 +155,8 @@ class MapView(QGraphicsView):
             self.scene().setSceneRect(QRectF(0, 0, grey.shape[1], grey.shape[0]))
             self._drawn = QRectF() if drawn is None else drawn_area(drawn, DRAWN_MARGIN) & self.sceneRect()
             self.fit_to_window()
+        if self.orientation_bar is not None:
+            self.orientation_bar.setVisible(grey is not None)  # nothing to turn without a map
         self.viewport().update()
 
     def has_image(self) -> bool:
@@ -227,6 +252,8 @@ class MapView(QGraphicsView):
         points keep the original frame.
         """
         self.orientation = (float(angle), bool(mirrored))
+        if self.orientation_bar is not None:
+            self.orientation_bar.show_mirrored(self.orientation[1])
         self.setTransform(self._oriented(1.0))
         self.fit_to_window()
 
@@ -385,6 +412,10 @@ class MapView(QGraphicsView):
 
     def resizeEvent(self, event) -> None:
         super().resizeEvent(event)
+        if self.orientation_bar is not None:
+            corner = self.viewport().geometry().topLeft()
+            self.orientation_bar.move(corner.x() + _BUTTONS_FROM_CORNER_PX, corner.y() + _BUTTONS_FROM_CORNER_PX)
+            self.orientation_bar.raise_()
         if self._fitted:
             self.fit_to_window()
         self.viewport_changed.emit()

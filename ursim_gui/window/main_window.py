@@ -26,6 +26,7 @@ from ursim_gui.jobs.controller import JobController
 from ursim_gui.model.orientation import SketchOrientation
 from ursim_gui.model.pair_settings import MapIdentities, recorded_settings
 from ursim_gui.model.session import AnnotationSession
+from ursim_gui.model.wording import counted
 from ursim_gui.panels.agreement_panel import AgreementPanel
 from ursim_gui.panels.anchors_list import AnchorsList
 from ursim_gui.panels.campaign_panel import CampaignPanel
@@ -74,6 +75,8 @@ _TOOLBAR = (
     "route_tool",
 )
 _DISPLAY = ("outlines", "region_ids", "graph", "laid_sketch")
+#: The right column's share of the window's width on a first start, and its widest (pixels).
+_PANEL_COLUMN_SHARE, _PANEL_COLUMN_MAX = 0.3, 560
 #: Display toggles remembered between runs, with their first-run state.
 _TOGGLE_DEFAULTS = {
     "dark_theme": False,
@@ -129,7 +132,8 @@ class MainWindow(QMainWindow):
         self._connect_review()
         for name, default in _TOGGLE_DEFAULTS.items():
             self.actions[name].setChecked(self.preferences.toggle(name, default))
-        if not self.preferences.restore_window(self):
+        self._layout_restored = self.preferences.restore_window(self)
+        if not self._layout_restored:
             self._fit_to_screen()
 
     # ---- layout ------------------------------------------------------------------------------
@@ -192,7 +196,9 @@ class MainWindow(QMainWindow):
         self.docks["evaluation"].raise_()
         self.docks["segmentation"].setMinimumWidth(300)
         self.resizeDocks([self.docks["table"]], [240], Qt.Orientation.Vertical)
-        self.resizeDocks([self.docks["segmentation"], self.docks["matching"]], [620, 220], Qt.Orientation.Vertical)
+        # Half the right column each: the matching dock shows Match, the orientation and the
+        # answer without scrolling (a quarter showed none of them); both scroll on a laptop screen.
+        self.resizeDocks([self.docks["segmentation"], self.docks["matching"]], [1, 1], Qt.Orientation.Vertical)
         self.resizeDocks([self.docks["table"], self.docks["evaluation"]], [800, 380], Qt.Orientation.Horizontal)
 
     def _build_menus(self) -> None:
@@ -267,11 +273,16 @@ class MainWindow(QMainWindow):
         self.matching_panel.orientation_changed.connect(
             lambda o: self.views["sketch"].set_orientation(o.angle or 0.0, o.mirrored)
         )
+        # The sketch view's own turn and mirror buttons ask the panel, which holds the orientation.
+        self.views["sketch"].turn_requested.connect(self.matching_panel.turn)
+        self.views["sketch"].mirror_requested.connect(self.matching_panel.set_mirrored)
         self.evaluation.load_requested.connect(lambda: docs.load_reference())
         self.jobs.busy_changed.connect(lambda _busy: self._update_ready())
         self.session.segmentation_changed.connect(lambda _side: self._update_ready())
         self.session.segmentation_changed.connect(self._show_summary)
         self.session.map_changed.connect(self._show_map_title)
+        # A drawn map gets its file when the document is first saved (and named).
+        self.session.path_changed.connect(lambda _path: [self._show_map_title(side) for side in SIDES])
         self._identities = MapIdentities({side: self._digest_of(side) for side in SIDES})
         self._record_reads_this_sketch = True
         self.session.map_changed.connect(self._forget_settings_of_another_map)
@@ -339,6 +350,13 @@ class MainWindow(QMainWindow):
         available = screen.availableGeometry()
         self.resize(min(1600, int(available.width() * 0.92)), min(980, int(available.height() * 0.9)))
 
+    def _size_panel_column(self) -> None:
+        """A first start: the right column of panels takes a share of the window as shown, at least
+        what its panels need (the maps get the rest of a laptop screen) and no more than they use."""
+        needed = max(self.docks[name].minimumSizeHint().width() for name in ("segmentation", "matching"))
+        width = max(needed, min(_PANEL_COLUMN_MAX, round(self.width() * _PANEL_COLUMN_SHARE)))
+        self.resizeDocks([self.docks["matching"]], [width], Qt.Orientation.Horizontal)
+
     def _zoom_changed(self, side: str, factor: float) -> None:
         self.status.show_zoom(factor)
         if self.actions["link_zoom"].isChecked():
@@ -405,7 +423,7 @@ class MainWindow(QMainWindow):
         if segmentation is None:
             text = "no segmentation"
         else:
-            text = f"{segmentation.n_regions} regions ({segmentation.method})"
+            text = f"{counted(segmentation.n_regions, 'region')} ({segmentation.method})"
             reason = self.session.no_region_reason(side)
             if reason is not None:
                 text += f": {reason}"
@@ -417,7 +435,7 @@ class MainWindow(QMainWindow):
             side.capitalize()
             if map_ is None
             # Width x height, as image tools say it (the status bar gives pixels as (row, col)).
-            else f"{side.capitalize()}: {map_.name}  ({map_.shape[1]} × {map_.shape[0]} px)"
+            else f"{side.capitalize()}: {_map_name(map_)}  ({map_.shape[1]} × {map_.shape[0]} px)"
         )
         self.view_titles[side].setText(text)
         self._update_ready()
@@ -445,10 +463,16 @@ class MainWindow(QMainWindow):
             # Qt's leftovers from tabifying the docks while hidden (dock_tabs). Only now: a later
             # show can come before a new tab bar is laid out, which would look like a leftover.
             self._shown = True
+            if not self._layout_restored:
+                self._size_panel_column()
             hide_stray_tab_bars(self)
 
     def closeEvent(self, event) -> None:
         if not getattr(self, "_discard_on_close", False):
+            # Drawing windows first: each asks about a drawing neither saved nor used.
+            if not all(sketch.close() for sketch in self.tools.sketch_windows if sketch.isVisible()):
+                event.ignore()
+                return
             if self.campaigns.campaign is not None and not self.campaigns.save_current():
                 event.ignore()
                 return
@@ -461,3 +485,8 @@ class MainWindow(QMainWindow):
         self.session.read_ahead.close()
         self.documents.close_document()
         event.accept()
+
+
+def _map_name(map_) -> str:
+    # A map with no file was drawn in the app; it gets one beside the document when that is saved.
+    return map_.name if map_.path is not None else "drawn, not saved yet"

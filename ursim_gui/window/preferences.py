@@ -13,9 +13,12 @@ from pathlib import Path
 from PySide6.QtCore import QSettings
 from PySide6.QtWidgets import QInputDialog, QWidget
 
-__all__ = ["Preferences", "MAX_RECENT"]
+__all__ = ["Preferences", "MAX_RECENT", "LAYOUT_VERSION"]
 
 MAX_RECENT = 10
+#: Raised when the docks' arrangement changes (2: the right column split evenly between the
+#: segmentation and matching docks), so a layout saved by an older app is not restored.
+LAYOUT_VERSION = 2
 
 
 class Preferences:
@@ -58,7 +61,7 @@ class Preferences:
     # ---- window layout ----------------------------------------------------------------------
     def save_window(self, window, toggles: dict[str, bool]) -> None:
         self.settings.setValue("window/geometry", window.saveGeometry())
-        self.settings.setValue("window/state", window.saveState())
+        self.settings.setValue("window/state", window.saveState(LAYOUT_VERSION))
         for name, checked in toggles.items():
             self.settings.setValue(f"display/{name}", bool(checked))
         self.settings.sync()
@@ -69,7 +72,9 @@ class Preferences:
         state = self.settings.value("window/state")
         restored = bool(geometry) and window.restoreGeometry(geometry)
         if state:
-            window.restoreState(state)
+            # A layout saved by an app whose docks were arranged otherwise is not restored
+            # (Qt refuses a state of another version): the user gets the new arrangement.
+            window.restoreState(state, LAYOUT_VERSION)
         return restored
 
     def toggle(self, name: str, default: bool) -> bool:

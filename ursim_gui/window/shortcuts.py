@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtGui import QAction, QGuiApplication, QKeySequence
 from PySide6.QtWidgets import QDialog, QDialogButtonBox, QHeaderView, QTableWidget, QTableWidgetItem, QVBoxLayout
 
 __all__ = ["ActionSpec", "SHORTCUTS", "MOUSE_GESTURES", "make_action", "ShortcutSheet"]
@@ -17,7 +17,11 @@ __all__ = ["ActionSpec", "SHORTCUTS", "MOUSE_GESTURES", "make_action", "Shortcut
 
 @dataclass(frozen=True)
 class ActionSpec:
-    """One user command: id, menu text, key sequences (first is shown) and what it does."""
+    """One user command: id, menu text, key sequences (first is shown) and what it does.
+
+    ``toolbar`` is its label on the toolbar when the menu text is too long for it (the toolbar must
+    fit a 1280-pixel window; the tooltip says the rest).
+    """
 
     id: str
     text: str
@@ -25,6 +29,7 @@ class ActionSpec:
     description: str
     group: str
     checkable: bool = False
+    toolbar: str = ""
 
 
 SHORTCUTS: tuple[ActionSpec, ...] = (
@@ -36,8 +41,17 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Open a dataset folder, a folder of sketches with one metric map, or a campaign manifest",
         "File",
     ),
-    ActionSpec("open_sketch", "Open &sketch…", (), "Open the sketch map (image or ROS YAML)", "File"),
-    ActionSpec("open_metric", "Open &metric map…", (), "Open the metric map (image or ROS YAML)", "File"),
+    ActionSpec(
+        "open_sketch", "Open &sketch…", ("Ctrl+1",), "Open the sketch map, the left view (image or ROS YAML)", "File"
+    ),
+    ActionSpec(
+        "open_metric",
+        "Open &metric map…",
+        ("Ctrl+2",),
+        "Open the metric map, the right view (image or ROS YAML)",
+        "File",
+        toolbar="Open metric",
+    ),
     ActionSpec(
         "open_correspondences", "&Open correspondences…", ("Ctrl+O",), "Open a correspondence JSON and its maps", "File"
     ),
@@ -57,10 +71,13 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         ("L",),
         "New clique of the selected regions (or add them to the selected clique)",
         "Edit",
+        toolbar="Link",
     ),
-    ActionSpec("unlink", "U&nlink region", ("U",), "Remove the selected region(s) from their cliques", "Edit"),
+    ActionSpec(
+        "unlink", "U&nlink region", ("U",), "Remove the selected region(s) from their cliques", "Edit", toolbar="Unlink"
+    ),
     ActionSpec("delete_clique", "&Delete clique", ("Delete",), "Delete the selected clique", "Edit"),
-    ActionSpec("accept", "&Accept clique", ("Y",), "Mark the selected clique accepted", "Edit"),
+    ActionSpec("accept", "&Accept clique", ("Y",), "Mark the selected clique accepted", "Edit", toolbar="Accept"),
     ActionSpec(
         "accept_next",
         "Accept and &next clique",
@@ -68,7 +85,7 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
         "Accept the selected clique, then select and zoom to the next one to review",
         "Edit",
     ),
-    ActionSpec("reject", "Re&ject clique", ("R",), "Mark the selected clique rejected", "Edit"),
+    ActionSpec("reject", "Re&ject clique", ("R",), "Mark the selected clique rejected", "Edit", toolbar="Reject"),
     ActionSpec(
         "relink",
         "Re&link clique",
@@ -107,7 +124,15 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("zoom_in", "Zoom &in", ("Ctrl++", "Ctrl+="), "Zoom both views in", "View"),
     ActionSpec("zoom_out", "Zoom &out", ("Ctrl+-",), "Zoom both views out", "View"),
     ActionSpec("link_zoom", "&Linked zoom", ("Ctrl+K",), "Zoom both views together", "View", checkable=True),
-    ActionSpec("connectors", "&Connector lines", ("C",), "Draw lines between matched regions", "View", checkable=True),
+    ActionSpec(
+        "connectors",
+        "&Connector lines",
+        ("C",),
+        "Draw lines between matched regions",
+        "View",
+        checkable=True,
+        toolbar="Connectors",
+    ),
     ActionSpec("outlines", "Region &outlines", ("O",), "Show region outlines", "View", checkable=True),
     ActionSpec("region_ids", "Region &ids", ("I",), "Show region ids", "View", checkable=True),
     ActionSpec("dark_theme", "&Dark theme", (), "Dark window and map backgrounds (remembered)", "View", checkable=True),
@@ -174,6 +199,11 @@ SHORTCUTS: tuple[ActionSpec, ...] = (
     ActionSpec("shortcuts", "&Keyboard shortcuts", ("F1",), "This sheet", "Help"),
 )
 
+#: The sheet's column of what each key does (the one that stretches).
+ACTION_COLUMN = 2
+#: The sheet's size where the screen has room for it.
+_SHEET_SIZE = (860, 680)
+
 MOUSE_GESTURES: tuple[tuple[str, str], ...] = (
     ("Click", "Select a region (and its clique)"),
     ("Ctrl+Click", "Add a region to the selection"),
@@ -181,7 +211,7 @@ MOUSE_GESTURES: tuple[tuple[str, str], ...] = (
     ("Drag / middle drag", "Pan"),
     ("Hover", "Highlight the partner regions in the other view"),
     ("Drop a file", "Open it as this view's map"),
-    ("Click / drag on the sketch (goal / route tool)", "Place a goal / draw a route"),
+    ("Click / drag (goal / route tool)", "Place a goal / draw a route on the sketch"),
 )
 
 
@@ -191,7 +221,7 @@ def make_action(spec: ActionSpec, parent) -> QAction:
     action.setObjectName(f"action_{spec.id}")
     # Toolbar label fixed once: menu texts such as "Undo Link sketch 3 to metric 5"
     # change with the history and would make the toolbar jump.
-    action.setIconText(spec.text.replace("&", "").replace("…", "").split(" selected")[0])
+    action.setIconText(spec.toolbar or spec.text.replace("&", "").replace("…", ""))
     action.setShortcuts([QKeySequence(key) for key in spec.keys])
     action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
     action.setCheckable(spec.checkable)
@@ -223,16 +253,31 @@ class ShortcutSheet(QDialog):
         for row, values in enumerate(rows):
             for column, value in enumerate(values):
                 self.table.setItem(row, column, QTableWidgetItem(value))
-        self.table.verticalHeader().setVisible(False)
         self.table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
-        self.table.horizontalHeader().setStretchLastSection(True)
+        # Group and keys as wide as their longest entry, the action takes the rest and wraps onto
+        # as many lines as it needs: never elided ("…").
+        header = self.table.horizontalHeader()
+        header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(ACTION_COLUMN, QHeaderView.ResizeMode.Stretch)
+        self.table.setWordWrap(True)
+        self.table.setTextElideMode(Qt.TextElideMode.ElideNone)
+        self.table.verticalHeader().setVisible(False)
+        self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close, self)
         buttons.rejected.connect(self.reject)
         layout = QVBoxLayout(self)
         layout.addWidget(self.table)
         layout.addWidget(buttons)
-        self.resize(620, 640)
+        self.resize(*self._fitting_size(parent))
+
+    @staticmethod
+    def _fitting_size(parent) -> tuple[int, int]:
+        """Wide enough for most actions on one line, never wider or taller than the screen allows."""
+        screen = (parent.screen() if parent is not None else None) or QGuiApplication.primaryScreen()
+        if screen is None:
+            return _SHEET_SIZE
+        available = screen.availableGeometry()
+        return min(_SHEET_SIZE[0], int(available.width() * 0.9)), min(_SHEET_SIZE[1], int(available.height() * 0.9))
 
     def key_texts(self) -> list[str]:
         """The Keys column (for tests and accessibility checks)."""

@@ -30,3 +30,16 @@ def test_resegmenting_clears_the_anchors_and_the_match_summary(window, qtbot, ma
     assert window.session.anchors == [] and window.anchors.list.count() == 0
     assert "pairs" not in window.matching_panel.summary.text()
     assert window.views["sketch"].marked_regions("anchors") == set()
+
+
+def test_each_anchor_says_whether_the_answer_pairs_it_too(window):
+    # Anchors are paired before matching; the answer may pair them otherwise, and a dashed
+    # outline on a region the answer leaves out must not read as a contradiction.
+    from types import SimpleNamespace
+
+    result = SimpleNamespace(pairs=[(1, 1), (2, 2)], anchors=[(1, 1), (3, 2)], m=0.1, cost=1.0, reason="")
+    window.session.apply_match(result)
+    anchors = window.anchors.list
+    assert anchors.item(0).text().endswith("(in the answer)")
+    assert anchors.item(1).text().endswith("(not in the answer)")
+    assert "other partners" in anchors.item(1).toolTip()
