@@ -8,7 +8,7 @@ here so that both commands read maps and correspondences the same way.
 from __future__ import annotations
 
 import argparse
-import json
+import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,7 +16,17 @@ from typing import Any
 
 from ursim_core.errors import ParameterError
 
-__all__ = ["add_parser", "cmd_goal", "prepare_navigation", "Navigation", "add_navigation_options", "parse_point"]
+__all__ = [
+    "add_parser",
+    "cmd_goal",
+    "prepare_navigation",
+    "Navigation",
+    "add_navigation_options",
+    "parse_point",
+    "finite_number",
+    "tolerance_value",
+    "write_json",
+]
 
 EXAMPLES = """examples:
   ursim goal sketch.png map.yaml --at 120,340
@@ -41,15 +51,78 @@ class Navigation:
     source: str
 
 
+#: Beyond any image's pixel index (OpenCV and the label images index with 32-bit integers): a
+#: point farther out is a typo, and its pixel would not even print readably.
+_MAX_COORDINATE = 2.0**31
+
+
 def parse_point(text: str) -> tuple[float, float]:
-    """``"ROW,COL"`` -> (row, col); argparse type of ``--at``."""
+    """``"ROW,COL"`` -> (row, col); argparse type of ``--at``.
+
+    Both must be finite numbers of at most 2**31 px (NaN and infinity have no pixel).
+
+    Examples
+    --------
+    >>> parse_point("12, 30.5")
+    (12.0, 30.5)
+    >>> parse_point("nan,3")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: expected ROW,COL (two finite numbers of pixels), got 'nan,3'
+    """
     parts = text.replace(" ", "").split(",")
     try:
         if len(parts) != 2:
             raise ValueError
-        return float(parts[0]), float(parts[1])
+        point = float(parts[0]), float(parts[1])
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected ROW,COL (two numbers), got '{text}'") from None
+    # float() reads 'nan', 'inf' and '1e400' (infinity) without complaint.
+    if not all(math.isfinite(v) and abs(v) <= _MAX_COORDINATE for v in point):
+        raise argparse.ArgumentTypeError(f"expected ROW,COL (two finite numbers of pixels), got '{text}'")
+    return point
+
+
+def finite_number(text: str) -> float:
+    """A finite float; argparse type of ``--yaw`` (NaN or infinity would make no heading).
+
+    Examples
+    --------
+    >>> finite_number("1.5")
+    1.5
+    >>> finite_number("inf")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: expected a finite number, got 'inf'
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
+    return value
+
+
+def tolerance_value(text: str) -> float:
+    """A finite float >= 0; argparse type of ``--tolerance`` (NaN compares false with every distance).
+
+    Examples
+    --------
+    >>> tolerance_value("10")
+    10.0
+    >>> tolerance_value("nan")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: expected a finite number of pixels >= 0, got 'nan'
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"expected a finite number of pixels >= 0, got '{text}'")
+    return value
 
 
 def add_navigation_options(parser: argparse.ArgumentParser) -> None:
@@ -74,7 +147,7 @@ def add_navigation_options(parser: argparse.ArgumentParser) -> None:
         help=f"metric segmentation (default {MATCH_PRESETS['metric']})",
     )
     parser.add_argument(
-        "--tolerance", type=float, default=10, help="px from a region a point still counts (default 10)"
+        "--tolerance", type=tolerance_value, default=10, help="px from a region a point still counts (default 10)"
     )
     parser.add_argument("-o", "--output", metavar="FILE", help="also write the JSON to FILE")
     group = parser.add_argument_group("map loading")
@@ -103,7 +176,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default="interior",
         help="interior point of the matched region (default) or the point mirroring the tap's place in its region",
     )
-    parser.add_argument("--yaw", type=float, default=0.0, help="heading of the goal in the map frame, radians")
+    parser.add_argument("--yaw", type=finite_number, default=0.0, help="heading of the goal in the map frame, radians")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -167,8 +240,18 @@ def goal_document(goal, *, frame_id: str = "map") -> dict[str, Any]:
 
 
 def write_json(document: Any, output: str | None) -> None:
-    """Print ``document`` and, with ``-o``, write it atomically to the file."""
-    text = json.dumps(document, indent=2) + "\n"
+    """Print ``document`` and, with ``-o``, write it atomically to the file.
+
+    Raises
+    ------
+    FormatError
+        A number in ``document`` is NaN or infinite (JSON has none; a map whose origin and
+        resolution overflow puts them in a pose), naming the file and the field; nothing is
+        printed or written.
+    """
+    from ursim_core.correspondences.exporters import finite_json
+
+    text = finite_json(document, output or "<standard output>", indent=2) + "\n"
     sys.stdout.write(text)
     if output:
         from ursim_core.io.atomic import atomic_write_text
@@ -177,25 +260,36 @@ def write_json(document: Any, output: str | None) -> None:
 
 
 def cmd_goal(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from ursim_core.navigation.goal import locate
 
-    if args.tolerance < 0:
-        raise ParameterError(f"--tolerance must be >= 0, got {args.tolerance}")
+    # The argparse types refuse these; a Namespace built in code gets the same checks.
+    if not (math.isfinite(args.tolerance) and args.tolerance >= 0):
+        raise ParameterError(f"--tolerance must be a finite number >= 0, got {args.tolerance}")
+    if not math.isfinite(args.yaw):
+        raise ParameterError(f"--yaw must be a finite number of radians, got {args.yaw}")
+    for row, col in args.at:
+        if not (math.isfinite(row) and math.isfinite(col)):
+            raise ParameterError(f"--at must be two finite numbers, got {row},{col}")
     nav = prepare_navigation(args)
-    goals = [
-        locate(
-            nav.table,
-            nav.sketch_seg,
-            nav.metric_seg,
-            nav.metric_map,
-            row,
-            col,
-            target=args.target,
-            tolerance=args.tolerance,
-            yaw=args.yaw,
-        )
-        for row, col in args.at
-    ]
+    # A georeference too large overflows to NaN or infinity, which write_json refuses by name:
+    # numpy's warnings would only add lines that do not say which file is at fault.
+    with np.errstate(over="ignore", invalid="ignore"):
+        goals = [
+            locate(
+                nav.table,
+                nav.sketch_seg,
+                nav.metric_seg,
+                nav.metric_map,
+                row,
+                col,
+                target=args.target,
+                tolerance=args.tolerance,
+                yaw=args.yaw,
+            )
+            for row, col in args.at
+        ]
     documents = [goal_document(goal) for goal in goals]
     write_json(documents[0] if len(documents) == 1 else documents, args.output)
     if nav.metric_map.resolution is None:

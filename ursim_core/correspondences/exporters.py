@@ -20,12 +20,13 @@ type) is ``clique.extra["label"]`` and is carried into every format.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ursim_core.errors import ParameterError
+from ursim_core.errors import FormatError, ParameterError
 from ursim_core.io.atomic import atomic_write_text
 
 __all__ = [
@@ -40,7 +41,11 @@ __all__ = [
     "export_correspondences",
     "export_format_of",
     "export_file",
+    "finite_json",
 ]
+
+#: Why an exported number can be NaN or infinite (refused when written: JSON and QGIS have none).
+_NON_FINITE_CAUSE = "a map's origin or resolution too large for its coordinates gives them"
 
 #: Formats of :func:`export_correspondences`, by name.
 EXPORT_FORMATS = ("geojson", "labelme", "qgis-points")
@@ -128,7 +133,9 @@ def _coordinate_system(the_map) -> tuple[dict[str, Any], Any]:
         from ursim_core.io.maps import pixel_to_world
 
         def convert(rows, cols):
-            xs, ys = pixel_to_world(the_map, np.asarray(rows, float), np.asarray(cols, float))
+            # An overflowing georeference is refused by name when written (finite_json), not warned of.
+            with np.errstate(over="ignore", invalid="ignore"):
+                xs, ys = pixel_to_world(the_map, np.asarray(rows, float), np.asarray(cols, float))
             return [[round(float(x), 6), round(float(y), 6)] for x, y in zip(np.atleast_1d(xs), np.atleast_1d(ys))]
 
         system = {"units": "metre", "axis_order": ["x", "y"], "frame_id": "map"}
@@ -319,10 +326,15 @@ def correspondences_to_qgis_points(corr, *, metric_map=None, crs_wkt: str = "") 
         if georeferenced:
             from ursim_core.io.maps import pixel_to_world
 
-            map_x, map_y = pixel_to_world(metric_map, metric_row, metric_col)
+            with np.errstate(over="ignore", invalid="ignore"):  # refused below, by name
+                map_x, map_y = pixel_to_world(metric_map, metric_row, metric_col)
         else:
             map_x, map_y = metric_col + 0.5, -(metric_row + 0.5)
         values = [map_x, map_y, sketch_col + 0.5, -(sketch_row + 0.5)]
+        for name, value in zip(("mapX", "mapY", "sourceX", "sourceY"), values):
+            if not math.isfinite(value):  # "nan" would not read back as a coordinate in QGIS
+                problem = f"{name} of clique {clique.id} is not a finite number ({float(value)!r}; {_NON_FINITE_CAUSE})"
+                raise FormatError(f"cannot be written: {problem}")
         lines.append(",".join(_number(v) for v in values) + ",1,0,0,0")
     return "\n".join(lines) + "\n"
 
@@ -364,17 +376,59 @@ def export_correspondences(
     """Write ``corr`` to ``path`` in one of :data:`EXPORT_FORMATS`, atomically; returns the format.
 
     ``side`` with its ``labels`` and ``the_map`` select what GeoJSON and labelme export (one
-    side per file); ``metric_map`` georeferences the QGIS points (which hold both sides).
+    side per file); ``metric_map`` georeferences the QGIS points (which hold both sides). A
+    coordinate that is not a finite number is a :class:`~ursim_core.errors.FormatError` naming
+    ``path`` and the field, and nothing is written.
     """
     kind = export_format_of(path, format)
     if kind == "geojson":
-        text = json.dumps(correspondences_to_geojson(corr, side=side, labels=labels, the_map=the_map), indent=1)
+        text = finite_json(correspondences_to_geojson(corr, side=side, labels=labels, the_map=the_map), path, indent=1)
     elif kind == "labelme":
-        text = json.dumps(correspondences_to_labelme(corr, side=side, labels=labels), indent=1)
+        text = finite_json(correspondences_to_labelme(corr, side=side, labels=labels), path, indent=1)
     else:
-        text = correspondences_to_qgis_points(corr, metric_map=metric_map)
+        try:
+            text = correspondences_to_qgis_points(corr, metric_map=metric_map)
+        except FormatError as error:
+            raise FormatError(error.problem, path=path, field=error.field) from None
     atomic_write_text(Path(path), text if text.endswith("\n") else text + "\n")
     return kind
+
+
+def finite_json(document: Any, path: str | Path, *, indent: int | None = None) -> str:
+    """``json.dumps(document, indent=indent)``; NaN or infinity (JSON has none) is a FormatError
+    naming ``path`` (the file it is for) and the first field holding one.
+
+    Examples
+    --------
+    >>> finite_json({"x": [1.5]}, "a.json")
+    '{"x": [1.5]}'
+    >>> finite_json({"pose": {"x": float("nan")}}, "a.json")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.FormatError: a.json: field 'pose.x': cannot be written as JSON: nan is not ...
+    """
+    try:
+        return json.dumps(document, indent=indent, allow_nan=False)
+    except ValueError as error:
+        from ursim_core.correspondences.schema import field_path
+
+        found = _non_finite(document)  # json.dumps says only "Out of range float values..."
+        if found is None:
+            raise FormatError(f"cannot be written as JSON: {error}", path=path) from None
+        problem = f"cannot be written as JSON: {found[1]!r} is not a finite number (JSON has none; {_NON_FINITE_CAUSE})"
+        raise FormatError(problem, path=path, field=field_path(found[0]) or "(the document)") from None
+
+
+def _non_finite(value: Any, where: tuple = ()) -> tuple[tuple, float] | None:
+    """``(location, value)`` of the first float in ``value`` that is NaN or infinite, or None."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return where, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, (list, tuple)) else ()
+    for key, item in items:
+        found = _non_finite(item, (*where, key))
+        if found is not None:
+            return found
+    return None
 
 
 def export_file(
@@ -419,13 +473,21 @@ def _georeferenced_map(path: Path | None):
 
 
 def _read_labels(path: Path, size) -> np.ndarray | None:
-    import cv2
+    """The single-channel label image at ``path`` (None when there is no file), which must be ``size``.
 
+    Read as ``label_files.read_label_array`` reads it (a sibling layer, not importable here):
+    :func:`ursim_core.io.unchanged.read_unchanged`, guarded.
+    """
     from ursim_core.errors import SegmentationError
+    from ursim_core.io.maps import DEFAULT_MAX_PIXELS
+    from ursim_core.io.unchanged import read_unchanged
 
-    if not Path(path).is_file():
+    path = Path(path)
+    if not path.is_file():
         return None
-    labels = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    # A map loaded with a higher limit than the default has label images as large as itself.
+    limit = DEFAULT_MAX_PIXELS if size is None else max(DEFAULT_MAX_PIXELS, int(size[0]) * int(size[1]))
+    labels = read_unchanged(path, max_pixels=limit, error=SegmentationError)
     if labels is None or labels.ndim != 2:
         raise SegmentationError("not a single-channel label image", path=path)
     if size is not None and tuple(labels.shape) != tuple(size):

@@ -12,6 +12,8 @@ import functools
 import hashlib
 import io
 import json
+import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,7 +23,7 @@ import numpy as np
 from ursim_core.evaluation.packing import Packed, packed_apart
 from ursim_core.evaluation.pool import Progress, completed, pixel_count
 
-__all__ = ["SegmentationJob", "segment_job", "segment_all", "read_cached", "store_segmentation"]
+__all__ = ["SegmentationJob", "segment_job", "segment_all", "read_cached", "store_segmentation", "check_cache_dir"]
 
 
 @dataclass(frozen=True)
@@ -142,19 +144,47 @@ def _disk_cache_path(cache_dir: Path, job: SegmentationJob) -> Path:
     return cache_dir / f"{job.path.stem}-{hashlib.sha256(identity.encode()).hexdigest()[:24]}.npz"
 
 
+#: What a damaged, cut or foreign ``.npz`` raises when opened or read: a cut zip archive
+#: (BadZipFile, EOFError), a damaged compressed member (zlib.error), a bad array header or object
+#: arrays (ValueError), a forged header's shape (MemoryError), a missing member (KeyError), and
+#: members of another form than written (TypeError, OverflowError: a 0-d shape, an infinite one).
+_DAMAGED_CACHE = (
+    OSError,
+    KeyError,
+    ValueError,
+    TypeError,
+    OverflowError,
+    EOFError,
+    MemoryError,
+    zipfile.BadZipFile,
+    zlib.error,
+)
+
+
 def _read_disk_cache(path: Path, job: SegmentationJob):
+    """The segmentation stored for ``job`` at ``path``, or None when there is no usable one.
+
+    A stored segmentation is used only when it names the map it is for (its SHA-256, as the job)
+    and every label image in it is a 2-D array of non-negative integers of that map's shape (as it
+    was segmented): anything else is a cache miss, as a missing file is, and is segmented again.
+    """
     from ursim_core.segmentation import Segmentation, resolve_params
     from ursim_core.segmentation.regions import region_table
 
     params = resolve_params("maoris", job.preset, {"canonical": job.canonical})
     try:
         with np.load(path) as stored:
-            labels = stored["labels"].astype(np.int32)
+            if str(stored["map_sha256"]) != job.digest:
+                return None  # another map's file under this name (copied, or renamed)
+            shape = tuple(int(v) for v in stored["map_shape"])
+            labels = _stored_labels(stored["labels"], shape)
             # The other resamplings (segment_canonical(..., resampled=True)) and their turns.
-            offsets = stored["resampled_offsets"].tolist() if "resampled_offsets" in stored else []
-            others = [stored[f"resampled_{index}"].astype(np.int32) for index in range(len(offsets))]
-    except (OSError, KeyError, ValueError):
+            offsets = [float(v) for v in stored["resampled_offsets"]] if "resampled_offsets" in stored else []
+            others = [_stored_labels(stored[f"resampled_{index}"], shape) for index in range(len(offsets))]
+    except _DAMAGED_CACHE:
         # A missing, damaged or foreign cache file is only a cache miss.
+        return None
+    if labels is None or any(other is None for other in others):
         return None
     resampled = tuple(
         Segmentation(
@@ -170,7 +200,20 @@ def _read_disk_cache(path: Path, job: SegmentationJob):
     )
 
 
-def _write_disk_cache(path: Path, segmentation) -> None:
+def _stored_labels(array: np.ndarray, shape: tuple[int, ...]) -> np.ndarray | None:
+    """``array`` as int32 labels when it is a label image of ``shape`` (the map's), else None.
+
+    Labels of another shape would be scored against the map's ground truth as if they were its
+    own: points off their image dropped, the rest read at the wrong pixels.
+    """
+    if array.ndim != 2 or array.shape != shape or array.dtype.kind not in "iu":
+        return None
+    if array.size and (int(array.min()) < 0 or int(array.max()) > np.iinfo(np.int32).max):
+        return None
+    return array.astype(np.int32)
+
+
+def _write_disk_cache(path: Path, job: SegmentationJob, segmentation) -> None:
     from ursim_core.io.atomic import atomic_write_bytes
 
     buffer = io.BytesIO()
@@ -178,7 +221,14 @@ def _write_disk_cache(path: Path, segmentation) -> None:
     if others:
         offsets = [other.params.get("canonical_turn_offset") for other in segmentation.resampled]
         others["resampled_offsets"] = np.array([np.nan if o is None else o for o in offsets], float)
-    np.savez_compressed(buffer, labels=segmentation.labels, **others)
+    # The map's digest and shape: what a read checks the file against (_read_disk_cache).
+    np.savez_compressed(
+        buffer,
+        labels=segmentation.labels,
+        map_sha256=np.array(job.digest),
+        map_shape=np.array(segmentation.labels.shape, np.int64),
+        **others,
+    )
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(path, buffer.getvalue())
@@ -210,7 +260,29 @@ def store_segmentation(job: SegmentationJob, segmentation, memory_cache, cache_d
     if memory_cache is not None:
         memory_cache[job.key] = segmentation
     if cache_dir is not None:
-        _write_disk_cache(_disk_cache_path(Path(cache_dir), job), segmentation)
+        _write_disk_cache(_disk_cache_path(Path(cache_dir), job), job, segmentation)
+
+
+def check_cache_dir(cache_dir: str | Path) -> None:
+    """Refuse a cache folder that is a file, or that cannot be made because a parent is a file.
+
+    Writing the cache fails quietly (a read-only or full folder must not fail an evaluation), so
+    without this a file named as the folder would only make every run segment everything again.
+
+    Raises
+    ------
+    ParameterError
+        Naming the path.
+    """
+    from ursim_core.errors import ParameterError
+
+    folder = Path(cache_dir)
+    existing = folder
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        where = "this is a file" if existing == folder else f"{existing} is a file"
+        raise ParameterError(f"the segmentation cache (--cache) must be a folder, but {where}", path=folder)
 
 
 def split_cached(jobs, reporter: Progress, memory_cache, cache_dir, packed: dict | None = None):
@@ -219,6 +291,8 @@ def split_cached(jobs, reporter: Progress, memory_cache, cache_dir, packed: dict
     Biggest first so that the workers (local processes or a Dask cluster) finish together.
     ``packed``: see :func:`segment_all`.
     """
+    if cache_dir is not None:
+        check_cache_dir(cache_dir)
     segmentations: dict[str, Any] = {}
     to_run = []
     for job in jobs:

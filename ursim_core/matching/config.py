@@ -521,7 +521,7 @@ class MatchConfig:
         pixel = input resolution / metric resolution. It is filled in only when the matcher
         uses it ('auto' or 'overlay') and no scale was given. An input with a resolution is a
         metric map (``input_kind``, when not given); a map without one (a sketch, a bare image)
-        changes nothing.
+        changes nothing. A ratio that is not a finite positive number raises ParameterError.
 
         Examples
         --------
@@ -539,7 +539,15 @@ class MatchConfig:
             return config
         if not sketch_resolution or not metric_resolution:
             return config
-        return config.replace(scale=float(sketch_resolution) / float(metric_resolution))
+        scale = float(sketch_resolution) / float(metric_resolution)
+        if not (math.isfinite(scale) and scale > 0):
+            # Each resolution was accepted alone; their ratio overflows or underflows.
+            raise ParameterError(
+                f"the maps' resolutions ({sketch_resolution:g} and {metric_resolution:g} m/px) give no "
+                f"usable scale (their ratio is {scale:g})",
+                field="scale",
+            )
+        return config.replace(scale=scale)
 
     def replace(self, **changes) -> MatchConfig:
         """A copy with some fields changed (validated like a new config).

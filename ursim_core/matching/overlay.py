@@ -43,6 +43,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ursim_core.errors import ParameterError
 from ursim_core.matching.alignment import Alignment, free_box_corners, orientation_matrix
 from ursim_core.matching.constraints import allowed_pairs
 
@@ -56,6 +57,7 @@ __all__ = [
     "constrained_pairs",
     "SCALE_SPREAD",
     "SCALE_SEARCH",
+    "MAX_EXTENT",
 ]
 
 #: Relative scales tried around a known scale: a robot map's resolution is known to a few percent.
@@ -65,6 +67,12 @@ SCALE_SEARCH = tuple(float(v) for v in np.round(np.exp(np.linspace(np.log(0.5), 
 #: Long side, in pixels, of the metric map during the search, and the wall band, in those pixels.
 _SIDE = 160
 _BAND = 2
+#: The longest the input map may be laid, in units of the long side of the map it is laid on. The
+#: correlation of a placement is at most the square root of the share of the template the other map
+#: covers: beyond 4 times its length, at most 1/16 of it, so no placement correlates above 0.25
+#: (the example pair at scale 3, 4.2 times: its two best readings tied), and the search grows with
+#: the template's area (scale 5: 27 s; 10: 95 s; 100: OpenCV out of memory, or a crash).
+MAX_EXTENT = 4.0
 
 
 def _coarse(free: np.ndarray, factor: float) -> np.ndarray:
@@ -74,15 +82,24 @@ def _coarse(free: np.ndarray, factor: float) -> np.ndarray:
     return cv2.resize(free.astype(np.float32), shape, interpolation=cv2.INTER_AREA)
 
 
-def _template(free: np.ndarray, corners: np.ndarray, linear: np.ndarray):
-    """The input map (float32 free space, the corners of its box) under ``linear`` (coarse metric
-    pixels per input pixel): free-space and wall-band templates, and the offset of their origin."""
-    import cv2
-
+def _template_box(corners: np.ndarray, linear: np.ndarray, limit: float):
+    """``(low, (rows, cols))`` of the template of the box ``corners`` under ``linear``; None when a
+    side would be longer than ``limit`` pixels (or is not finite): no OpenCV call gets that size."""
     turned = corners @ linear.T
     low = turned.min(axis=0) - _BAND - 1
-    high = turned.max(axis=0) + _BAND + 1
-    size = (int(math.ceil(high[1] - low[1])) + 1, int(math.ceil(high[0] - low[0])) + 1)
+    extent = turned.max(axis=0) + _BAND + 1 - low
+    if not (np.all(np.isfinite(extent)) and extent.max() + 1 <= limit):
+        return None
+    return low, (int(math.ceil(extent[0])) + 1, int(math.ceil(extent[1])) + 1)
+
+
+def _template(free: np.ndarray, low: np.ndarray, shape: tuple[int, int], linear: np.ndarray):
+    """The input map (float32 free space) under ``linear`` (coarse metric pixels per input pixel),
+    in a ``shape`` window whose origin is ``low`` (:func:`_template_box`): free-space and wall-band
+    templates, and the offset of their origin."""
+    import cv2
+
+    size = (shape[1], shape[0])
     offset = -low
     opencv = np.array([[linear[1, 1], linear[1, 0], offset[1]], [linear[0, 1], linear[0, 0], offset[0]]])
     flags = cv2.INTER_AREA if abs(np.linalg.det(linear)) < 1 else cv2.INTER_LINEAR
@@ -127,7 +144,7 @@ class _Side:
 def _best_placement(moving: _Side, fixed: _Side, linear: np.ndarray):
     """``(score, shift, agreement)`` of the best placement of ``moving`` under ``linear`` (coarse
     ``fixed`` pixels per ``moving`` pixel) on ``fixed``, over every placement with any overlap; None
-    when the template is too small.
+    when the template is too small, or too large to lay on ``fixed`` (:data:`MAX_EXTENT`).
 
     ``score`` is the normalised cross-correlation of the two signed images (free +1, wall band -1)
     over the template's window: the placements of every scale and turn are ranked by it.
@@ -139,7 +156,12 @@ def _best_placement(moving: _Side, fixed: _Side, linear: np.ndarray):
     """
     import cv2
 
-    template, band, offset = _template(moving.source, moving.corners, linear)
+    # The guard behind _check_scale's refusal, for the estimated scales too: a side of at most
+    # MAX_EXTENT times the fixed map's, turned (sqrt 2 < 1.5), rounded and banded.
+    box = _template_box(moving.corners, linear, 1.5 * MAX_EXTENT * (max(fixed.free.shape) + 1) + 2 * _BAND + 4)
+    if box is None:
+        return None
+    template, band, offset = _template(moving.source, *box, linear)
     rows, cols = template.shape
     mass = float(template.sum() + band.sum())
     if rows < 3 or cols < 3 or mass == 0:
@@ -165,6 +187,28 @@ def _agreement_at(fixed: _Side, template: np.ndarray, band: np.ndarray, top: int
         return 0.0
     inner = (slice(r0 - top, r1 - top), slice(c0 - left, c1 - left))
     return float((fixed.free[r0:r1, c0:c1] * template[inner]).sum() + (fixed.walls[r0:r1, c0:c1] * band[inner]).sum())
+
+
+def _check_scale(corners: np.ndarray | None, metric_shape: tuple[int, ...], scale: float) -> None:
+    """Refuse (ParameterError, field ``scale``) a known ``scale`` that lays the input's free space, box
+    ``corners``, at the largest spread searched, over more than :data:`MAX_EXTENT` times the long
+    side of the metric map (``metric_shape``)."""
+    if corners is None:
+        return
+    (top, left), (bottom, right) = corners[0], corners[3]
+    rows, cols = int(bottom - top) + 1, int(right - left) + 1
+    # Python floats: a scale near the largest float makes the length infinite (refused), silently.
+    ratio = float(max(rows, cols)) * float(scale) * max(SCALE_SPREAD) / max(metric_shape[:2])
+    if ratio <= MAX_EXTENT:
+        return
+    times = f"{ratio:.3g} times" if math.isfinite(ratio) else "immeasurably many times"
+    raise ParameterError(
+        f"scale {scale:g} (metric pixels per input pixel: the one given, or the input map's resolution "
+        f"over the metric map's) lays the input map's free space ({cols} x {rows} px) {times} as "
+        f"long as the metric map ({metric_shape[1]} x {metric_shape[0]} px) it is laid on; at most "
+        f"{MAX_EXTENT:g} times can be placed: check the scale or the maps' resolutions",
+        field="scale",
+    )
 
 
 def estimate_scale(
@@ -262,8 +306,13 @@ def ranked_overlays(
         The normalised cross-correlation of the placement's free space and walls with the metric
         map's, and the placement; best first (ties: the earlier orientation), so the first is
         :func:`fit_overlay`'s. Empty when either map has no free space or the input is too small
-        to place. The runner-up tells how close the call was: a corridor lined with rooms
+        (or, at an estimated scale, too large) to place. The runner-up tells how close the call was: a corridor lined with rooms
         correlates nearly as well turned by a half turn (docs/studies.md, round 42).
+
+    Raises
+    ------
+    ParameterError
+        When ``scale`` lays the input over more than :data:`MAX_EXTENT` times the metric map's length.
 
     Examples
     --------
@@ -279,7 +328,9 @@ def ranked_overlays(
         return []
     # Read once, for the scale estimate and for the search.
     sketch, metric = _Side(sketch_free), _Side(metric_free)
-    if scale is None:
+    if scale is not None:
+        _check_scale(sketch.corners, metric_free.shape, scale)
+    else:
         scale = _estimated_scale(sketch, metric, orientations, SCALE_SEARCH)
     # The candidate's own turn first: a tie keeps it.
     turns = (0.0, -angle_step, angle_step, -2 * angle_step, 2 * angle_step) if angle_step > 0 else (0.0,)

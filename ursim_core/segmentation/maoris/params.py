@@ -103,13 +103,13 @@ class MaorisParams:
         Percent (summed over neighbours) of a region's contour touching other
         regions above which it is a door and is fused, >= 0.
     max_radius : int
-        Largest inscribed-disc radius considered, px (>= 1).
+        Largest inscribed-disc radius considered, px (1 .. 2**53).
     quantum : int
         Values are rounded up to multiples of this (1..255).
     small_before : int
-        Zones smaller than this (px) are fused before ripple merging.
+        Zones smaller than this (px) are fused before ripple merging (0 .. 2**53).
     small_after : int
-        Regions smaller than this (px) are fused after door removal.
+        Regions smaller than this (px) are fused after door removal (0 .. 2**53).
 
     Examples
     --------
@@ -133,15 +133,18 @@ class MaorisParams:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
                 raise ParameterError(f"must be a number, got {value!r}", field=name)
-            if kind is int and float(value) != int(value):
-                raise ParameterError(f"must be an integer, got {value!r}", field=name)
+            # The range first, compared as given (float() of an integer of 400 digits overflows):
+            # a huge integer is "out of range", not "not an integer" (as a float it is not one),
+            # and no value past it reaches a kernel's 64-bit argument.
             if (
-                not math.isfinite(float(value))
+                (isinstance(value, (float, np.floating)) and not math.isfinite(value))
                 or value < low
                 or (high is not None and (value >= high if high_open else value > high))
             ):
                 bound = "" if high is None else (f" and < {high}" if high_open else f" and <= {high}")
                 raise ParameterError(f"must be >= {low}{bound}, got {value!r}", field=name)
+            if kind is int and float(value) != int(value):
+                raise ParameterError(f"must be an integer, got {value!r}", field=name)
             # Store plain Python numbers so to_dict() is JSON-serialisable.
             object.__setattr__(self, name, int(value) if kind is int else _plain_number(value))
 
@@ -191,16 +194,22 @@ def _plain_number(value: Any) -> int | float:
     return int(value) if value.is_integer() and abs(value) < 2**53 else value
 
 
+#: Largest size (px) and radius accepted: far more pixels than any map a computer holds (a larger
+#: value fuses every zone, or bounds no disc, just as this one does), and the largest integers a
+#: float holds exactly, so a value written 1e20 is not silently rounded. Without a bound, 1e20 went
+#: to the kernels' 64-bit arguments as an OverflowError traceback.
+_SIZE_MAX = 2**53
+
 # name -> (kind, minimum, maximum or None, maximum excluded)
 _PARAM_RULES: dict[str, tuple[type, float, float | None, bool]] = {
     "threshold": (float, 0.0, 1.0, True),
     "margin": (float, 0.0, 1.0, True),
     "ripples": (float, 0.0, 100.0, False),
     "doors": (float, 0.0, None, False),
-    "max_radius": (int, 1, None, False),
+    "max_radius": (int, 1, _SIZE_MAX, False),
     "quantum": (int, 1, 255, False),
-    "small_before": (int, 0, None, False),
-    "small_after": (int, 0, None, False),
+    "small_before": (int, 0, _SIZE_MAX, False),
+    "small_after": (int, 0, _SIZE_MAX, False),
 }
 
 PRESETS: dict[str, MaorisParams] = {
