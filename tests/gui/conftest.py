@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import types
 from pathlib import Path
@@ -98,21 +99,27 @@ def _never_block_on_questions(monkeypatch):
     monkeypatch.setattr(QInputDialog, "getText", staticmethod(lambda *args, **kwargs: ("tester", True)))
 
 
-@pytest.fixture
-def window(qtbot, tmp_path, map_files):
-    """Main window with both maps open and segmented from their label images (no MAORIS)."""
+def segmented_window(qtbot, data_dir, map_files, size=(1400, 900)):
+    """A main window of ``size`` with both maps open and segmented from their label images (no MAORIS)."""
     from ursim_core.segmentation import load_label_image
     from ursim_gui.window.main_window import MainWindow
 
-    win = MainWindow(data_dir=tmp_path / "userdata")
+    win = MainWindow(data_dir=data_dir)
     qtbot.addWidget(win)
-    win.resize(1400, 900)
+    win.resize(*size)
     win.show()
     qtbot.waitExposed(win)
     for side in ("sketch", "metric"):
         win.session.load_map(side, map_files[side])
         labels = load_label_image(map_files[f"{side}_labels"], shape=win.session.map(side).shape)
         win.session.set_segmentation(side, labels)
+    return win
+
+
+@pytest.fixture
+def window(qtbot, tmp_path, map_files):
+    """Main window with both maps open and segmented from their label images (no MAORIS)."""
+    win = segmented_window(qtbot, tmp_path / "userdata", map_files)
     yield win
     win.jobs.runner.shutdown()
 
@@ -338,3 +345,13 @@ def plain_campaign(tmp_path, labels3):
     for name in ("s1", "s2", "s3"):
         cv2.imwrite(str(folder / f"{name}.png"), np.where(labels3 > 0, 255, 0).astype(np.uint8))
     return folder
+
+
+@pytest.fixture
+def restore_logging():
+    """main() installs log handlers on the root logger; take them off afterwards."""
+    yield
+    root = logging.getLogger()
+    for handler in [h for h in root.handlers if getattr(h, "_ursim_gui", False)]:
+        root.removeHandler(handler)
+        handler.close()

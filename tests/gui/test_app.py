@@ -15,16 +15,6 @@ from PySide6.QtWidgets import QMessageBox
 from ursim_gui import app
 
 
-@pytest.fixture
-def restore_logging():
-    """main() installs log handlers on the root logger; take them off afterwards."""
-    yield
-    root = logging.getLogger()
-    for handler in [h for h in root.handlers if getattr(h, "_ursim_gui", False)]:
-        root.removeHandler(handler)
-        handler.close()
-
-
 def test_screenshot_option_writes_a_png_in_process(map_files, tmp_path, restore_logging):
     shot = tmp_path / "shot.png"
     code = app.main([str(map_files["sketch"]), str(map_files["metric"]), "--screenshot", str(shot)])

@@ -2,22 +2,9 @@
 
 from __future__ import annotations
 
-import logging
-
-import pytest
 from PySide6.QtGui import QGuiApplication
 
 from ursim_gui import app
-
-
-@pytest.fixture
-def restore_logging():
-    """main() installs log handlers on the root logger; take them off afterwards."""
-    yield
-    root = logging.getLogger()
-    for handler in [h for h in root.handlers if getattr(h, "_ursim_gui", False)]:
-        root.removeHandler(handler)
-        handler.close()
 
 
 def title_bar(title: str, display_name: str | None) -> str:

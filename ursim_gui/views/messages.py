@@ -12,7 +12,7 @@ import logging
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QMessageBox, QWidget
 
-__all__ = ["show_error", "ask_keep_drawing"]
+__all__ = ["show_error", "ask_save_discard_cancel", "ask_keep_drawing"]
 
 _log = logging.getLogger("ursim_gui")
 #: Parentless error boxes are kept here while shown; Python would otherwise delete them.
@@ -32,13 +32,13 @@ def show_error(parent: QWidget | None, title: str, message: str) -> QMessageBox:
     return box
 
 
-def ask_keep_drawing(parent: QWidget | None) -> str:
-    """Ask what to do with a drawing neither saved nor used: 'save', 'discard' or 'cancel'."""
+def ask_save_discard_cancel(parent: QWidget | None, title: str, text: str, name: str) -> str:
+    """A modal Save / Discard / Cancel question (Save the default): 'save', 'discard' or 'cancel'."""
     box = QMessageBox(parent)
-    box.setObjectName("unkept_drawing_box")
+    box.setObjectName(name)
     box.setIcon(QMessageBox.Icon.Warning)
-    box.setWindowTitle("Unsaved drawing")
-    box.setText("The drawing has not been saved or used as the sketch. Save it before closing?")
+    box.setWindowTitle(title)
+    box.setText(text)
     box.setStandardButtons(
         QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel
     )
@@ -46,4 +46,14 @@ def ask_keep_drawing(parent: QWidget | None) -> str:
     answer = box.exec()
     return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
         QMessageBox.StandardButton(answer), "cancel"
+    )
+
+
+def ask_keep_drawing(parent: QWidget | None) -> str:
+    """Ask what to do with a drawing neither saved nor used: 'save', 'discard' or 'cancel'."""
+    return ask_save_discard_cancel(
+        parent,
+        "Unsaved drawing",
+        "The drawing has not been saved or used as the sketch. Save it before closing?",
+        "unkept_drawing_box",
     )

@@ -9,25 +9,15 @@ from pathlib import Path
 
 from PySide6.QtWidgets import QMessageBox, QWidget
 
-from ursim_gui.views.messages import show_error
+from ursim_gui.views.messages import ask_save_discard_cancel, show_error
 
 __all__ = ["show_error", "ask_unsaved_changes", "ask_recover", "ask_overwrite_changed"]
 
 
 def ask_unsaved_changes(parent: QWidget | None, what: str) -> str:
     """Ask what to do with unsaved changes before ``what``: 'save', 'discard' or 'cancel'."""
-    box = QMessageBox(parent)
-    box.setObjectName("unsaved_box")
-    box.setIcon(QMessageBox.Icon.Warning)
-    box.setWindowTitle("Unsaved changes")
-    box.setText(f"The correspondences have unsaved changes. Save them before {what}?")
-    box.setStandardButtons(
-        QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel
-    )
-    box.setDefaultButton(QMessageBox.StandardButton.Save)
-    answer = box.exec()
-    return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
-        QMessageBox.StandardButton(answer), "cancel"
+    return ask_save_discard_cancel(
+        parent, "Unsaved changes", f"The correspondences have unsaved changes. Save them before {what}?", "unsaved_box"
     )
 
 

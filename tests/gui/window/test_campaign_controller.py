@@ -21,6 +21,14 @@ def kth_folder():
     return folder
 
 
+def campaign_window(qtbot, tmp_path, folder, out):
+    """A new window with the campaign of ``folder`` open (pairs' files in ``out``) and its first pair matched."""
+    window = new_window(qtbot, tmp_path / "userdata")
+    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
+        assert window.campaigns.open(folder, output_dir=out)
+    return window
+
+
 def test_a_kth_campaign_of_18_pairs_through_the_widgets_and_back(qtbot, tmp_path):
     folder = kth_folder()
     out, data = tmp_path / "annotations", tmp_path / "userdata"
@@ -93,9 +101,7 @@ def test_a_campaign_of_robot_maps_is_matched_as_robot_maps(qtbot, tmp_path):
     kth = dataset_root() / "ursim_kth_sketches"
     if kth.is_dir():
         assert {pair.input_kind for pair in open_campaign(kth, output_dir=tmp_path / "kth").pairs} == {"sketch"}
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        assert window.campaigns.open(folder, output_dir=tmp_path / "out")
+    window = campaign_window(qtbot, tmp_path, folder, tmp_path / "out")
     assert window.matching_panel.config().input_kind == "metric"
     assert window.session.last_match.config.resolved().matcher == "overlay"
     window.close()
@@ -106,9 +112,7 @@ def test_the_pairs_list_says_how_each_sketch_was_read_and_marks_close_calls(plai
     from ursim_gui.panels.campaign_panel import CLOSE_CALL_COLOUR
 
     out = tmp_path / "out"
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        window.campaigns.open(plain_campaign, output_dir=out)
+    window = campaign_window(qtbot, tmp_path, plain_campaign, out)
     panel = window.campaign_panel
     record = load_correspondences(out / "s1.json").extra["matcher"]
     assert panel.reading_text(0) == reading_of(record)[0] != ""  # matched with the orientation unknown
@@ -135,9 +139,7 @@ def test_the_next_pair_s_sketch_is_read_ahead_while_a_pair_is_worked_on(plain_ca
         return load(path, *args, **kwargs)
 
     monkeypatch.setattr(maps, "load_map", recording)
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        window.campaigns.open(plain_campaign, output_dir=tmp_path / "out")
+    window = campaign_window(qtbot, tmp_path, plain_campaign, tmp_path / "out")
     assert window.session.read_ahead.pending == ((plain_campaign / "s2.png").absolute(),)
     with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
         qtbot.keyClick(window.views["sketch"], Qt.Key.Key_D)
@@ -161,9 +163,7 @@ def test_another_file_opened_over_a_pair_never_overwrites_the_pair_s_file(plain_
     from ursim_gui.window import dialogs
 
     out = tmp_path / "out"
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        window.campaigns.open(plain_campaign, output_dir=out)
+    window = campaign_window(qtbot, tmp_path, plain_campaign, out)
     window.actions["accept_all"].trigger()
     assert window.campaigns.save_current()
     mine = (out / "s1.json").read_bytes()
@@ -194,9 +194,7 @@ def test_a_pair_that_cannot_be_opened_is_shown_empty_at_its_place(plain_campaign
     from conftest import error_boxes
 
     out = tmp_path / "out"
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        window.campaigns.open(plain_campaign, output_dir=out)
+    window = campaign_window(qtbot, tmp_path, plain_campaign, out)
     session, campaigns = window.session, window.campaigns
     session.set_status(session.correspondences.cliques[0].id, "rejected")
     (out / "s2.json").write_text("{ not json")  # the next pair's file, damaged
@@ -217,9 +215,7 @@ def test_paging_faster_than_the_matcher_leaves_the_pair_landed_on_matched(plain_
     from conftest import error_boxes
 
     out = tmp_path / "out"
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        window.campaigns.open(plain_campaign, output_dir=out)
+    window = campaign_window(qtbot, tmp_path, plain_campaign, out)
     campaigns = window.campaigns
     assert campaigns.next()
     assert campaigns.next()  # s2's segmentation and match still queued
@@ -233,9 +229,7 @@ def test_paging_faster_than_the_matcher_leaves_the_pair_landed_on_matched(plain_
 
 
 def test_the_progress_bar_counts_a_pair_as_done_as_soon_as_it_is(plain_campaign, qtbot, tmp_path):
-    window = new_window(qtbot, tmp_path / "userdata")
-    with qtbot.waitSignal(window.campaigns.pair_ready, timeout=180_000):
-        window.campaigns.open(plain_campaign, output_dir=tmp_path / "out")
+    window = campaign_window(qtbot, tmp_path, plain_campaign, tmp_path / "out")
     assert window.campaign_panel.progress.value() == 0
     window.actions["accept_all"].trigger()
     assert window.campaign_panel.status_text(0) == "done" and window.campaign_panel.progress.value() == 1

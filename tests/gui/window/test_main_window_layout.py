@@ -6,10 +6,10 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import pytest
+from conftest import segmented_window
 from PySide6.QtCore import QRect
 from PySide6.QtWidgets import QMenu, QToolBar, QWidget
 
-from ursim_core.segmentation import load_label_image
 from ursim_gui.panels.correspondence_table import FREE_TEXT_COLUMNS
 from ursim_gui.window.main_window import MainWindow
 
@@ -18,15 +18,7 @@ LAPTOP_SIZES = [(1280, 800), (1366, 768)]
 
 def first_start(qtbot, tmp_path, map_files, size) -> MainWindow:
     """A window started for the first time (no layout remembered) at ``size``, both maps segmented."""
-    window = MainWindow(data_dir=tmp_path / f"first_start_{size[0]}")
-    qtbot.addWidget(window)
-    window.resize(*size)
-    window.show()
-    qtbot.waitExposed(window)
-    for side in ("sketch", "metric"):
-        window.session.load_map(side, map_files[side])
-        labels = load_label_image(map_files[f"{side}_labels"], shape=window.session.map(side).shape)
-        window.session.set_segmentation(side, labels)
+    window = segmented_window(qtbot, tmp_path / f"first_start_{size[0]}", map_files, size)
     qtbot.wait(20)
     return window
 
