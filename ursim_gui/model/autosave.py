@@ -157,13 +157,16 @@ def recover_with_origin(path: str | os.PathLike) -> tuple[Correspondences, Path 
 
 
 def discard(path: str | os.PathLike) -> None:
-    """Delete an autosave file and its edited label images (no error when they are already gone)."""
+    """Delete an autosave file, its edited label images and its drawn maps (no error when they are
+    already gone)."""
+    from ursim_gui.model.session_documents import drawn_map_path_for
     from ursim_gui.model.session_label_edits import labels_path_for
 
     path = Path(path)
     path.unlink(missing_ok=True)
     for side in SIDES:
         labels_path_for(path, side).unlink(missing_ok=True)
+        drawn_map_path_for(path, side).unlink(missing_ok=True)
 
 
 class Autosaver:

@@ -92,3 +92,26 @@ def test_a_drawn_sketch_is_saved_beside_the_document_and_reopens_with_it(session
     assert reopened.map("sketch").path == beside and not reopened.dirty
     assert np.array_equal(reopened.map("sketch").free, session.map("sketch").free)
     assert reopened.map("sketch").sha256 == session.map("sketch").sha256
+
+
+def test_a_drawn_sketch_survives_a_crash_through_the_autosave_copy(session, tmp_path):
+    from ursim_core.io.maps import map_from_array
+    from ursim_gui.model.autosave import Autosaver, discard, recover
+
+    drawn = np.full((50, 70), 255, np.uint8)
+    drawn[0, :] = drawn[-1, :] = drawn[:, 0] = drawn[:, -1] = 0
+    session.new_document(keep=["metric"])
+    session.set_map("sketch", map_from_array(drawn))
+    saver = Autosaver(session, tmp_path / "autosave")
+    saver.flush()
+    copy = saver.path
+    drawing = copy.with_name(f"{copy.stem}.sketch.png")
+    assert copy.is_file() and drawing.is_file()
+    assert session.map("sketch").path is None  # the session is untouched: the copy only references it
+
+    recovered = AnnotationSession()
+    recovered.restore(recover(copy))
+    assert np.array_equal(recovered.map("sketch").free, session.map("sketch").free)
+    discard(copy)
+    assert not copy.exists() and not drawing.exists()
+    saver.close()
