@@ -8,14 +8,17 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import re
 import shutil
+import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterator
+import time
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from ursim_core.errors import ParameterError
+from ursim_core.errors import ParameterError, SaveRefusedError
 
 __all__ = [
     "UsageError",
@@ -27,6 +30,8 @@ __all__ = [
     "progress_bar",
     "announce_kernel_compilation",
     "check_output_folder",
+    "check_output_files",
+    "refuse_overwriting_inputs",
     "staged_folder",
 ]
 
@@ -155,32 +160,196 @@ def check_output_folder(path: str | Path, option: str = "-o") -> Path:
     return folder
 
 
+def _same_file(first: Path, second: Path) -> bool:
+    """Whether two paths name one file: the same inode when both exist (hard links, symbolic
+    links, a case-insensitive file system), else the same resolved path."""
+    try:
+        return os.path.samefile(first, second)
+    except (OSError, ValueError):
+        pass
+    try:
+        return os.path.normcase(os.path.realpath(first)) == os.path.normcase(os.path.realpath(second))
+    except (OSError, ValueError):
+        return False
+
+
+def refuse_overwriting_inputs(
+    outputs: Iterable[str | os.PathLike | None], inputs: Iterable[str | os.PathLike | None]
+) -> None:
+    """Refuse, before any work, an output that is one of the command's input files, or another output.
+
+    ``ursim goal sketch.png map.yaml --at 1,2 -o sketch.png`` would otherwise turn the sketch
+    into JSON, and ``-o a.json --waypoints a.json`` keep only the second file. The rule of the
+    correspondence savers (which refuse to write onto the maps they refer to), for every
+    command that writes files. ``None`` entries (options not given) are skipped.
+
+    Raises
+    ------
+    SaveRefusedError
+        Naming the output and the input it would overwrite; nothing was written.
+
+    Examples
+    --------
+    >>> refuse_overwriting_inputs(["out.json", None], ["sketch.png", "map.yaml"])
+    >>> refuse_overwriting_inputs(["./sketch.png"], ["sketch.png"])
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.SaveRefusedError: sketch.png: refusing to write an output onto the input sketch.png (it would be overwritten): choose another file name
+    """
+    given_inputs = [Path(path) for path in inputs if path is not None]
+    seen: list[Path] = []
+    for output in (Path(path) for path in outputs if path is not None):
+        for source in given_inputs:
+            if _same_file(output, source):
+                raise SaveRefusedError(
+                    f"refusing to write an output onto the input {source} (it would be overwritten): "
+                    "choose another file name",
+                    path=output,
+                )
+        for earlier in seen:
+            if _same_file(output, earlier):
+                raise SaveRefusedError(
+                    f"two outputs would be written to one file (also {earlier}): choose another file name",
+                    path=output,
+                )
+        seen.append(output)
+
+
+def _in_the_way(path: Path) -> str | None:
+    """Why the output ``path`` cannot be replaced by a file, or None when it can (missing or a file)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError as error:
+        return f"cannot be checked ({error.strerror or error})"
+    if stat.S_ISREG(mode) or stat.S_ISLNK(mode):
+        return None  # os.replace swaps a file or a link for the new file
+    return "is a folder" if stat.S_ISDIR(mode) else "is not a regular file (a device, pipe or socket)"
+
+
+def check_output_files(out: str | os.PathLike, names: Iterable[str]) -> None:
+    """Refuse, before any work, outputs ``out/NAME`` that cannot be written: a folder, a device or a
+    pipe is in their place.
+
+    Raises
+    ------
+    SaveRefusedError
+        Naming the first such output; nothing was written.
+    """
+    out = Path(out)
+    for name in names:
+        problem = _in_the_way(out / name)
+        if problem is not None:
+            raise SaveRefusedError(f"{problem}, not a file: cannot write this output here", path=out / name)
+
+
 @contextlib.contextmanager
 def staged_folder(out: Path) -> Iterator[Path]:
     """A temporary folder beside ``out`` whose files are moved into ``out`` when the block succeeds.
 
     On an error (a full disk, an interruption) the temporary folder is removed and ``out`` is left
-    as it was, so a run never leaves half of its outputs. Files are moved one by one with
-    ``os.replace`` (atomic on one file system), so each output in ``out`` is whole, and ``out``
-    is synced once after the moves (the staging folder's own syncs are skipped: see
-    :func:`ursim_core.io.atomic.scratch_directory`).
+    as it was, so a run never leaves half of its outputs. Every destination is checked before the
+    first move (a folder or a device in the place of an output: :class:`SaveRefusedError`, nothing
+    moved); files are then moved one by one with ``os.replace`` (atomic on one file system), so
+    each output in ``out`` is whole, and ``out`` is synced once after the moves (the staging
+    folder's own syncs are skipped: see :func:`ursim_core.io.atomic.scratch_directory`).
+
+    A staging folder left by a run that was killed (``.OUT.xxxxxxxx.tmp`` beside ``out``) is
+    removed by the next run into ``out`` (:func:`_remove_stale_staging`).
     """
     from ursim_core.io.atomic import scratch_directory, sync_directory
 
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
+    _remove_stale_staging(out)
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    lock = _hold(staging)
     try:
         # The staged files' contents are synced as they are saved; their names are made
         # durable once, where they end up, not in the staging folder, which is removed.
-        with scratch_directory(staging):
-            yield staging
+        try:
+            with scratch_directory(staging):
+                yield staging
+        except OSError as error:
+            _name_final_paths(error, staging, out)
+            raise
+        items = sorted(staging.iterdir())
+        check_output_files(out, (item.name for item in items))
         out.mkdir(exist_ok=True)
-        for item in sorted(staging.iterdir()):
+        for item in items:
             os.replace(item, out / item.name)
         sync_directory(out)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+        if lock is not None:
+            os.close(lock)
+
+
+def _name_final_paths(error: OSError, staging: Path, out: Path) -> None:
+    """Make ``error`` name the output in ``out``, not its staged copy: the user never sees the
+    staging folder (e.g. ``out/matches.png: File too large``)."""
+    for attribute in ("filename", "filename2"):
+        name = getattr(error, attribute)
+        if isinstance(name, (str, os.PathLike)):
+            relative = os.path.relpath(os.fspath(name), staging)
+            if relative != os.pardir and not relative.startswith(os.pardir + os.sep):
+                setattr(error, attribute, os.fspath(out / relative))
+
+
+def _hold(folder: Path | str) -> int | None:
+    """A descriptor of ``folder`` holding an exclusive ``flock`` on it, or None when it cannot be
+    taken (another process holds it, or no locks here: Windows, some network file systems).
+
+    The lock marks a staging folder as in use: the system drops it when its process dies, however
+    it dies, so a folder whose lock can be taken belongs to no running ``ursim``.
+    """
+    try:
+        import fcntl
+    except ImportError:
+        return None
+    try:
+        descriptor = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return None
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(descriptor)
+        return None
+    return descriptor
+
+
+def _remove_stale_staging(out: Path) -> None:
+    """Remove the staging folders of ``out`` that killed runs left (see :func:`staged_folder`).
+
+    Only folders of the exact name ``tempfile.mkdtemp`` gives them (``.OUT.`` + 8 characters +
+    ``.tmp``), untouched for :data:`~ursim_core.io.atomic.STALE_TEMP_SECONDS` and whose lock can
+    be taken (no live run holds it; a run of an older version, which took no lock, would have
+    touched its folder within that time unless it was long dead). Cleaning is a courtesy: any
+    problem leaves the folder.
+    """
+    from ursim_core.io.atomic import STALE_TEMP_SECONDS
+
+    pattern = re.compile(re.escape(f".{out.name}.") + r"[a-z0-9_]{8}\.tmp\Z")
+    deadline = time.time() - STALE_TEMP_SECONDS
+    try:
+        entries = [entry for entry in os.scandir(out.parent) if pattern.match(entry.name)]
+    except OSError:
+        return
+    for entry in entries:
+        try:
+            if not entry.is_dir(follow_symlinks=False) or entry.stat(follow_symlinks=False).st_mtime >= deadline:
+                continue
+        except OSError:
+            continue
+        lock = _hold(entry.path)
+        if lock is None:
+            continue
+        try:
+            shutil.rmtree(entry.path, ignore_errors=True)
+        finally:
+            os.close(lock)
 
 
 def add_subcommand(subparsers, name: str, module) -> argparse.ArgumentParser:

@@ -7,7 +7,7 @@ import argparse
 import dataclasses
 from pathlib import Path
 
-from ursim_core.cli.common import UsageError
+from ursim_core.cli.common import UsageError, refuse_overwriting_inputs
 from ursim_core.errors import ParameterError
 
 __all__ = ["convert_correspondences"]
@@ -44,7 +44,12 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("is a folder; give the file to write", path=target)
     if not target.parent.is_dir():
         raise ParameterError(f"no folder {target.parent} to write into", path=target)
-    if args.format is not None or _is_export(target):
+    export = args.format is not None or _is_export(target)
+    # Converting a file onto itself in its own format rewrites it in the project's layout (it is
+    # read before it is written); in another format, or onto a map, it would lose it.
+    same_format = not export and target.suffix.lower() == Path(args.input).suffix.lower()
+    refuse_overwriting_inputs([target], [args.sketch, args.metric, None if same_format else args.input])
+    if export:
         from ursim_core.correspondences.exporters import export_file
 
         kind = export_file(Path(args.input), target, format=args.format, side=args.side)

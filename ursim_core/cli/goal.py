@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ursim_core.cli.common import refuse_overwriting_inputs
 from ursim_core.errors import ParameterError
 
 __all__ = [
@@ -272,6 +273,7 @@ def cmd_goal(args: argparse.Namespace) -> int:
     for row, col in args.at:
         if not (math.isfinite(row) and math.isfinite(col)):
             raise ParameterError(f"--at must be two finite numbers, got {row},{col}")
+    refuse_overwriting_inputs([args.output], [args.sketch, args.metric, args.correspondences])
     nav = prepare_navigation(args)
     # A georeference too large overflows to NaN or infinity, which write_json refuses by name:
     # numpy's warnings would only add lines that do not say which file is at fault.

@@ -17,9 +17,11 @@ from typing import Any
 
 from ursim_core.cli.common import (
     add_map_options,
+    check_output_files,
     check_output_folder,
     keep_freed_memory,
     load,
+    refuse_overwriting_inputs,
     segmentation_params,
     staged_folder,
 )
@@ -307,6 +309,25 @@ def _return_freed_memory() -> None:
         pass
 
 
+#: The files ``ursim match`` writes into its output folder.
+OUTPUT_NAMES = ("sketch.labels.png", "metric.labels.png", "matches.png", "correspondences.json")
+
+
+def save_staged_correspondences(corr, staging: Path, out: Path) -> None:
+    """What :func:`~ursim_core.correspondences.save_correspondences` writes to ``out``, written
+    to ``staging`` (paths relative to ``out``), so it appears with the images or not at all."""
+    import dataclasses
+
+    from ursim_core.correspondences import correspondences_to_json, utc_timestamp
+    from ursim_core.correspondences.files import paused_garbage_collection, write_guarded
+
+    stamp = utc_timestamp()
+    corr = dataclasses.replace(corr, created=corr.created or stamp, modified=stamp)
+    with paused_garbage_collection():
+        text = correspondences_to_json(corr, folder=out, path=out / "correspondences.json")
+    write_guarded(corr, staging / "correspondences.json", text.encode(), expected_sha256=None, what="correspondences")
+
+
 def match_pair(
     sketch, metric, out: Path, options: dict[str, Any], *, reference_path=None, review_path=None
 ) -> dict[str, Any]:
@@ -319,7 +340,7 @@ def match_pair(
     """
     from types import SimpleNamespace
 
-    from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs, save_correspondences
+    from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs
     from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review
     from ursim_core.matching.results import laid_by, match_record, next_reading_record
     from ursim_core.render.figures import save_png, side_by_side_matches
@@ -328,6 +349,9 @@ def match_pair(
     args = SimpleNamespace(**options)
     config = match_config(args)
     out = check_output_folder(out)
+    # Before any work: no output may replace an input, nor land where a folder or device is.
+    refuse_overwriting_inputs([out / name for name in OUTPUT_NAMES], [sketch, metric, reference_path, review_path])
+    check_output_files(out, OUTPUT_NAMES)
     # A bad ground-truth file is reported before any work.
     reference = None if reference_path is None else load_reference(reference_path)
     review = None if review_path is None else load_reference(review_path)
@@ -345,8 +369,8 @@ def match_pair(
             check_maps(loaded, sketch_map, metric_map, loaded_path)
     # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
     config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
-    # The images are staged and moved in together; the JSON, which names them, is written last
-    # (atomically, in place, so the paths it stores are relative to its own folder).
+    # The images and the JSON that names them are staged and moved in together, so a failure
+    # leaves none of them; the JSON's paths are made relative to OUT, where it ends up.
     # The two label images are encoded on two threads while the maps are matched (OpenCV
     # releases the GIL, the matcher holds it most of the time; 8000 px labels take about half a
     # second each); errors are raised in the order of the steps (match, labels, figure).
@@ -404,8 +428,8 @@ def match_pair(
             anchors=result.anchors,
         )
         save_png(staging / "matches.png", figure)
+        save_staged_correspondences(corr, staging, out)
 
-    save_correspondences(corr, out / "correspondences.json")
     record: dict[str, Any] = {
         "n_matches": len(result.pairs),
         "n_sketch_regions": sketch_seg.n_regions,

@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import json
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -70,8 +70,20 @@ def configure(parser: argparse.ArgumentParser) -> None:
     match.add_pair_options(parser)
 
 
+#: Largest manifest read: a million pairs of short paths.
+MAX_MANIFEST_BYTES = 256 * 1024**2
+#: The file match-batch writes beside the pairs' folders.
+SUMMARY_NAME = "summary.csv"
+# A pair's folder is staged as ".NAME.xxxxxxxx.tmp" (14 more bytes) and no name may exceed 255.
+_MAX_NAME_BYTES = 240
+
+
 def read_manifest(path: str | Path) -> list[dict[str, Any]]:
     """The pairs of a manifest: dicts with ``name``, ``sketch``, ``metric``, ``reference`` and ``review`` (or None).
+
+    The manifest is read as every input is (a regular file, never a pipe; UTF-8 with or without
+    a byte-order mark, as Excel saves "CSV UTF-8"), and every pair's name is checked before any
+    pair runs (:func:`_check_name`).
 
     Examples
     --------
@@ -81,28 +93,26 @@ def read_manifest(path: str | Path) -> list[dict[str, Any]]:
     >>> [(p["name"], p["sketch"].name) for p in read_manifest(folder / "p.csv")]
     [('001-map', 'map.png'), ('002-map', 'map.png')]
     """
+    from ursim_core.io.reading import decode_text, parse_json, read_regular_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ParameterError("manifest not found", path=path) from None
-    except UnicodeDecodeError:
-        raise FormatError("not UTF-8 text", path=path) from None
+    raw = read_regular_file(path, max_bytes=MAX_MANIFEST_BYTES, error=FormatError, what="manifest")
+    text = decode_text(raw, path, error=FormatError, what="manifest")
     if path.suffix.lower() == ".json":
-        try:
-            items = json.loads(text)
-        except (ValueError, RecursionError) as error:
-            raise FormatError(f"not valid JSON ({str(error)[:80]})", path=path) from None
+        items = parse_json(text, path, error=FormatError, what="manifest")
         if not isinstance(items, list) or not all(isinstance(item, dict) for item in items):
             raise FormatError("expected a JSON list of objects with 'sketch' and 'metric'", path=path)
     else:
-        reader = csv.DictReader(io.StringIO(text))
-        if not reader.fieldnames or not {"sketch", "metric"} <= set(reader.fieldnames):
-            raise FormatError("expected a CSV header with the columns sketch and metric", path=path)
-        items = list(reader)
+        try:
+            reader = csv.DictReader(io.StringIO(text))
+            if not reader.fieldnames or not {"sketch", "metric"} <= set(reader.fieldnames):
+                raise FormatError("expected a CSV header with the columns sketch and metric", path=path)
+            items = list(reader)
+        except csv.Error as error:
+            raise FormatError(f"not a CSV file: {error}", path=path) from None
     if not items:
         raise FormatError("the manifest lists no pair", path=path)
-    pairs, names = [], set()
+    pairs, names = [], {}
     for index, item in enumerate(items, start=1):
         for key in ("sketch", "metric"):
             if not isinstance(item.get(key), str) or not item[key].strip():
@@ -113,11 +123,16 @@ def read_manifest(path: str | Path) -> list[dict[str, Any]]:
             if value is not None and not isinstance(value, str):
                 raise FormatError(f"pair {index}: '{key}' must be a path", path=path)
             optional[key] = path.parent / value.strip() if value and value.strip() else None
+        for key in ("sketch", "metric", "reference", "review"):
+            if "\x00" in (item.get(key) or ""):
+                raise FormatError(f"pair {index}: '{key}' contains a NUL character", path=path)
         sketch = path.parent / item["sketch"].strip()
-        name = str(item.get("name") or "").strip() or f"{index:03d}-{sketch.stem}"
-        if name in names or "/" in name or name in (".", ".."):
-            raise FormatError(f"pair {index}: the name '{name}' is taken or not a folder name", path=path)
-        names.add(name)
+        given = item.get("name")
+        if given is not None and (isinstance(given, bool) or not isinstance(given, (str, int))):
+            raise FormatError(f"pair {index}: 'name' must be a text (a folder name)", path=path)
+        name = str(given or "").strip() or f"{index:03d}-{sketch.stem}"
+        _check_name(name, index, names, path)
+        names[name.casefold()] = index
         pairs.append(
             {
                 "name": name,
@@ -127,6 +142,37 @@ def read_manifest(path: str | Path) -> list[dict[str, Any]]:
             }
         )
     return pairs
+
+
+def _check_name(name: str, index: int, taken: dict[str, int], manifest: Path) -> None:
+    """Refuse a pair name that cannot be the folder ``OUT/NAME`` of this pair alone.
+
+    Checked before any pair runs: otherwise a NUL stops the pair's staging with a traceback, a
+    lone surrogate stops the summary after every pair has run, and a name equal to another's
+    (also in another case: one folder on macOS and Windows) or to the summary's mixes outputs.
+    """
+
+    def refuse(problem: str) -> FormatError:
+        shown = repr(name) if len(name) <= 60 else repr(name[:57]) + "..."
+        return FormatError(f"pair {index}: the name {shown} {problem}; give the pair another 'name'", path=manifest)
+
+    if any(ord(char) < 32 or ord(char) == 127 for char in name):
+        raise refuse("contains a control character (NUL, newline, tab...)")
+    if "/" in name or "\\" in name:
+        raise refuse("contains a path separator (/ or \\): it must be one folder name")
+    if name.startswith("."):
+        raise refuse("starts with '.' (a hidden folder, '.' or '..')")
+    try:
+        encoded = name.encode("utf-8")
+        os.fsencode(name)
+    except UnicodeEncodeError:
+        raise refuse("holds characters that are no text (lone surrogates)") from None
+    if len(encoded) > _MAX_NAME_BYTES:
+        raise refuse(f"is too long for a folder name ({len(encoded)} bytes, at most {_MAX_NAME_BYTES})")
+    if name.casefold() == SUMMARY_NAME:
+        raise refuse(f"is the name of the summary ({SUMMARY_NAME})")
+    if name.casefold() in taken:
+        raise refuse(f"is taken by pair {taken[name.casefold()]} (names must differ, also in case)")
 
 
 def run_pair(pair: dict[str, Any], out: Path, options: dict[str, Any]) -> dict[str, Any]:
@@ -208,13 +254,48 @@ def _run_dask(pairs, out, options, scheduler, progress):
         client.close()
 
 
+def check_options(options: dict[str, Any]) -> None:
+    """Refuse, before any pair runs, options every pair would fail on: ``--m``, ``--set``, the
+    presets, ``--param``, ``--threshold``, ``--max-pixels`` (:class:`~ursim_core.errors.ParameterError`)."""
+    from types import SimpleNamespace
+
+    from ursim_core.cli.common import segmentation_params
+    from ursim_core.cli.match import match_config
+    from ursim_core.segmentation import resolve_params
+
+    args = SimpleNamespace(**options)
+    match_config(args).resolved()
+    params = segmentation_params(args)
+    for option, preset in (("--sketch-preset", args.sketch_preset), ("--metric-preset", args.metric_preset)):
+        try:
+            resolve_params("maoris", preset, params)
+        except ParameterError as error:
+            if error.field:  # a --param value, named by the error itself
+                raise
+            raise ParameterError(f"{option}: {error.problem}") from None
+    if not 0 <= args.threshold <= 255:
+        raise ParameterError(f"--threshold must be in 0..255, got {args.threshold}")
+    if args.max_pixels < 1:
+        raise ParameterError(f"--max-pixels must be a positive integer, got {args.max_pixels}")
+
+
+def _encoded(text: str) -> bytes:
+    # A path from a JSON manifest may hold the undecodable bytes of a file name (as os.fsdecode
+    # keeps them): written back as those bytes, any other lone surrogate escaped.
+    try:
+        return text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "backslashreplace")
+
+
 def run(args: argparse.Namespace) -> int:
     from ursim_core.cli.match import options_of
-    from ursim_core.io.atomic import atomic_write_text
+    from ursim_core.io.atomic import atomic_write_bytes
 
     out = check_output_folder(args.output)
     pairs = read_manifest(args.manifest)
     options = options_of(args)
+    check_options(options)
     progress = progress_bar(len(pairs), "match-batch")
     out.mkdir(parents=True, exist_ok=True)
     if args.scheduler:
@@ -223,9 +304,9 @@ def run(args: argparse.Namespace) -> int:
         records = list(_run_local(pairs, out, options, max(1, args.workers), progress))
     order = {pair["name"]: index for index, pair in enumerate(pairs)}
     records.sort(key=lambda record: order[record["name"]])
-    atomic_write_text(out / "summary.csv", _summary_csv(records))
+    atomic_write_bytes(out / SUMMARY_NAME, _encoded(_summary_csv(records)))
     failed = [record for record in records if record["status"] != "ok"]
     for record in failed:
         print(f"error: {record['name']}: {record['error']}", file=sys.stderr)
-    print(f"{len(records) - len(failed)} of {len(records)} pairs matched; wrote {out / 'summary.csv'}")
+    print(f"{len(records) - len(failed)} of {len(records)} pairs matched; wrote {out / SUMMARY_NAME}")
     return 1 if failed else 0

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -51,27 +52,34 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return add_subcommand(subparsers, "route", sys.modules[__name__])
 
 
+#: Largest points file read: a polyline of a million points is about 15 MB of text.
+MAX_POINTS_BYTES = 64 * 1024**2
+
+
 def read_points(path: str | Path) -> list[tuple[float, float]]:
     """The polyline of a points file (see the examples of ``ursim route --help``).
 
+    The file is read as every input is (:func:`ursim_core.io.reading.read_regular_file`: a regular
+    file of at most :data:`MAX_POINTS_BYTES`, never a pipe), UTF-8 with or without a byte-order
+    mark; JSON too deep, with NaN or numbers out of range is refused.
+
     Raises :class:`~ursim_core.errors.FormatError` naming the file and the line or item.
     """
+    from ursim_core.io.reading import decode_text, parse_json, read_regular_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
-        raise FormatError(f"cannot read the points file: {error}", path=path) from None
+    what = "points file"
+    raw = read_regular_file(path, max_bytes=MAX_POINTS_BYTES, error=FormatError, what=what)
+    text = decode_text(raw, path, error=FormatError, what=what)
     stripped = text.lstrip()
     if stripped.startswith(("[", "{")):
-        try:
-            document = json.loads(text)
-        except json.JSONDecodeError as error:
-            raise FormatError(f"not valid JSON: {error}", path=path) from None
+        document = parse_json(text, path, error=FormatError, what=what)
         items = document.get("points") if isinstance(document, dict) else document
         if not isinstance(items, list):
             raise FormatError('expected a list of [row, col] points (or {"points": [...]})', path=path)
         points = []
         for index, item in enumerate(items):
+            # parse_json admits only finite numbers that convert to float.
             if (
                 not isinstance(item, list)
                 or len(item) != 2
@@ -91,20 +99,27 @@ def read_points(path: str | Path) -> list[tuple[float, float]]:
             try:
                 if len(parts) != 2:
                     raise ValueError
-                points.append((float(parts[0]), float(parts[1])))
+                point = (float(parts[0]), float(parts[1]))
             except ValueError:
                 raise FormatError(f"line {number}: expected ROW,COL, got '{content[:40]}'", path=path) from None
+            if not all(math.isfinite(v) for v in point):
+                raise FormatError(f"line {number}: ROW and COL must be finite numbers, got '{content[:40]}'", path=path)
+            points.append(point)
     if not points:
         raise FormatError("no point in the file", path=path)
     return points
 
 
 def cmd_route(args: argparse.Namespace) -> int:
+    from ursim_core.cli.common import refuse_overwriting_inputs
     from ursim_core.navigation.nav2_files import pose_stamped, save_waypoints_yaml
     from ursim_core.navigation.route import plan_route
 
     if args.tolerance < 0:
         raise ParameterError(f"--tolerance must be >= 0, got {args.tolerance}")
+    refuse_overwriting_inputs(
+        [args.output, args.waypoints], [args.sketch, args.metric, args.points, args.correspondences]
+    )
     points = read_points(args.points)
     nav = prepare_navigation(args)
     if args.waypoints and nav.metric_map.resolution is None:

@@ -12,9 +12,11 @@ from ursim_core.cli.common import (
     UsageError,
     add_map_options,
     announce_kernel_compilation,
+    check_output_files,
     check_output_folder,
     load,
     progress_bar,
+    refuse_overwriting_inputs,
     segmentation_params,
     staged_folder,
 )
@@ -93,14 +95,20 @@ def region_records(segmentation) -> list[dict[str, Any]]:
     ]
 
 
+def output_files(name: str) -> tuple[str, str, str]:
+    """The files :func:`write_segmentation_outputs` writes for the map of output name ``name``."""
+    return f"{name}.labels.png", f"{name}.overlay.png", f"{name}.regions.json"
+
+
 def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, preset: str | None) -> None:
     from ursim_core.io.atomic import atomic_write_text
     from ursim_core.render.figures import overlay_segmentation, save_png
     from ursim_core.segmentation import save_label_image
 
-    save_label_image(segmentation, out / f"{name}.labels.png")
+    labels_name, overlay_name, regions_name = output_files(name)
+    save_label_image(segmentation, out / labels_name)
     save_png(
-        out / f"{name}.overlay.png",
+        out / overlay_name,
         overlay_segmentation(segmentation.labels, segmentation.regions, image=the_map.image, free=the_map.free),
     )
     document = {
@@ -110,7 +118,7 @@ def write_segmentation_outputs(the_map, segmentation, out: Path, *, name: str, p
         "segmentation": {"method": segmentation.method, "preset": preset, "params": segmentation.params},
         "regions": region_records(segmentation),
     }
-    atomic_write_text(out / f"{name}.regions.json", json.dumps(document, indent=2) + "\n")
+    atomic_write_text(out / regions_name, json.dumps(document, indent=2) + "\n")
 
 
 def segment_checked(
@@ -183,6 +191,12 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("give an output folder with -o OUT")
     out = check_output_folder(args.output)
     names = output_names(args.maps)
+    # No output may replace a map still to be read, nor the merge model of --method learned.
+    model = params.get("model")
+    refuse_overwriting_inputs(
+        [out / file for name in names for file in output_files(name)],
+        [*args.maps, model if isinstance(model, str) and model != "default" else None],
+    )
     for path, name in zip(args.maps, names):
         if name != Path(path).stem:
             print(f"note: {path} is written as {name}.* (another map has the same name)", file=sys.stderr)
@@ -190,6 +204,7 @@ def run(args: argparse.Namespace) -> int:
     failures = 0
     for index, (path, name) in enumerate(zip(args.maps, names), start=1):
         try:
+            check_output_files(out, output_files(name))
             the_map = load(path, args)
             method, preset = segmenter_of(args, the_map)
             if _by_kind(args) and method != "maoris":

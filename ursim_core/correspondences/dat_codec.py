@@ -174,7 +174,8 @@ def save_dat(corr: Correspondences, path: str | os.PathLike, *, expected_sha256:
     SaveRefusedError
         ``path`` is one of the maps (or label images) of ``corr``.
     FormatError
-        A map path cannot be written in the header.
+        A map path cannot be written in the header, or a point has a coordinate too large
+        for the format (more than 18 digits: :func:`load_dat` would refuse it).
     OSError
         Writing failed; an existing file is left unchanged.
 
@@ -197,6 +198,7 @@ def save_dat(corr: Correspondences, path: str | os.PathLike, *, expected_sha256:
     path = Path(path)
     lines = [f"# {_dat_header_token(corr.sketch, path)} {_dat_header_token(corr.metric, path)}"]
     for index, clique in enumerate(corr.cliques):
+        _check_readable_points(clique, index, path)
         lines.append(f"# {index}match set")
         lines.append("# map1")
         lines.extend(f"{row} {col}" for row, col in clique.sketch_points)
@@ -207,9 +209,25 @@ def save_dat(corr: Correspondences, path: str | os.PathLike, *, expected_sha256:
     return write_guarded(corr, path, data, expected_sha256=expected_sha256, what=".dat file")
 
 
+def _check_readable_points(clique: Clique, index: int, path: Path) -> None:
+    """Refuse a point :func:`load_dat` would refuse to read back (a coordinate of more than
+    ``_MAX_DIGITS`` digits): a file that saves must load."""
+    limit = 10**_MAX_DIGITS
+    for side in ("sketch_points", "metric_points"):
+        for number, point in enumerate(getattr(clique, side)):
+            if any(value >= limit for value in point):
+                raise FormatError(
+                    f"clique {clique.id}: the point {point} has a coordinate of more than {_MAX_DIGITS} digits, "
+                    "which a .dat file cannot hold (it would not read back); nothing was written",
+                    path=path,
+                    field=f"cliques[{index}].{side}[{number}]",
+                )
+
+
 def _dat_lines(raw: bytes, path: Path) -> list[str]:
     try:
-        text = raw.decode("utf-8")
+        # A leading byte-order mark (Notepad's "UTF-8") is dropped, as the JSON reader does.
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         line = raw[: error.start].count(b"\n") + 1
         raise FormatError(f"line {line}: not text (undecodable byte); not a .dat file", path=path) from None

@@ -456,12 +456,25 @@ def export_file(
     kind = export_format_of(target, format)
     source = Path(source)
     corr = load_dat(source) if source.suffix.lower() == ".dat" else load_correspondences(source)
+    _check_not_an_input(corr, source, Path(target))
     ref = getattr(corr, side)
     labels = _read_labels(ref.labels_path, ref.size) if ref.labels_path is not None else None
     the_map, metric_map = _georeferenced_map(ref.path), _georeferenced_map(corr.metric.path)
     return export_correspondences(
         corr, target, format=kind, side=side, labels=labels, the_map=the_map, metric_map=metric_map
     )
+
+
+def _check_not_an_input(corr, source: Path, target: Path) -> None:
+    """An export never replaces the file it exports, nor a map or label image that file names."""
+    from ursim_core.correspondences.files import _check_not_a_map, _real
+    from ursim_core.errors import SaveRefusedError
+
+    if _real(source) == _real(target):
+        raise SaveRefusedError(
+            f"refusing to export onto the file exported ({source}): choose another file name", path=target
+        )
+    _check_not_a_map(corr, target)
 
 
 def _georeferenced_map(path: Path | None):

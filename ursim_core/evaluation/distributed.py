@@ -26,7 +26,13 @@ __all__ = ["connect", "segment_all_dask", "run_tasks_dask"]
 
 
 def connect(scheduler: Any):
-    """A ``distributed.Client`` for ``scheduler``: an address (``tcp://host:8786``) or a Client."""
+    """A ``distributed.Client`` for ``scheduler``: an address (``tcp://host:8786``) or a Client.
+
+    Raises
+    ------
+    ParameterError
+        Dask is not installed, the address is malformed, or the scheduler cannot be reached.
+    """
     try:
         from distributed import Client
     except ImportError:
@@ -35,10 +41,32 @@ def connect(scheduler: Any):
         ) from None
     if isinstance(scheduler, Client):
         return scheduler
+    address = str(scheduler)
     try:
-        return Client(str(scheduler), timeout="10s")
+        # Checked before a Client exists: a Client that fails to start is left half made, and
+        # its __del__ can deadlock the next Client started in the process (seen with distributed
+        # 2026.11: the clean-up waits for the loop lock the starting Client holds).
+        _check_address(address)
+        return Client(address, timeout="10s")
     except (OSError, TimeoutError) as error:
-        raise ParameterError(f"cannot reach the Dask scheduler {scheduler}: {error}", field="scheduler") from None
+        raise ParameterError(f"cannot reach the Dask scheduler {address}: {error}", field="scheduler") from None
+    except (ValueError, TypeError) as error:
+        # 'not a url' (no port), 'http://x:y' (unknown scheme), 'tcp://h:p' (no port number).
+        raise ParameterError(
+            f"{address!r} is not a Dask scheduler address ({error}); expected e.g. tcp://HOST:8786",
+            field="scheduler",
+        ) from None
+
+
+def _check_address(address: str) -> None:
+    """Raise ValueError for an address Dask would refuse: an unknown scheme, no host and port."""
+    from distributed.comm import get_address_host_port, parse_address
+    from distributed.comm.registry import get_backend
+
+    scheme, _ = parse_address(address)
+    get_backend(scheme)
+    if scheme in ("tcp", "tls", "ws", "wss"):
+        get_address_host_port(address)
 
 
 def _run_task_with(task: MatchTask, sketch, metric, place) -> list[RunRow]:

@@ -12,11 +12,25 @@ A writer killed between the two leaves its hidden ``.NAME.xxxxxxxx.tmp`` behind.
 The next save of ``NAME`` removes such files of our own pattern once they are
 older than :data:`STALE_TEMP_SECONDS` (no live save takes minutes), so repeated
 crashes cannot fill a disk.
+
+A destination that exists and is not a regular file is never replaced: renaming a file
+over ``/dev/null`` (as root) or over a named pipe would destroy the node and silently
+turn it into a plain file. A character device (``/dev/null``, ``/dev/full``, a terminal)
+is written through instead, in place, since writing to it is what the user asked for and
+it has no old content to keep; a folder, a named pipe (opening it would block until a
+reader comes), a socket (cannot be opened) or a block device (a disk: never what a JSON
+or an image is meant for) is refused with an error naming it.
+
+Every :class:`OSError` raised names the caller's path (``error.filename``), not the
+hidden temporary file, whatever step failed (a missing folder, a read-only folder, a
+full disk, a file-size limit), so a message of ``PATH: problem`` points at the file the
+user gave.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import secrets
@@ -41,6 +55,8 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
     path : str or path-like
         The file to create or replace. Its directory must exist. If it is a
         symbolic link, the file it points to is replaced (the link is kept).
+        If it is a character device (``/dev/null``), ``data`` is written to the
+        device in place (see the module's docstring).
     data : bytes-like
         The complete new content.
 
@@ -48,8 +64,10 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
     ------
     OSError
         The original error when the temporary file cannot be created, written,
-        synced or renamed. The temporary file is removed first and an existing
-        file at ``path`` is left untouched.
+        synced or renamed, with ``filename`` set to ``path``. The temporary file
+        is removed first and an existing file at ``path`` is left untouched.
+        Also raised, before anything is written, when ``path`` is a folder
+        (:class:`IsADirectoryError`), a named pipe, a socket or a block device.
 
     Notes
     -----
@@ -63,9 +81,30 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
     >>> atomic_write_bytes(folder / "a.bin", b"new")
     >>> (folder / "a.bin").read_bytes()
     b'new'
+    >>> atomic_write_bytes(folder, b"new")
+    Traceback (most recent call last):
+    ...
+    IsADirectoryError: [Errno 21] is a folder, not a file: ...
     """
     payload = memoryview(data).cast("B")
-    target = Path(path)
+    try:
+        _write(Path(path), payload)
+    except OSError as error:
+        # The same object (callers may compare it), renamed after the user's path.
+        error.filename, error.filename2 = os.fspath(path), None
+        folder = os.path.dirname(os.fspath(path)) or "."
+        if error.errno == errno.ENOENT and not os.path.isdir(folder):
+            error.strerror = f"{error.strerror or 'No such file or directory'} (no folder {folder})"
+        raise
+
+
+def _write(target: Path, payload: memoryview) -> None:
+    mode = _existing_mode(target)
+    if mode is not None and not stat.S_ISREG(mode):
+        if stat.S_ISCHR(mode):
+            _write_through(target, payload)
+            return
+        raise _refusal(mode)
     if target.is_symlink():
         # Replacing the link itself would silently detach it from its file.
         target = Path(os.path.realpath(target))
@@ -90,6 +129,49 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
         raise
     if not _is_scratch(directory):
         _fsync_directory(directory)
+
+
+def _existing_mode(target: Path) -> int | None:
+    """``st_mode`` of what ``target`` names (links followed), None when nothing is there yet."""
+    try:
+        return os.stat(target).st_mode
+    except (OSError, ValueError):
+        # Missing, or a problem the save itself reports (a dangling link is created through).
+        return None
+
+
+def _refusal(mode: int) -> OSError:
+    if stat.S_ISDIR(mode):
+        return IsADirectoryError(errno.EISDIR, "is a folder, not a file: nothing was written")
+    if stat.S_ISFIFO(mode):
+        kind = "a named pipe (FIFO)"
+    elif stat.S_ISSOCK(mode):
+        kind = "a socket"
+    elif stat.S_ISBLK(mode):
+        kind = "a block device (a disk)"
+    else:
+        kind = "a special file"
+    return OSError(errno.EINVAL, f"is {kind}, not a regular file: refusing to write to it or replace it")
+
+
+def _write_through(target: Path, payload: memoryview) -> None:
+    """Write ``payload`` to the character device ``target`` in place (nothing to keep, nothing to sync)."""
+    # Non-blocking open, so that a named pipe swapped in since the stat cannot hang the save;
+    # no O_CREAT: if the device went away, nothing is created in its place.
+    flags = os.O_WRONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0)
+    descriptor = os.open(target, flags)
+    try:
+        mode = os.fstat(descriptor).st_mode
+        if not stat.S_ISCHR(mode):
+            # Replaced between the stat and the open: refuse rather than write a file in place.
+            raise _refusal(mode) if not stat.S_ISREG(mode) else OSError(errno.EAGAIN, "changed while being saved")
+        os.set_blocking(descriptor, True)
+        view = payload
+        while view:
+            written = os.write(descriptor, view)
+            view = view[written:]
+    finally:
+        os.close(descriptor)
 
 
 def atomic_write_text(path: str | os.PathLike, text: str, *, encoding: str = "utf-8") -> None:
@@ -174,7 +256,7 @@ def _create_temp_file(directory: Path, name: str) -> tuple[int, Path]:
             return os.open(candidate, flags, 0o666), candidate
         except FileExistsError:
             continue
-    raise FileExistsError(f"could not create a temporary file in {directory}")
+    raise FileExistsError(errno.EEXIST, f"could not create a temporary file in {directory}")
 
 
 def _remove_stale_temp_files(directory: Path, name: str) -> None:

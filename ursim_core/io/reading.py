@@ -7,6 +7,11 @@ symbolic link loop or a dangling link each get their own message, and a multi-gi
 file is refused from its size. The file is opened non-blocking and checked again after the
 open, so swapping a pipe in between does not hang either.
 
+Text and JSON read through here too (:func:`decode_text`, :func:`parse_json`,
+:func:`read_json_file`): UTF-8 with or without a byte-order mark, and JSON whose nesting or
+numbers would make ``json.loads`` or the next ``float()`` raise (``RecursionError``, an
+integer of thousands of digits, ``NaN``, ``1e999``) refused with a message.
+
 Errors are the caller's :class:`~ursim_core.errors.UrsimError` subclass, naming the file.
 """
 
@@ -19,7 +24,15 @@ from pathlib import Path
 
 from ursim_core.errors import UrsimError
 
-__all__ = ["check_regular_file", "read_regular_file", "describe_size"]
+__all__ = [
+    "check_regular_file",
+    "read_regular_file",
+    "describe_size",
+    "decode_text",
+    "parse_json",
+    "read_json_file",
+    "MAX_JSON_DEPTH",
+]
 
 _CHUNK = 1 << 20
 
@@ -181,3 +194,122 @@ def _check_size(size: int, path: Path, *, max_bytes: int, error, what: str, limi
             f"{limit_reason}",
             path=path,
         )
+
+
+# Deeper than any JSON file the project reads by far (a points list is 2 levels, a merge model
+# 4), shallow enough that no recursive step after parsing (validation, json.dumps on the next
+# save) comes near Python's recursion limit.
+MAX_JSON_DEPTH = 64
+# The most digits an integer may have and still convert to a float (10**308 < 1.8e308):
+# every number the project reads ends up as one, and int() refuses more than 4300 digits.
+_MAX_INT_DIGITS = 308
+
+
+def decode_text(raw: bytes, path: Path, *, error: type[UrsimError], what: str) -> str:
+    """``raw`` as UTF-8 text, a leading byte-order mark dropped (Excel's "CSV UTF-8", Notepad).
+
+    Examples
+    --------
+    >>> from ursim_core.errors import FormatError
+    >>> decode_text(b"\\xef\\xbb\\xbfsketch,metric", Path("p.csv"), error=FormatError, what="manifest")
+    'sketch,metric'
+    """
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as problem:
+        line = raw[: problem.start].count(b"\n") + 1
+        raise error(f"line {line}: not UTF-8 text (byte {problem.start}): not a {what}", path=path) from None
+
+
+class _JsonRefused(ValueError):
+    """A JSON value the project refuses (its text says why); a ValueError so json stops parsing."""
+
+
+def _parse_int(text: str) -> int:
+    digits = len(text.lstrip("-"))
+    if digits > _MAX_INT_DIGITS:
+        raise _JsonRefused(f"an integer of {digits} digits is too large (at most {_MAX_INT_DIGITS})")
+    return int(text)
+
+
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if value in (float("inf"), float("-inf")):
+        shown = text if len(text) <= 40 else text[:37] + "..."
+        raise _JsonRefused(f"the number {shown} is out of range")
+    return value
+
+
+def _refuse_constant(name: str):
+    raise _JsonRefused(f"{name} is not a JSON number")
+
+
+def parse_json(data: bytes | str, path: Path, *, error: type[UrsimError], what: str, max_depth: int = MAX_JSON_DEPTH):
+    """The JSON document in ``data``, or ``error`` naming ``path`` and what is wrong.
+
+    ``json.loads`` alone raises ``RecursionError`` for arrays nested a few thousand deep,
+    ``ValueError`` for an integer of more than 4300 digits, and lets through ``NaN``,
+    ``Infinity``, ``1e999`` and integers too large for a float (``OverflowError`` at the
+    first ``float()``). Each of these is refused here, as is nesting deeper than
+    ``max_depth``, so whatever is returned can be used and written again.
+
+    Parameters
+    ----------
+    data : bytes or str
+        The file's content; bytes are decoded as UTF-8 (a byte-order mark allowed).
+    path : Path
+        The file, for the messages.
+    error : UrsimError subclass
+        Raised for every problem, with ``path=path``.
+    what : str
+        What the file should be, for the messages ("points file").
+    max_depth : int, optional
+        Most levels of arrays and objects inside each other.
+
+    Examples
+    --------
+    >>> from ursim_core.errors import FormatError
+    >>> parse_json(b'{"points": [[1, 2]]}', Path("p.json"), error=FormatError, what="points file")
+    {'points': [[1, 2]]}
+    >>> parse_json("[1e999]", Path("p.json"), error=FormatError, what="points file")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.FormatError: p.json: not JSON for a points file: the number 1e999 is out of range
+    """
+    import json
+
+    text = decode_text(data, path, error=error, what=what) if isinstance(data, (bytes, bytearray)) else data
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    try:
+        document = json.loads(text, parse_int=_parse_int, parse_float=_parse_float, parse_constant=_refuse_constant)
+    except json.JSONDecodeError as problem:
+        raise error(f"not JSON: {problem.msg} (line {problem.lineno}, column {problem.colno})", path=path) from None
+    except _JsonRefused as problem:
+        raise error(f"not JSON for a {what}: {problem}", path=path) from None
+    except RecursionError:
+        raise error(f"not JSON for a {what}: nested deeper than {max_depth} levels", path=path) from None
+    except (ValueError, OverflowError) as problem:
+        raise error(f"not JSON for a {what}: {problem}", path=path) from None
+    _check_depth(document, path, error=error, what=what, max_depth=max_depth)
+    return document
+
+
+def _check_depth(document, path: Path, *, error, what: str, max_depth: int) -> None:
+    # An explicit stack: a check of depth must not itself recurse.
+    stack = [(document, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if isinstance(value, (dict, list)):
+            if depth > max_depth:
+                raise error(f"not JSON for a {what}: nested deeper than {max_depth} levels", path=path)
+            stack.extend((item, depth + 1) for item in (value.values() if isinstance(value, dict) else value))
+
+
+def read_json_file(path: Path, *, max_bytes: int, error: type[UrsimError], what: str, max_depth: int = MAX_JSON_DEPTH):
+    """The JSON document of a regular file of at most ``max_bytes``: :func:`read_regular_file`,
+    then :func:`parse_json`; every problem is ``error`` naming ``path``."""
+    raw = read_regular_file(
+        path, max_bytes=max_bytes, error=error, what=what, empty_problem=f"empty file: not a {what}"
+    )
+    return parse_json(raw, path, error=error, what=what, max_depth=max_depth)

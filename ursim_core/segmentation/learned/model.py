@@ -152,20 +152,19 @@ class MergeModel:
         )
 
 
+#: Largest model file read: the shipped one is about 20 kB; a thousand trees take 200 kB.
+MAX_MODEL_BYTES = 16 * 1024**2
+
+
 def load_merge_model(path: str | Path) -> MergeModel:
     """Read a model file; :class:`~ursim_core.errors.SegmentationError` naming the file
-    when it is missing, not JSON, or not a valid model."""
+    when it is missing, not a regular file (a pipe is never opened), larger than
+    :data:`MAX_MODEL_BYTES`, not JSON (or JSON nested too deep or with numbers out of range),
+    or not a valid model."""
+    from ursim_core.io.reading import read_json_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SegmentationError("merge model file not found", path=path) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise SegmentationError(f"cannot read the merge model ({error.__class__.__name__})", path=path) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise SegmentationError(f"not JSON (line {error.lineno}: {error.msg})", path=path) from None
+    data = read_json_file(path, max_bytes=MAX_MODEL_BYTES, error=SegmentationError, what="merge model file")
     return MergeModel.from_dict(data, path=path)
 
 
