@@ -135,6 +135,8 @@ class AnnotationSession(
         self._focus: tuple[str, int] | None = None
         self._reference_corr: Correspondences | None = None
         self._reference_path: Path | None = None
+        # PNG files written for drawn maps (session_documents.drawn_maps_beside): path -> (map, sha256).
+        self._drawn_files: dict[Path, tuple[Any, str]] = {}
         self._reference: list[tuple[frozenset[int], frozenset[int]]] | None = None
         self._evaluation = None
         self._clique_marks: dict[int, str] = {}

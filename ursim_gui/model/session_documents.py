@@ -220,12 +220,20 @@ class DocumentOperations:
         written; the autosave copy only references them).
         """
         drawn = {}
+        # The autosave calls this at each flush; a drawing does not change once shown, so its PNG
+        # is encoded and written once per file (a KTH-sized one takes about 10 ms on the GUI thread).
+        written = self._drawn_files
         for side in SIDES:
             map_ = self._maps[side]
             if map_ is None or map_.path is not None:
                 continue
             path = drawn_map_path_for(target, side)
-            sha256 = write_map_png(map_, path)
+            kept = written.get(path)
+            if kept is not None and kept[0] is map_ and path.is_file():
+                sha256 = kept[1]
+            else:
+                sha256 = write_map_png(map_, path)
+                written[path] = (map_, sha256)
             drawn[side] = dataclasses.replace(map_, path=path, sha256=sha256)
             ref = getattr(corr, side)
             if ref.path is None:
