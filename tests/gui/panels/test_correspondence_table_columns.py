@@ -37,3 +37,15 @@ def test_every_header_but_the_obvious_ones_says_what_it_holds(window):
     for name in ("Sketch", "Metric", "Source", "Status", "Eval", "Label", "Note"):
         tip = model.headerData(COLUMNS.index(name), Qt.Orientation.Horizontal, Qt.ItemDataRole.ToolTipRole)
         assert tip, name
+
+
+def test_filling_the_table_does_not_narrow_it(window, qtbot):
+    # A scroll bar that appears with the rows would narrow the view and lay the columns out again.
+    table = window.table
+    table.view.setFixedHeight(70)  # room for about two rows: the third needs scrolling
+    qtbot.wait(10)
+    width = table.view.viewport().width()
+    for region in (1, 2, 3):
+        window.session.link([region], [region])
+    qtbot.wait(10)
+    assert table.view.viewport().width() == width
