@@ -30,6 +30,7 @@ __all__ = [
     "progress_bar",
     "announce_kernel_compilation",
     "check_output_folder",
+    "finite_or_nan",
     "check_output_files",
     "refuse_overwriting_inputs",
     "staged_folder",
@@ -141,6 +142,22 @@ def announce_kernel_compilation() -> None:
     notice = compile_notice()
     if notice:
         print(notice, file=sys.stderr, flush=True)
+
+
+def finite_or_nan(text: str) -> float:
+    """``float(text)``, or NaN when it is not a number or not finite (NaN, infinity, ``1e400``): the
+    argparse types that want a finite number test the one value.
+
+    >>> finite_or_nan("2.5"), finite_or_nan("inf"), finite_or_nan("x")
+    (2.5, nan, nan)
+    """
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        return math.nan
+    return value if math.isfinite(value) else math.nan
 
 
 def check_output_folder(path: str | Path, option: str = "-o") -> Path:

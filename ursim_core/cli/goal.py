@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ursim_core.cli.common import refuse_overwriting_inputs
+from ursim_core.cli.common import finite_or_nan, refuse_overwriting_inputs
 from ursim_core.errors import ParameterError
 
 __all__ = [
@@ -96,11 +96,8 @@ def finite_number(text: str) -> float:
     ...
     argparse.ArgumentTypeError: expected a finite number, got 'inf'
     """
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value):
+    value = finite_or_nan(text)
+    if math.isnan(value):
         raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
     return value
 
@@ -117,11 +114,8 @@ def tolerance_value(text: str) -> float:
     ...
     argparse.ArgumentTypeError: expected a finite number of pixels >= 0, got 'nan'
     """
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value >= 0):
+    value = finite_or_nan(text)
+    if not value >= 0:  # NaN too
         raise argparse.ArgumentTypeError(f"expected a finite number of pixels >= 0, got '{text}'")
     return value
 

@@ -19,6 +19,7 @@ from ursim_core.cli.common import (
     add_map_options,
     check_output_files,
     check_output_folder,
+    finite_or_nan,
     keep_freed_memory,
     load,
     refuse_overwriting_inputs,
@@ -129,11 +130,8 @@ def orientation_value(text: str):
     """``--orientation``: 'any', 'upright' or a finite number of degrees (else a usage error)."""
     if text in ("any", "upright"):
         return text
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value):
+    value = finite_or_nan(text)
+    if math.isnan(value):
         raise argparse.ArgumentTypeError(f"expects 'any', 'upright' or a number of degrees, got '{text}'")
     return value
 

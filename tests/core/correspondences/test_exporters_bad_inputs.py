@@ -3,30 +3,15 @@ numbers (a georeference that overflows) and label images too large or cut, refus
 
 from __future__ import annotations
 
-import struct
-import zlib
-
 import cv2
 import numpy as np
 import pytest
+from image_files import png_header_only
 
 from ursim_core.correspondences import Clique, Correspondences, MapRef, save_correspondences
 from ursim_core.correspondences.exporters import export_correspondences, export_file, finite_json
 from ursim_core.errors import FormatError, SegmentationError
 from ursim_core.io.maps import load_map
-
-
-def _png_header_only(path, width: int, height: int):
-    """A PNG whose header declares width x height pixels, with almost no data."""
-
-    def chunk(kind: bytes, body: bytes) -> bytes:
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
-    path.write_bytes(
-        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(b"\0" * 100)) + chunk(b"IEND", b"")
-    )
-    return path
 
 
 def _map(folder, *, overflow: bool):
@@ -80,7 +65,7 @@ def _file_with_labels(tmp_path, labels_path, size=(40, 60)):
 
 
 def test_a_label_image_whose_header_claims_too_many_pixels_is_refused_by_name(tmp_path):
-    labels = _png_header_only(tmp_path / "metric.labels.png", 100_000, 100_000)
+    labels = png_header_only(tmp_path / "metric.labels.png", 100_000, 100_000)
     source = _file_with_labels(tmp_path, labels)
     with pytest.raises(SegmentationError, match="max_pixels") as raised:
         export_file(source, tmp_path / "out.geojson")

@@ -4,31 +4,19 @@ reading: a header declaring too many pixels, a cut file or a FIFO is a Segmentat
 from __future__ import annotations
 
 import os
-import struct
-import zlib
 
 import cv2
 import numpy as np
 import pytest
+from image_files import png_header_only
 
 from ursim_core.errors import SegmentationError
 from ursim_core.segmentation import Segmentation, load_label_image, read_label_array, save_label_image
 from ursim_core.segmentation.regions import region_table
 
 
-def _png_header_only(path, width: int, height: int):
-    def chunk(kind: bytes, body: bytes) -> bytes:
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
-    path.write_bytes(
-        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(b"\0" * 100)) + chunk(b"IEND", b"")
-    )
-    return path
-
-
 def test_a_header_claiming_too_many_pixels_is_refused_before_decoding(tmp_path):
-    path = _png_header_only(tmp_path / "huge.png", 100_000, 100_000)
+    path = png_header_only(tmp_path / "huge.png", 100_000, 100_000)
     with pytest.raises(SegmentationError, match="max_pixels") as raised:
         read_label_array(path)
     assert raised.value.path == path
