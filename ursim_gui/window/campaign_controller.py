@@ -188,12 +188,8 @@ class CampaignController(QObject):
             self.pair_ready.emit(index)
             return True
         self._awaiting_match = index
-        panel, jobs = window.segmentation_panel, window.jobs
-        for side in ("sketch", "metric"):
-            if session.segmentation(side) is None:
-                box = panel.boxes[side]
-                jobs.segment(side, box.preset.currentText(), box.overrides())
-        jobs.match(window.matching_panel.config())
+        window.documents.segment_unsegmented()
+        window.jobs.match(window.matching_panel.config())
         return True
 
     def _read_neighbours_ahead(self, index: int) -> None:

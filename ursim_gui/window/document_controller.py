@@ -121,16 +121,14 @@ class DocumentController(QObject):
         if path is None or not self._try("Cannot open the correspondences", self.session.open, path):
             return False
         self._remember(path)
-        self._segment_what_the_file_does_not_say()
+        self.segment_unsegmented()
         return True
 
-    def _segment_what_the_file_does_not_say(self) -> None:
-        """A file that records no segmentation of a map (ground truth clicked elsewhere, a
-        generated example) gets it from the segmentation panel's preset, as a campaign's new pair
-        does: without regions its clicked points show as nothing and it cannot be matched."""
-        panel, jobs = getattr(self.window, "segmentation_panel", None), getattr(self.window, "jobs", None)
-        if panel is None or jobs is None:
-            return
+    def segment_unsegmented(self) -> None:
+        """Queue the segmentation of each map shown without one, with the segmentation panel's
+        preset: a campaign's new pair, and a file that records no segmentation (ground truth
+        clicked elsewhere, a generated example), whose points would otherwise show as nothing."""
+        panel, jobs = self.window.segmentation_panel, self.window.jobs
         for side in ("sketch", "metric"):
             if self.session.map(side) is not None and self.session.segmentation(side) is None:
                 box = panel.boxes[side]
