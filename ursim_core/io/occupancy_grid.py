@@ -28,6 +28,7 @@ import numpy as np
 
 from ursim_core.errors import MapError, ParameterError
 from ursim_core.io.maps import OCCUPANCY_FREE, OCCUPANCY_OCCUPIED, OCCUPANCY_UNKNOWN, Map
+from ursim_core.io.ros_yaml import world_extent_problem
 
 __all__ = [
     "OccupancyGrid",
@@ -94,6 +95,9 @@ class OccupancyGrid:
         if len(origin) != 3 or not all(math.isfinite(value) for value in origin):
             raise MapError(f"origin must be (x, y, yaw), three finite numbers, got {self.origin!r}", field="origin")
         object.__setattr__(self, "origin", origin)
+        extent_problem = world_extent_problem(self.resolution, origin, (height, width))
+        if extent_problem is not None:
+            raise MapError(f"OccupancyGrid: {extent_problem[1]}", field=extent_problem[0])
 
     def cells(self) -> np.ndarray:
         """The cells as an image: shape (height, width), row 0 at the *top* (rows flipped)."""

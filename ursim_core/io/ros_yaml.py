@@ -87,6 +87,9 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
         pixels = decode_image(data, image_path, max_pixels=max_pixels, apply_exif_orientation=False)
     except MapError as error:
         raise MapError(f"cannot load the image {shown}: {error.problem}", path=yaml_path, field="image") from error
+    extent_problem = world_extent_problem(settings["resolution"], settings["origin"], pixels.colour.shape[:2])
+    if extent_problem is not None:
+        raise MapError(extent_problem[1], path=yaml_path, field=extent_problem[0])
 
     occupancy = _nav2_occupancy(
         pixels,
@@ -115,6 +118,49 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
         sha256=hashlib.sha256(data).hexdigest(),
         resolution=settings["resolution"],
         origin=settings["origin"],
+    )
+
+
+#: Farthest, in metres, a map's corner may lie from the world's origin: a hundred million
+#: kilometres, far beyond any map a robot makes (UTM northings are under 1e7 m), and far below
+#: where the pixel <-> world conversions and their exports would overflow to infinity or NaN.
+MAX_WORLD_EXTENT = 1e11
+
+
+def world_extent_problem(
+    resolution: float, origin: tuple[float, float, float], shape: tuple[int, int]
+) -> tuple[str, str] | None:
+    """``(field, problem)`` when a map of ``shape`` pixels at ``resolution`` metres a pixel and
+    ``origin`` (x, y, yaw) would have a corner farther than :data:`MAX_WORLD_EXTENT` from the
+    world's origin, else None.
+
+    Each number of a YAML file can be finite while their product is not (``resolution: 1e306``
+    on a 1000-pixel image): refused when the map is loaded, rather than as NaN in a goal or an
+    export later.
+
+    Examples
+    --------
+    >>> world_extent_problem(0.05, (-10.0, -5.0, 0.0), (400, 600)) is None
+    True
+    >>> world_extent_problem(1e306, (0.0, 0.0, 0.0), (400, 600))[0]
+    'resolution'
+    """
+    x0, y0, yaw = origin
+    rows, cols = shape
+    cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
+    farthest = 0.0
+    for frame_x in (0.0, resolution * cols):
+        for frame_y in (0.0, resolution * rows):
+            x = x0 + cos_yaw * frame_x - sin_yaw * frame_y
+            y = y0 + sin_yaw * frame_x + cos_yaw * frame_y
+            farthest = max(farthest, abs(x), abs(y)) if math.isfinite(x) and math.isfinite(y) else math.inf
+    if farthest <= MAX_WORLD_EXTENT:
+        return None
+    field = "origin" if max(abs(x0), abs(y0)) > MAX_WORLD_EXTENT / 2 else "resolution"
+    shown = "beyond any floating-point number" if math.isinf(farthest) else f"{farthest:.3g} m"
+    return field, (
+        f"resolution {resolution:g} m/pixel on {cols}x{rows} pixels from origin ({x0:g}, {y0:g}) puts the "
+        f"map's far corner {shown} from the world origin (at most {MAX_WORLD_EXTENT:.0e} m)"
     )
 
 

@@ -74,3 +74,9 @@ def test_cell_zero_lies_at_the_origin_in_world_coordinates():
 def test_bad_grids_raise_map_error(problem, call):
     with pytest.raises(MapError, match=problem):
         call()
+
+
+def test_a_grid_whose_corners_overflow_is_refused():
+    with pytest.raises(MapError, match="from the world origin") as raised:
+        OccupancyGrid(data=[0] * 4, width=2, height=2, resolution=1e306, origin=(1.7e308, 0.0, 0.0))
+    assert raised.value.field == "origin"

@@ -273,6 +273,30 @@ def test_huge_yaml_numbers_are_map_errors(tmp_path, text, field):
         assert f"field '{field}'" in message
 
 
+@pytest.mark.parametrize(
+    ("numbers", "field"),
+    [
+        # Each number finite, the far corner not: 1e306 m a pixel x 8 pixels, or past the origin.
+        ("resolution: 1.0e+306\norigin: [0, 0, 0]", "resolution"),
+        ("resolution: 1.0e+306\norigin: [1.7e+308, 1.7e+308, 0.0]", "origin"),
+        ("resolution: 0.05\norigin: [1.0e+12, 0, 0]", "origin"),
+        ("resolution: 2.0e+10\norigin: [0, 0, 0.7]", "resolution"),
+    ],
+)
+def test_a_georeference_whose_corners_overflow_is_refused_when_loaded(tmp_path, numbers, field):
+    _png(tmp_path)
+    message = _refused(_yaml(tmp_path, f"image: room.png\n{numbers}\n"), "from the world origin")
+    assert f"field '{field}'" in message
+
+
+def test_a_georeference_far_but_within_the_bound_loads(tmp_path):
+    _png(tmp_path)
+    # UTM-like coordinates: millions of metres from the world's origin.
+    the_map = load_map(_yaml(tmp_path, "image: room.png\nresolution: 0.05\norigin: [654321.5, 5432109.25, 1.2]\n"))
+    x, y = pixel_to_world(the_map, 0, 0)
+    assert abs(x - 654321.5) < 1 and abs(y - 5432109.25) < 1
+
+
 def test_nul_in_the_yaml_image_is_a_map_error(tmp_path):
     _refused(_yaml(tmp_path, 'image: "room\\0.png"\nresolution: 0.05\norigin: [0, 0, 0]\n'), "image")
 
