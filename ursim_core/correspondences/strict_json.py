@@ -1,38 +1,33 @@
-"""Strict JSON reading for URSIM's files: what :func:`json.loads` lets through, refused by name.
+"""Strict JSON reading of correspondence files, with the field's path in every refusal.
 
-``json.loads`` keeps the last of two equal keys, accepts ``NaN`` and ``Infinity``, turns
-``1e999`` into infinity and raises a bare ``ValueError`` for an integer of thousands of digits.
-A hand-edited file would then load with data silently lost or load and fail to save.
-:func:`parse_json_object` refuses each with a :class:`~ursim_core.errors.FormatError` naming the
-file; :func:`check_values` refuses numbers out of range and nesting too deep for the steps after
-parsing, with the field's path.
+:func:`parse_json_object` reads through :func:`ursim_core.io.reading.parse_json` (duplicate
+keys, ``NaN``, nesting that would crash ``json.loads`` refused, naming the file), keeping numbers
+out of range as placeholders; :func:`check_values` then refuses those placeholders and nesting
+too deep, naming the field (``extra.long``), in what the schema does not look at.
 """
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 from typing import Any
 
 from ursim_core.correspondences.schema import OutOfRange, field_path, json_type
 from ursim_core.errors import FormatError
+from ursim_core.io.reading import MAX_JSON_DEPTH, parse_json
 
 __all__ = ["MAX_DEPTH", "parse_json_object", "check_values"]
 
 
-# Deeper than any file URSIM writes (6 levels) by far, shallow enough for every recursive
-# step after parsing (schema, encoder) to stay far from Python's recursion limit.
-MAX_DEPTH = 64
-# 4300 is Python's own limit for int(str); anything this long is garbage for URSIM anyway.
-_MAX_INT_DIGITS = 4000
+MAX_DEPTH = MAX_JSON_DEPTH
+_WHAT = "correspondence file"
 
 
 def parse_json_object(raw: bytes, path: Path) -> dict:
     """The JSON object in ``raw`` (UTF-8, a byte-order mark allowed), or a
-    :class:`~ursim_core.errors.FormatError` naming ``path`` and what is wrong.
+    :class:`~ursim_core.errors.FormatError` naming ``path`` and what is wrong
+    (:func:`ursim_core.io.reading.parse_json`, the project's one strict JSON reader).
 
-    Numbers out of range (``1e999``, integers of more than 4000 digits) parse to
+    Numbers out of range (``1e999``, integers too long for ``int()``) parse to
     :class:`~ursim_core.correspondences.schema.OutOfRange` placeholders, which
     :func:`check_values` or the schema refuse with the field's path.
 
@@ -43,43 +38,12 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
     >>> parse_json_object(b'{"a": 1, "a": 2}', Path("x.json"))
     Traceback (most recent call last):
     ...
-    ursim_core.errors.FormatError: x.json: not valid JSON for URSIM: key 'a' appears twice in one object
+    ursim_core.errors.FormatError: x.json: not JSON for a correspondence file: key 'a' appears twice in one object
     """
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        raise FormatError(f"not UTF-8 text (byte {error.start}): not a JSON file", path=path) from None
-    hooks = {"object_pairs_hook": _reject_duplicate_keys, "parse_constant": _reject_constant}
-    try:
-        try:
-            document = json.loads(text, parse_float=_parse_float, **hooks)
-        except ValueError as error:
-            if isinstance(error, json.JSONDecodeError) or "digits" not in str(error):
-                raise
-            # An integer too long for int(): parse again, keeping it as a value with a place.
-            document = json.loads(text, parse_float=_parse_float, parse_int=_parse_int, **hooks)
-    except json.JSONDecodeError as error:
-        raise FormatError(
-            f"not valid JSON: {error.msg} at line {error.lineno}, column {error.colno}", path=path
-        ) from None
-    except _InvalidJsonValue as error:
-        raise FormatError(f"not valid JSON for URSIM: {error}", path=path) from None
-    except RecursionError:
-        raise FormatError(
-            f"nested deeper than {MAX_DEPTH} levels (arrays or objects inside each other)", path=path
-        ) from None
+    document = parse_json(raw, path, error=FormatError, what=_WHAT, max_depth=None, out_of_range=OutOfRange)
     if not isinstance(document, dict):
         raise FormatError(f"expected a JSON object at the top level, got {json_type(document)}", path=path)
     return document
-
-
-def _parse_float(text: str):
-    value = float(text)
-    return value if math.isfinite(value) else OutOfRange(text)
-
-
-def _parse_int(text: str):
-    return OutOfRange(text) if len(text) > _MAX_INT_DIGITS else int(text)
 
 
 def check_values(document: dict, path: Path, *, known_clique_keys: frozenset = frozenset()) -> None:
@@ -112,25 +76,3 @@ def check_values(document: dict, path: Path, *, known_clique_keys: frozenset = f
                 )
             items = value.items() if isinstance(value, dict) else enumerate(value)
             stack.extend((item, (*where, key), depth + 1) for key, item in items)
-
-
-class _InvalidJsonValue(ValueError):
-    pass
-
-
-def _reject_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict:
-    # json.loads silently keeps the last of two equal keys; a hand-edited file
-    # would lose data without notice.
-    result = dict(pairs)
-    if len(result) != len(pairs):
-        seen: set[str] = set()
-        for key, _ in pairs:
-            if key in seen:
-                shown = repr(key) if len(key) <= 60 else repr(key[:57]) + "..."
-                raise _InvalidJsonValue(f"key {shown} appears twice in one object")
-            seen.add(key)
-    return result
-
-
-def _reject_constant(name: str) -> Any:
-    raise _InvalidJsonValue(f"{name} is not a JSON number")

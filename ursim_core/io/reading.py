@@ -20,7 +20,9 @@ from __future__ import annotations
 import errno
 import os
 import stat
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ursim_core.errors import UrsimError
 
@@ -197,12 +199,13 @@ def _check_size(size: int, path: Path, *, max_bytes: int, error, what: str, limi
 
 
 # Deeper than any JSON file the project reads by far (a points list is 2 levels, a merge model
-# 4), shallow enough that no recursive step after parsing (validation, json.dumps on the next
-# save) comes near Python's recursion limit.
+# 4, a correspondence file 6), shallow enough that no recursive step after parsing (validation,
+# json.dumps on the next save) comes near Python's recursion limit.
 MAX_JSON_DEPTH = 64
 # The most digits an integer may have and still convert to a float (10**308 < 1.8e308):
-# every number the project reads ends up as one, and int() refuses more than 4300 digits.
+# every number the project reads ends up as one.
 _MAX_INT_DIGITS = 308
+_LARGEST_FLOAT_INT = int(1.7976931348623157e308)
 
 
 def decode_text(raw: bytes, path: Path, *, error: type[UrsimError], what: str) -> str:
@@ -225,33 +228,48 @@ class _JsonRefused(ValueError):
     """A JSON value the project refuses (its text says why); a ValueError so json stops parsing."""
 
 
-def _parse_int(text: str) -> int:
-    digits = len(text.lstrip("-"))
-    if digits > _MAX_INT_DIGITS:
-        raise _JsonRefused(f"an integer of {digits} digits is too large (at most {_MAX_INT_DIGITS})")
-    return int(text)
-
-
-def _parse_float(text: str) -> float:
-    value = float(text)
-    if value in (float("inf"), float("-inf")):
-        shown = text if len(text) <= 40 else text[:37] + "..."
-        raise _JsonRefused(f"the number {shown} is out of range")
-    return value
+def _refuse_out_of_range(text: str):
+    if text.lstrip("-").isdigit():
+        raise _JsonRefused(f"an integer of {len(text.lstrip('-'))} digits is too large (at most {_MAX_INT_DIGITS})")
+    shown = text if len(text) <= 40 else text[:37] + "..."
+    raise _JsonRefused(f"the number {shown} is out of range")
 
 
 def _refuse_constant(name: str):
     raise _JsonRefused(f"{name} is not a JSON number")
 
 
-def parse_json(data: bytes | str, path: Path, *, error: type[UrsimError], what: str, max_depth: int = MAX_JSON_DEPTH):
+def _refuse_duplicate_keys(pairs: list) -> dict:
+    # json.loads keeps the last of two equal keys: a hand-edited file would lose data unseen.
+    result = dict(pairs)
+    if len(result) != len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                shown = repr(key) if len(key) <= 60 else repr(key[:57]) + "..."
+                raise _JsonRefused(f"key {shown} appears twice in one object")
+            seen.add(key)
+    return result
+
+
+def parse_json(
+    data: bytes | str,
+    path: Path,
+    *,
+    error: type[UrsimError],
+    what: str,
+    max_depth: int | None = MAX_JSON_DEPTH,
+    out_of_range: Callable[[str], Any] | None = None,
+):
     """The JSON document in ``data``, or ``error`` naming ``path`` and what is wrong.
 
-    ``json.loads`` alone raises ``RecursionError`` for arrays nested a few thousand deep,
-    ``ValueError`` for an integer of more than 4300 digits, and lets through ``NaN``,
-    ``Infinity``, ``1e999`` and integers too large for a float (``OverflowError`` at the
-    first ``float()``). Each of these is refused here, as is nesting deeper than
-    ``max_depth``, so whatever is returned can be used and written again.
+    ``json.loads`` alone keeps the last of two equal keys, raises ``RecursionError`` for
+    arrays nested a few thousand deep and ``ValueError`` for an integer of more than 4300
+    digits, and lets through ``NaN``, ``Infinity``, ``1e999`` and integers too large for a
+    float (``OverflowError`` at the first ``float()``). Each of these is refused here, as is
+    nesting deeper than ``max_depth``, so whatever is returned can be used and written again.
+    This is the one JSON reader of the project: points files, manifests, merge models and
+    correspondence files.
 
     Parameters
     ----------
@@ -263,8 +281,14 @@ def parse_json(data: bytes | str, path: Path, *, error: type[UrsimError], what: 
         Raised for every problem, with ``path=path``.
     what : str
         What the file should be, for the messages ("points file").
-    max_depth : int, optional
-        Most levels of arrays and objects inside each other.
+    max_depth : int or None, optional
+        Most levels of arrays and objects inside each other; None leaves the depth and the
+        integers' size to the caller, which walks the document anyway (the correspondence
+        codec, to name the field).
+    out_of_range : callable, optional
+        Given the text of a number that is not a finite float (``1e999``) or an integer too
+        long for ``int()``, returns the value to keep in its place: a placeholder the caller
+        refuses later with the field's path. By default such numbers are refused here.
 
     Examples
     --------
@@ -275,27 +299,55 @@ def parse_json(data: bytes | str, path: Path, *, error: type[UrsimError], what: 
     Traceback (most recent call last):
     ...
     ursim_core.errors.FormatError: p.json: not JSON for a points file: the number 1e999 is out of range
+    >>> parse_json('{"a": 1, "a": 2}', Path("p.json"), error=FormatError, what="points file")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.FormatError: p.json: not JSON for a points file: key 'a' appears twice in one object
     """
     import json
 
     text = decode_text(data, path, error=error, what=what) if isinstance(data, (bytes, bytearray)) else data
     if text.startswith("\ufeff"):
         text = text[1:]
+    keep = out_of_range or _refuse_out_of_range
+
+    def parse_float(number: str):
+        value = float(number)
+        return value if value not in (_INF, -_INF) else keep(number)
+
+    hooks = {"object_pairs_hook": _refuse_duplicate_keys, "parse_constant": _refuse_constant}
     try:
-        document = json.loads(text, parse_int=_parse_int, parse_float=_parse_float, parse_constant=_refuse_constant)
+        try:
+            document = json.loads(text, parse_float=parse_float, **hooks)
+        except ValueError as problem:
+            if isinstance(problem, (json.JSONDecodeError, _JsonRefused)) or "digits" not in str(problem):
+                raise
+
+            # An integer too long for int() (rare): parse again, each integer through Python.
+            def parse_int(number: str):
+                try:
+                    return int(number)
+                except ValueError:
+                    return keep(number)
+
+            document = json.loads(text, parse_float=parse_float, parse_int=parse_int, **hooks)
     except json.JSONDecodeError as problem:
         raise error(f"not JSON: {problem.msg} (line {problem.lineno}, column {problem.colno})", path=path) from None
-    except _JsonRefused as problem:
-        raise error(f"not JSON for a {what}: {problem}", path=path) from None
     except RecursionError:
-        raise error(f"not JSON for a {what}: nested deeper than {max_depth} levels", path=path) from None
+        raise error(
+            f"not JSON for a {what}: nested deeper than {max_depth or MAX_JSON_DEPTH} levels", path=path
+        ) from None
     except (ValueError, OverflowError) as problem:
         raise error(f"not JSON for a {what}: {problem}", path=path) from None
-    _check_depth(document, path, error=error, what=what, max_depth=max_depth)
+    if max_depth is not None:
+        _check_depth_and_integers(document, path, error=error, what=what, max_depth=max_depth)
     return document
 
 
-def _check_depth(document, path: Path, *, error, what: str, max_depth: int) -> None:
+_INF = float("inf")
+
+
+def _check_depth_and_integers(document, path: Path, *, error, what: str, max_depth: int) -> None:
     # An explicit stack: a check of depth must not itself recurse.
     stack = [(document, 1)]
     while stack:
@@ -304,6 +356,12 @@ def _check_depth(document, path: Path, *, error, what: str, max_depth: int) -> N
             if depth > max_depth:
                 raise error(f"not JSON for a {what}: nested deeper than {max_depth} levels", path=path)
             stack.extend((item, depth + 1) for item in (value.values() if isinstance(value, dict) else value))
+        elif type(value) is int and not -_LARGEST_FLOAT_INT <= value <= _LARGEST_FLOAT_INT:
+            digits = len(str(abs(value)))
+            raise error(
+                f"not JSON for a {what}: an integer of {digits} digits is too large (at most {_MAX_INT_DIGITS})",
+                path=path,
+            )
 
 
 def read_json_file(path: Path, *, max_bytes: int, error: type[UrsimError], what: str, max_depth: int = MAX_JSON_DEPTH):

@@ -32,6 +32,9 @@ def _parse(text):
         ("[NaN]", "NaN is not a JSON number"),
         ("[-Infinity]", "-Infinity is not a JSON number"),
         ("[1, 2", "not JSON"),
+        # json.loads would keep the second value and lose the first without a word.
+        ('{"points": [[1, 2]], "points": []}', "key 'points' appears twice in one object"),
+        ('[{"a": {"b": 1, "b": 1}}]', "key 'b' appears twice"),
     ],
 )
 def test_bad_json_is_one_error_naming_the_file(text, problem):
