@@ -19,13 +19,13 @@ type) is ``clique.extra["label"]`` and is carried into every format.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ursim_core.correspondences.json_text import NON_FINITE_CAUSE, finite_json
 from ursim_core.errors import FormatError, ParameterError
 from ursim_core.io.atomic import atomic_write_text
 
@@ -41,11 +41,7 @@ __all__ = [
     "export_correspondences",
     "export_format_of",
     "export_file",
-    "finite_json",
 ]
-
-#: Why an exported number can be NaN or infinite (refused when written: JSON and QGIS have none).
-_NON_FINITE_CAUSE = "a map's origin or resolution too large for its coordinates gives them"
 
 #: Formats of :func:`export_correspondences`, by name.
 EXPORT_FORMATS = ("geojson", "labelme", "qgis-points")
@@ -239,9 +235,10 @@ def correspondences_to_geojson(corr, *, side: str = "metric", labels=None, the_m
 
 
 def correspondences_to_labelme(
-    corr, *, side: str = "sketch", labels=None, image_path: str | None = None, image_size=None
+    corr, *, side: str = "metric", labels=None, image_path: str | None = None, image_size=None
 ) -> dict[str, Any]:
-    """A labelme annotation of one side: a point shape per clique point, a polygon per region.
+    """A labelme annotation of one side (the metric map's by default, as every export): a point
+    shape per clique point, a polygon per region.
 
     Shapes of one clique share its id as ``group_id``; their ``label`` is the clique's semantic
     label, else ``"clique N"``. Region polygons are labelled ``"region N"`` (with the clique's
@@ -251,7 +248,7 @@ def correspondences_to_labelme(
     --------
     >>> from ursim_core.correspondences import Clique, Correspondences
     >>> corr = Correspondences(cliques=(Clique(id=2, sketch_points=[(10, 4)]),))
-    >>> shape = correspondences_to_labelme(corr, image_size=(20, 30))["shapes"][0]
+    >>> shape = correspondences_to_labelme(corr, side="sketch", image_size=(20, 30))["shapes"][0]
     >>> shape["label"], shape["points"], shape["group_id"], shape["shape_type"]
     ('clique 2', [[4.5, 10.5]], 2, 'point')
     """
@@ -333,7 +330,7 @@ def correspondences_to_qgis_points(corr, *, metric_map=None, crs_wkt: str = "") 
         values = [map_x, map_y, sketch_col + 0.5, -(sketch_row + 0.5)]
         for name, value in zip(("mapX", "mapY", "sourceX", "sourceY"), values):
             if not math.isfinite(value):  # "nan" would not read back as a coordinate in QGIS
-                problem = f"{name} of clique {clique.id} is not a finite number ({float(value)!r}; {_NON_FINITE_CAUSE})"
+                problem = f"{name} of clique {clique.id} is not a finite number ({float(value)!r}; {NON_FINITE_CAUSE})"
                 raise FormatError(f"cannot be written: {problem}")
         lines.append(",".join(_number(v) for v in values) + ",1,0,0,0")
     return "\n".join(lines) + "\n"
@@ -394,43 +391,6 @@ def export_correspondences(
     return kind
 
 
-def finite_json(document: Any, path: str | Path, *, indent: int | None = None) -> str:
-    """``json.dumps(document, indent=indent)``; NaN or infinity (JSON has none) is a FormatError
-    naming ``path`` (the file it is for) and the first field holding one.
-
-    Examples
-    --------
-    >>> finite_json({"x": [1.5]}, "a.json")
-    '{"x": [1.5]}'
-    >>> finite_json({"pose": {"x": float("nan")}}, "a.json")
-    Traceback (most recent call last):
-    ...
-    ursim_core.errors.FormatError: a.json: field 'pose.x': cannot be written as JSON: nan is not ...
-    """
-    try:
-        return json.dumps(document, indent=indent, allow_nan=False)
-    except ValueError as error:
-        from ursim_core.correspondences.schema import field_path
-
-        found = _non_finite(document)  # json.dumps says only "Out of range float values..."
-        if found is None:
-            raise FormatError(f"cannot be written as JSON: {error}", path=path) from None
-        problem = f"cannot be written as JSON: {found[1]!r} is not a finite number (JSON has none; {_NON_FINITE_CAUSE})"
-        raise FormatError(problem, path=path, field=field_path(found[0]) or "(the document)") from None
-
-
-def _non_finite(value: Any, where: tuple = ()) -> tuple[tuple, float] | None:
-    """``(location, value)`` of the first float in ``value`` that is NaN or infinite, or None."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return where, value
-    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, (list, tuple)) else ()
-    for key, item in items:
-        found = _non_finite(item, (*where, key))
-        if found is not None:
-            return found
-    return None
-
-
 def export_file(
     source: str | Path,
     target: str | Path,
@@ -486,25 +446,20 @@ def _georeferenced_map(path: Path | None):
 
 
 def _read_labels(path: Path, size) -> np.ndarray | None:
-    """The single-channel label image at ``path`` (None when there is no file), which must be ``size``.
-
-    Read as ``label_files.read_label_array`` reads it (a sibling layer, not importable here):
-    :func:`ursim_core.io.unchanged.read_unchanged`, guarded.
-    """
+    """The label image at ``path`` as the app and the loaders read it (None when there is no
+    file), which must be ``size``."""
     from ursim_core.errors import SegmentationError
     from ursim_core.io.maps import DEFAULT_MAX_PIXELS
-    from ursim_core.io.unchanged import read_unchanged
+    from ursim_core.io.unchanged import read_label_array
 
     path = Path(path)
     if not path.is_file():
         return None
     # A map loaded with a higher limit than the default has label images as large as itself.
     limit = DEFAULT_MAX_PIXELS if size is None else max(DEFAULT_MAX_PIXELS, int(size[0]) * int(size[1]))
-    labels = read_unchanged(path, max_pixels=limit, error=SegmentationError)
-    if labels is None or labels.ndim != 2:
-        raise SegmentationError("not a single-channel label image", path=path)
+    labels = read_label_array(path, max_pixels=limit)
     if size is not None and tuple(labels.shape) != tuple(size):
         raise SegmentationError(
             f"label image is {labels.shape[0]}x{labels.shape[1]} but the map is {size[0]}x{size[1]}", path=path
         )
-    return labels.astype(np.int32)
+    return labels

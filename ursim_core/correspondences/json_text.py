@@ -3,7 +3,8 @@
 :func:`cliques_text` writes the ``"cliques"`` member, nearly all of a big file, byte for byte
 as ``json.dumps(indent=2, ensure_ascii=False)`` followed by :func:`collapse_number_lists` would,
 about ten times faster (a fuzz test compares the two). :func:`escape_lone_surrogates` writes
-the strings UTF-8 cannot hold as ``\\uXXXX`` escapes.
+the strings UTF-8 cannot hold as ``\\uXXXX`` escapes. :func:`finite_json` is ``json.dumps`` for
+the exports and goals, refusing NaN and infinity by field.
 """
 
 from __future__ import annotations
@@ -12,10 +13,24 @@ import json
 import math
 import re
 from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
+from ursim_core.correspondences.schema import field_path
 from ursim_core.correspondences.values import Clique
+from ursim_core.errors import FormatError
 
-__all__ = ["EMPTY_CLIQUES", "cliques_text", "collapse_number_lists", "escape_lone_surrogates"]
+__all__ = [
+    "EMPTY_CLIQUES",
+    "NON_FINITE_CAUSE",
+    "cliques_text",
+    "collapse_number_lists",
+    "escape_lone_surrogates",
+    "finite_json",
+]
+
+#: Why an exported number can be NaN or infinite (refused when written: JSON and QGIS have none).
+NON_FINITE_CAUSE = "a map's origin or resolution too large for its coordinates gives them"
 
 # json.dumps(indent=2) writes the top-level key at two spaces; strings hold no raw newline,
 # so this text occurs once, where the cliques go.
@@ -93,3 +108,38 @@ _NUMBER_LIST = re.compile(r"\[\n\s*(" + _NUMBER + r"(?:,\n\s*" + _NUMBER + r")*)
 def collapse_number_lists(text: str) -> str:
     # [row, col] points and region lists on one line each: a file a person can read.
     return _NUMBER_LIST.sub(lambda match: "[" + ", ".join(re.split(r",\n\s*", match.group(1))) + "]", text)
+
+
+def finite_json(document: Any, path: str | Path, *, indent: int | None = None) -> str:
+    """``json.dumps(document, indent=indent)``; NaN or infinity (JSON has none) is a FormatError
+    naming ``path`` (the file it is for) and the first field holding one.
+
+    Examples
+    --------
+    >>> finite_json({"x": [1.5]}, "a.json")
+    '{"x": [1.5]}'
+    >>> finite_json({"pose": {"x": float("nan")}}, "a.json")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.FormatError: a.json: field 'pose.x': cannot be written as JSON: nan is not ...
+    """
+    try:
+        return json.dumps(document, indent=indent, allow_nan=False)
+    except ValueError as error:
+        found = _non_finite(document)  # json.dumps says only "Out of range float values..."
+        if found is None:
+            raise FormatError(f"cannot be written as JSON: {error}", path=path) from None
+        problem = f"cannot be written as JSON: {found[1]!r} is not a finite number (JSON has none; {NON_FINITE_CAUSE})"
+        raise FormatError(problem, path=path, field=field_path(found[0]) or "(the document)") from None
+
+
+def _non_finite(value: Any, where: tuple = ()) -> tuple[tuple, float] | None:
+    """``(location, value)`` of the first float in ``value`` that is NaN or infinite, or None."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return where, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, (list, tuple)) else ()
+    for key, item in items:
+        found = _non_finite(item, (*where, key))
+        if found is not None:
+            return found
+    return None

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["read_unchanged"]
+__all__ = ["read_unchanged", "read_label_array"]
 
 
 def read_unchanged(path: str | Path, *, max_pixels: int | None = None, error=None) -> np.ndarray | None:
@@ -93,3 +93,32 @@ def _png_chunks_intact(data: bytes) -> bool:
             return True
         position = end + 4
     return False
+
+
+def read_label_array(path: str | Path, *, max_pixels: int | None = None) -> np.ndarray:
+    """Read a label image file as an int32 array of the stored ids (0 = no region).
+
+    Accepts 8- or 16-bit single-channel images, and colour images whose channels are equal.
+    Raises :class:`~ursim_core.errors.SegmentationError` naming the file otherwise, or when the
+    file is not a regular file, is cut, or declares more than ``max_pixels`` pixels in its header
+    (checked before decoding, :func:`ursim_core.io.unchanged.read_unchanged`; default
+    :data:`~ursim_core.io.maps.DEFAULT_MAX_PIXELS`, the map loader's).
+    """
+    from ursim_core.errors import SegmentationError
+
+    path = Path(path)
+    if not path.exists():
+        raise SegmentationError("label image not found", path=path)
+    labels = read_unchanged(path, max_pixels=max_pixels, error=SegmentationError)
+    if labels is None:
+        raise SegmentationError("not a readable image", path=path)
+    if labels.ndim == 3:
+        channels = labels[..., :3]
+        if not (
+            np.array_equal(channels[..., 0], channels[..., 1]) and np.array_equal(channels[..., 0], channels[..., 2])
+        ):
+            raise SegmentationError("a label image must have one channel (grey, 8 or 16 bit), got colour", path=path)
+        labels = channels[..., 0]
+    if labels.dtype not in (np.uint8, np.uint16):
+        raise SegmentationError(f"a label image must be 8 or 16 bit, got {labels.dtype}", path=path)
+    return labels.astype(np.int32)

@@ -150,3 +150,16 @@ def test_export_file_uses_the_referenced_labels_and_yaml_map(tmp_path):
     the_map = load_map(tmp_path / "metric.yaml")
     x, y = pixel_to_world(the_map, 4, 4)
     assert (tmp_path / "out.points").read_text().splitlines()[2].startswith(f"{x:g},{y:g},")
+
+
+def test_every_export_of_one_side_defaults_to_the_metric_map(tmp_path):
+    # correspondences_to_labelme defaulted to the sketch while the GeoJSON and the file export
+    # defaulted to the metric map: one call gave the other side's points of another.
+    from ursim_core.correspondences.exporters import export_correspondences
+
+    corr = sample_corr()
+    points = [s["points"] for s in correspondences_to_labelme(corr)["shapes"] if s["shape_type"] == "point"]
+    # The three metric points, labelme's (x, y) = (col + 0.5, row + 0.5); the sketch has four.
+    assert points == [[[4.5, 4.5]], [[20.5, 10.5]], [[25.5, 15.5]]]
+    export_correspondences(corr, tmp_path / "out.labelme.json")
+    assert json.loads((tmp_path / "out.labelme.json").read_text()) == correspondences_to_labelme(corr)

@@ -9,20 +9,26 @@ import pytest
 from image_files import png_header_only
 
 from ursim_core.correspondences import Clique, Correspondences, MapRef, save_correspondences
-from ursim_core.correspondences.exporters import export_correspondences, export_file, finite_json
+from ursim_core.correspondences.exporters import export_correspondences, export_file
+from ursim_core.correspondences.json_text import finite_json
 from ursim_core.errors import FormatError, SegmentationError
-from ursim_core.io.maps import load_map
+from ursim_core.io.maps import Map, load_map
 
 
-def _map(folder, *, overflow: bool):
+def _map(folder):
     image = np.zeros((40, 60), np.uint8)
     image[5:35, 5:55] = 255
     cv2.imwrite(str(folder / "map.png"), image)
-    numbers = (
-        "resolution: 1.0e+306\norigin: [1.7e+308, 1.7e+308, 0.0]" if overflow else "resolution: 0.05\norigin: [0, 0, 0]"
-    )
-    (folder / "map.yaml").write_text(f"image: map.png\n{numbers}\n")
+    (folder / "map.yaml").write_text("image: map.png\nresolution: 0.05\norigin: [0, 0, 0]\n")
     return folder / "map.yaml"
+
+
+def _overflowing_map():
+    # The loaders refuse such a georeference (test_ros_yaml); a Map built in code can still hold
+    # one, and the writers are the last line.
+    free = np.zeros((40, 60), bool)
+    free[5:35, 5:55] = True
+    return Map(free=free, resolution=1.0e306, origin=(1.7e308, 1.7e308, 0.0))
 
 
 def _corr(sketch=None, metric=None):
@@ -42,7 +48,7 @@ def test_finite_json_names_the_first_field_that_is_not_a_number():
 
 @pytest.mark.parametrize("name", ["out.geojson", "out.points"])
 def test_an_export_whose_georeference_overflows_is_refused_and_not_written(tmp_path, name):
-    the_map = load_map(_map(tmp_path, overflow=True))
+    the_map = _overflowing_map()
     target = tmp_path / name
     with np.errstate(all="raise"), pytest.raises(FormatError, match="not a finite number") as raised:
         export_correspondences(_corr(), target, the_map=the_map, metric_map=the_map)
@@ -51,7 +57,7 @@ def test_an_export_whose_georeference_overflows_is_refused_and_not_written(tmp_p
 
 
 def test_a_sane_georeference_still_exports(tmp_path):
-    the_map = load_map(_map(tmp_path, overflow=False))
+    the_map = load_map(_map(tmp_path))
     export_correspondences(_corr(), tmp_path / "out.geojson", the_map=the_map, metric_map=the_map)
     export_correspondences(_corr(), tmp_path / "out.points", metric_map=the_map)
     assert "nan" not in (tmp_path / "out.points").read_text().lower()
@@ -90,3 +96,19 @@ def test_a_good_16_bit_label_image_is_exported_as_before(tmp_path):
     export_file(_file_with_labels(tmp_path, labels), tmp_path / "out.geojson")
     regions = (tmp_path / "out.geojson").read_text()
     assert '"region": 300' in regions and '"region": 7' in regions
+
+
+def test_a_label_image_the_app_reads_is_exported_too(tmp_path):
+    # A grey label image saved as RGB by another tool loads in the app (equal channels); the
+    # export read it with a reader of its own that refused it.
+    values = np.zeros((40, 60), np.uint8)
+    values[5:20, 5:30], values[20:35, 30:55] = 3, 7
+    labels = tmp_path / "metric.labels.png"
+    cv2.imwrite(str(labels), np.dstack([values] * 3))
+    export_file(_file_with_labels(tmp_path, labels), tmp_path / "out.geojson")
+    regions = (tmp_path / "out.geojson").read_text()
+    assert '"region": 3' in regions and '"region": 7' in regions
+    cv2.imwrite(str(labels), np.dstack([values, values, values + 1]))
+    with pytest.raises(SegmentationError, match="one channel") as raised:
+        export_file(_file_with_labels(tmp_path, labels), tmp_path / "other.geojson")
+    assert raised.value.path == labels and not (tmp_path / "other.geojson").exists()
