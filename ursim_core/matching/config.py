@@ -214,7 +214,10 @@ class MatchConfig:
         (4 quarter turns of the wall-angle difference) and keeps the lowest-scoring answer
         (:mod:`ursim_core.matching.orientation`). 'upright': drawn in the metric map's
         orientation. A number: the sketch is brought to the metric map by turning it that
-        many degrees counter-clockwise (after mirroring when ``mirrored``).
+        many degrees counter-clockwise (after mirroring when ``mirrored``). It undoes how the
+        sketch was drawn: a sketch drawn turned 90 degrees counter-clockwise from the map is
+        ``orientation=270`` (or ``-90``), the inverse of the turn that
+        :class:`ursim_core.evaluation.augment.Orientation` applies to an upright sketch.
     mirrored : bool or None
         Whether the sketch is a left-right mirror image of the map; None (default) = unknown,
         both are tried with ``orientation='any'`` (with 'upright' or a number, None = no). For
@@ -389,7 +392,9 @@ class MatchConfig:
         if self.input_kind not in (None, "sketch", "metric"):
             raise ParameterError(f"must be 'sketch', 'metric' or null, not {self.input_kind!r}", field="input_kind")
         if self.mirrored not in (None, True, False):
-            raise ParameterError(f"must be true, false or null, not {self.mirrored!r}", field="mirrored")
+            raise ParameterError(
+                f"must be True, False or None (true, false or null in JSON), not {self.mirrored!r}", field="mirrored"
+            )
         for name, smallest, wording in (
             ("position_refits", 0, "a non-negative integer"),
             ("vote_segmentations", 1, "a positive integer"),

@@ -17,8 +17,10 @@ evaluation protocol).
 
 Segmentation for matching: the evidence was gathered with MAORIS preset ``"default"`` (t = 0.25,
 doors 40; the parameters the KTH ground truth was clicked on) for both maps, binarised at > 250.
-The ``"sketch"`` preset (t = 0.30, doors 60) splits the sketches more and matched worse (paper T4,
-oracle m: 0.51 against 0.665 mean F1).
+The ``"sketch"`` preset (:func:`~ursim_core.segmentation.segment`'s default, chosen for
+segmentation quality; t = 0.30, doors 60 when this was measured) split the sketches more and
+matched worse (paper T4, oracle m: 0.51 against 0.665 mean F1). :func:`~ursim_core.matching.match_maps`
+segments two maps as the matcher expects before matching them.
 
 Degenerate inputs (an empty graph, a single region, no unique region, no anchor, no seed,
 disconnected graphs, constant attributes) never raise: the result is valid, possibly empty, and its
