@@ -112,3 +112,18 @@ def test_a_match_saves_as_a_correspondence_file_and_loads_back(tmp_path):
     assert record["config"]["orientation"] == "any" and record["orientation"]["degrees"] in (90.0, 270.0)
     relabelled = load_label_image(loaded.sketch.labels_path, shape=found.sketch_seg.labels.shape)
     assert np.array_equal(relabelled.labels, found.sketch_seg.labels)
+
+
+def test_a_configuration_is_built_without_importing_the_matcher():
+    # ``from ursim_core.matching import MatchConfig`` imported the pipeline, networkx and the
+    # matcher (379 ms, 582 modules) for a dataclass; a caller building options pays for them
+    # only when it matches.
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from ursim_core.matching import MatchConfig, MATCH_PRESETS; MatchConfig(orientation=90);"
+        "print('networkx' in sys.modules, 'ursim_core.matching.pipeline' in sys.modules)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.split() == ["False", "False"]
