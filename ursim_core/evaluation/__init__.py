@@ -49,6 +49,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "SCORING_MODES",
             "PlaceScore",
             "place_accuracy",
+            "PLACE_REFERENCE_PRESET",
         ],
         "ceiling": ["Ceiling", "best_one_to_one"],
         "match_scores": ["MatchScores", "score_against_reference"],
