@@ -26,6 +26,7 @@ __all__ = [
     "parse_param",
     "segmentation_params",
     "add_map_options",
+    "check_map_options",
     "load",
     "progress_bar",
     "announce_kernel_compilation",
@@ -81,6 +82,23 @@ def add_map_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--max-pixels", type=int, default=64_000_000, help="refuse maps larger than this (default 64 Mpx)"
     )
+
+
+def check_map_options(args: argparse.Namespace) -> None:
+    """Refuse, before any work, a ``--threshold`` outside 0..255 or a ``--max-pixels`` below 1.
+
+    The rules are the map loader's (:func:`ursim_core.io.maps.check_threshold`,
+    :func:`~ursim_core.io.maps.check_max_pixels`); the message names the option.
+
+    Raises
+    ------
+    ParameterError
+        For example ``--threshold must be a number in 0..255, got 300``.
+    """
+    from ursim_core.io.maps import check_max_pixels, check_threshold
+
+    check_threshold(args.threshold, option="--threshold")
+    check_max_pixels(args.max_pixels, option="--max-pixels")
 
 
 def load(path: str | Path, args: argparse.Namespace):
@@ -191,7 +209,8 @@ def _same_file(first: Path, second: Path) -> bool:
 
 
 def refuse_overwriting_inputs(
-    outputs: Iterable[str | os.PathLike | None], inputs: Iterable[str | os.PathLike | None]
+    outputs: Iterable[str | os.PathLike | None],
+    inputs: Iterable[str | os.PathLike | tuple[str | os.PathLike, str] | None],
 ) -> None:
     """Refuse, before any work, an output that is one of the command's input files, or another output.
 
@@ -199,6 +218,15 @@ def refuse_overwriting_inputs(
     into JSON, and ``-o a.json --waypoints a.json`` keep only the second file. The rule of the
     correspondence savers (which refuse to write onto the maps they refer to), for every
     command that writes files. ``None`` entries (options not given) are skipped.
+
+    Parameters
+    ----------
+    outputs : iterable of path or None
+        The files the command will write.
+    inputs : iterable of path, (path, why) or None
+        The files it reads: its arguments, and as ``(path, why)`` those it reads because a file
+        names them (:mod:`ursim_core.cli.inputs`: a YAML map's image, a correspondence file's
+        label images); ``why`` is said in the message.
 
     Raises
     ------
@@ -212,14 +240,22 @@ def refuse_overwriting_inputs(
     Traceback (most recent call last):
     ...
     ursim_core.errors.SaveRefusedError: sketch.png: refusing to write an output onto the input sketch.png (it would be overwritten): choose another file name
+    >>> refuse_overwriting_inputs(["map.pgm"], [("map.pgm", "the image map.yaml names")])
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.SaveRefusedError: map.pgm: refusing to write an output onto the input map.pgm (the image map.yaml names; it would be overwritten): choose another file name
     """
-    given_inputs = [Path(path) for path in inputs if path is not None]
+    given_inputs = [
+        (Path(item[0]), f"{item[1]}; ") if isinstance(item, tuple) else (Path(item), "")
+        for item in inputs
+        if item is not None
+    ]
     seen: list[Path] = []
     for output in (Path(path) for path in outputs if path is not None):
-        for source in given_inputs:
+        for source, why in given_inputs:
             if _same_file(output, source):
                 raise SaveRefusedError(
-                    f"refusing to write an output onto the input {source} (it would be overwritten): "
+                    f"refusing to write an output onto the input {source} ({why}it would be overwritten): "
                     "choose another file name",
                     path=output,
                 )

@@ -58,7 +58,7 @@ SUMMARY_COLUMNS = (
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    from ursim_core.cli import match
+    from ursim_core.cli.match_options import add_pair_options
 
     parser.add_argument(
         "manifest", metavar="MANIFEST", help="CSV (sketch,metric[,reference][,review][,name]) or JSON list"
@@ -67,7 +67,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run the pairs on a Dask cluster instead")
     # The options of `ursim match`, applied to every pair.
-    match.add_pair_options(parser)
+    add_pair_options(parser)
 
 
 #: Largest manifest read: a million pairs of short paths.
@@ -259,8 +259,8 @@ def check_options(options: dict[str, Any]) -> None:
     presets, ``--param``, ``--threshold``, ``--max-pixels`` (:class:`~ursim_core.errors.ParameterError`)."""
     from types import SimpleNamespace
 
-    from ursim_core.cli.common import segmentation_params
-    from ursim_core.cli.match import match_config
+    from ursim_core.cli.common import check_map_options, segmentation_params
+    from ursim_core.cli.match_options import match_config
     from ursim_core.segmentation import resolve_params
 
     args = SimpleNamespace(**options)
@@ -273,10 +273,7 @@ def check_options(options: dict[str, Any]) -> None:
             if error.field:  # a --param value, named by the error itself
                 raise
             raise ParameterError(f"{option}: {error.problem}") from None
-    if not 0 <= args.threshold <= 255:
-        raise ParameterError(f"--threshold must be in 0..255, got {args.threshold}")
-    if args.max_pixels < 1:
-        raise ParameterError(f"--max-pixels must be a positive integer, got {args.max_pixels}")
+    check_map_options(args)
 
 
 def _encoded(text: str) -> bytes:
@@ -289,7 +286,7 @@ def _encoded(text: str) -> bytes:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ursim_core.cli.match import options_of
+    from ursim_core.cli.match_options import options_of
     from ursim_core.io.atomic import atomic_write_bytes
 
     out = check_output_folder(args.output)

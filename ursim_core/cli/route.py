@@ -11,7 +11,7 @@ import math
 import sys
 from pathlib import Path
 
-from ursim_core.cli.goal import add_navigation_options, prepare_navigation, write_json
+from ursim_core.cli.goal import add_navigation_options, navigation_inputs, prepare_navigation, write_json
 from ursim_core.errors import FormatError, ParameterError
 
 __all__ = ["add_parser", "cmd_route", "read_points"]
@@ -111,17 +111,17 @@ def read_points(path: str | Path) -> list[tuple[float, float]]:
 
 
 def cmd_route(args: argparse.Namespace) -> int:
-    from ursim_core.cli.common import refuse_overwriting_inputs
+    from ursim_core.cli.common import check_map_options, refuse_overwriting_inputs
     from ursim_core.navigation.nav2_files import pose_stamped, save_waypoints_yaml
     from ursim_core.navigation.route import plan_route
 
     if args.tolerance < 0:
         raise ParameterError(f"--tolerance must be >= 0, got {args.tolerance}")
-    refuse_overwriting_inputs(
-        [args.output, args.waypoints], [args.sketch, args.metric, args.points, args.correspondences]
-    )
+    check_map_options(args)
+    inputs, corr = navigation_inputs(args)
+    refuse_overwriting_inputs([args.output, args.waypoints], [*inputs, args.points])
     points = read_points(args.points)
-    nav = prepare_navigation(args)
+    nav = prepare_navigation(args, correspondences=corr)
     if args.waypoints and nav.metric_map.resolution is None:
         raise ParameterError(
             f"--waypoints needs a georeferenced map (map_server YAML), {args.metric} has no resolution"

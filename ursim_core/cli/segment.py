@@ -12,6 +12,7 @@ from ursim_core.cli.common import (
     UsageError,
     add_map_options,
     announce_kernel_compilation,
+    check_map_options,
     check_output_files,
     check_output_folder,
     load,
@@ -20,6 +21,7 @@ from ursim_core.cli.common import (
     segmentation_params,
     staged_folder,
 )
+from ursim_core.cli.inputs import map_inputs
 from ursim_core.errors import ParameterError, SegmentationError, UrsimError
 
 HELP = "Segment maps into regions (MAORIS) and write labels, overlays and region tables."
@@ -180,6 +182,7 @@ def run(args: argparse.Namespace) -> int:
 
     params = segmentation_params(args)
     # Fail on a bad option before any work (with no option given, both defaults are checked).
+    check_map_options(args)
     choices = set(DEFAULT_SEGMENTERS.values()) if _by_kind(args) else {segmenter_of(args)}
     for method, preset in choices:
         resolve_params(method, preset, params)
@@ -191,11 +194,16 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("give an output folder with -o OUT")
     out = check_output_folder(args.output)
     names = output_names(args.maps)
-    # No output may replace a map still to be read, nor the merge model of --method learned.
+    # No output may replace a map still to be read (nor a YAML map's image), nor the merge model
+    # of --method learned.
     model = params.get("model")
     refuse_overwriting_inputs(
         [out / file for name in names for file in output_files(name)],
-        [*args.maps, model if isinstance(model, str) and model != "default" else None],
+        [
+            *args.maps,
+            *(image for path in args.maps for image in map_inputs(path)),
+            model if isinstance(model, str) and model != "default" else None,
+        ],
     )
     for path, name in zip(args.maps, names):
         if name != Path(path).stem:

@@ -68,6 +68,8 @@ __all__ = [
     "map_from_array",
     "pixel_to_world",
     "world_to_pixel",
+    "check_threshold",
+    "check_max_pixels",
     "DEFAULT_FREE_THRESHOLD",
     "DEFAULT_MAX_PIXELS",
     "OCCUPANCY_FREE",
@@ -108,6 +110,12 @@ class Map:
     origin: tuple[float, float, float] | None = None
     occupancy: np.ndarray | None = field(default=None, repr=False)
     image: np.ndarray | None = field(default=None, repr=False)
+
+    def __repr__(self) -> str:
+        # Not the arrays: a building's map printed as pages of booleans says less than its shape.
+        known = {"path": self.path, "resolution": self.resolution, "origin": self.origin}
+        shown = "".join(f", {name}={value!r}" for name, value in known.items() if value is not None)
+        return f"Map(shape={self.shape}, free={int(np.count_nonzero(self.free))} px{shown})"
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -191,8 +199,8 @@ def load_map(
     >>> room.shape, int(room.free.sum()), room.name
     ((4, 6), 8, 'room')
     """
-    _check_threshold(threshold)
-    _check_max_pixels(max_pixels)
+    check_threshold(threshold)
+    check_max_pixels(max_pixels)
     path = Path(path)
     if path.suffix.lower() in ROS_SUFFIXES:
         ros = read_ros_yaml(path, max_pixels=max_pixels)
@@ -262,7 +270,7 @@ def map_from_array(
     array([[False,  True,  True],
            [ True, False, False]])
     """
-    _check_threshold(threshold)
+    check_threshold(threshold)
     path = None if path is None else Path(path)
     values = np.asarray(array)
     if values.size == 0 or values.ndim < 2:
@@ -372,14 +380,66 @@ def _is_real_number(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
-def _check_threshold(threshold) -> None:
+def check_threshold(threshold, *, option: str | None = None) -> None:
+    """Refuse a free threshold (:func:`load_map`'s ``threshold``) that is not a number in 0..255.
+
+    Parameters
+    ----------
+    threshold : object
+        The value to check; a bool is refused (a flag passed by mistake is no grey value).
+    option : str, optional
+        The command-line option that gave the value (``"--threshold"``): the message names it
+        instead of the parameter, so a user sees what to change.
+
+    Raises
+    ------
+    ParameterError
+        Naming the parameter (its ``field``) or the option, and the value.
+
+    Examples
+    --------
+    >>> check_threshold(250)
+    >>> check_threshold(300, option="--threshold")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: --threshold must be a number in 0..255, got 300
+    """
     if not _is_real_number(threshold) or not math.isfinite(threshold) or not 0 <= threshold <= 255:
-        raise ParameterError(f"threshold must be a number in 0..255, got {threshold!r}", field="threshold")
+        _refuse(option, "threshold", f"must be a number in 0..255, got {threshold!r}")
 
 
-def _check_max_pixels(max_pixels) -> None:
+def check_max_pixels(max_pixels, *, option: str | None = None) -> None:
+    """Refuse a pixel limit (:func:`load_map`'s ``max_pixels``) that is not a positive integer.
+
+    Parameters
+    ----------
+    max_pixels : object
+        The value to check; a bool or a float is refused.
+    option : str, optional
+        The command-line option that gave the value (``"--max-pixels"``), named by the message.
+
+    Raises
+    ------
+    ParameterError
+        Naming the parameter (its ``field``) or the option, and the value.
+
+    Examples
+    --------
+    >>> check_max_pixels(0, option="--max-pixels")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: --max-pixels must be a positive integer, got 0
+    """
     if not isinstance(max_pixels, numbers.Integral) or isinstance(max_pixels, bool) or max_pixels < 1:
-        raise ParameterError(f"max_pixels must be a positive integer, got {max_pixels!r}", field="max_pixels")
+        _refuse(option, "max_pixels", f"must be a positive integer, got {max_pixels!r}")
+
+
+def _refuse(option: str | None, parameter: str, problem: str) -> None:
+    if option is None:
+        # The field names the parameter: "field 'threshold': must be ..." (not "threshold" twice).
+        raise ParameterError(problem, field=parameter)
+    # An option names itself: "field '--threshold'" would read as a place in a file.
+    raise ParameterError(f"{option} {problem}")
 
 
 # ---------------------------------------------------------------------------------------------

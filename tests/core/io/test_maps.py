@@ -54,6 +54,26 @@ def test_max_pixels_must_be_positive_integer(tmp_path, max_pixels):
         load_map(path, max_pixels=max_pixels)
 
 
+def test_the_parameter_checks_are_public_and_name_a_command_line_option():
+    # One rule for the loader and the command line (ursim_core.cli.common.check_map_options).
+    from ursim_core.io import maps
+
+    assert {"check_threshold", "check_max_pixels"} <= set(maps.__all__)
+    maps.check_threshold(0)
+    maps.check_threshold(255.0)
+    maps.check_max_pixels(1)
+    with pytest.raises(ParameterError) as caught:
+        maps.check_threshold(256)
+    # The field names the parameter once: not "field 'threshold': threshold must be ...".
+    assert str(caught.value) == "field 'threshold': must be a number in 0..255, got 256"
+    with pytest.raises(ParameterError) as caught:
+        maps.check_threshold(256, option="--threshold")
+    assert str(caught.value) == "--threshold must be a number in 0..255, got 256" and caught.value.field is None
+    with pytest.raises(ParameterError) as caught:
+        maps.check_max_pixels(0, option="--max-pixels")
+    assert str(caught.value) == "--max-pixels must be a positive integer, got 0"
+
+
 def test_nonzero_free_every_non_zero_grey_is_free(tmp_path):
     path = save(Image.fromarray(GREY), tmp_path / "grey.png")
     loaded = load_map(path, nonzero_free=True, threshold=250)
@@ -331,3 +351,10 @@ def test_nonzero_free_reproduces_released_driver_on_kth_sketches():
         # Ignoring alpha is harmless on this data: no transparent pixel is free.
         rgba = np.asarray(Image.open(path).convert("RGBA"))
         assert not (loaded.free & (rgba[..., 3] < 128)).any(), path.name
+
+
+def test_a_maps_repr_is_one_short_line():
+    free = np.zeros((400, 600), bool)
+    free[10:20, 10:30] = True
+    text = repr(Map(free=free, resolution=0.05, origin=(1.0, 2.0, 0.0)))
+    assert text == "Map(shape=(400, 600), free=200 px, resolution=0.05, origin=(1.0, 2.0, 0.0))"
