@@ -8,6 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from ursim_core.cli.common import UsageError, refuse_overwriting_inputs
+from ursim_core.cli.inputs import correspondence_inputs, load_correspondence_file, map_inputs
 from ursim_core.errors import ParameterError
 
 __all__ = ["convert_correspondences"]
@@ -44,18 +45,27 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("is a folder; give the file to write", path=target)
     if not target.parent.is_dir():
         raise ParameterError(f"no folder {target.parent} to write into", path=target)
+    source = Path(args.input)
     export = args.format is not None or _is_export(target)
+    if not export:
+        # An unknown file type is named before the input is read.
+        _kind(source)
+        _kind(target)
+    corr = load_correspondence_file(source)
     # Converting a file onto itself in its own format rewrites it in the project's layout (it is
-    # read before it is written); in another format, or onto a map, it would lose it.
-    same_format = not export and target.suffix.lower() == Path(args.input).suffix.lower()
-    refuse_overwriting_inputs([target], [args.sketch, args.metric, None if same_format else args.input])
+    # read before it is written); in another format, or onto a map, it would lose it. The maps
+    # and label images the file names, and the images of YAML maps, are inputs too.
+    same_format = not export and target.suffix.lower() == source.suffix.lower()
+    inputs = [args.sketch, args.metric, None if same_format else source]
+    inputs += [*map_inputs(args.sketch), *map_inputs(args.metric), *correspondence_inputs(source, corr)]
+    refuse_overwriting_inputs([target], inputs)
     if export:
         from ursim_core.correspondences.exporters import export_file
 
-        kind = export_file(Path(args.input), target, format=args.format, side=args.side)
+        kind = export_file(source, target, format=args.format, side=args.side)
         print(f"wrote {args.output} ({kind})")
         return 0
-    convert_correspondences(Path(args.input), target, sketch=args.sketch, metric=args.metric)
+    convert_correspondences(source, target, sketch=args.sketch, metric=args.metric, loaded=corr)
     print(f"wrote {args.output}")
     return 0
 
@@ -82,12 +92,14 @@ def convert_correspondences(
     sketch: str | Path | None = None,
     metric: str | Path | None = None,
     tolerance: int = 10,
+    loaded=None,
 ) -> None:
     """Convert ``source`` (.dat or .json) to ``target`` (.json or .dat).
 
     For ``.dat -> .json``, ``sketch`` and ``metric`` name the two maps: they are recorded in the JSON
     (path, sha256, size) and, when given, both maps are segmented with the 'default' MAORIS preset
     (the one the original annotators clicked on) so the cliques also carry region ids.
+    ``loaded``: ``source`` as the caller has loaded it already (else it is loaded here).
 
     Examples
     --------
@@ -106,7 +118,10 @@ def convert_correspondences(
     )
 
     source_kind, target_kind = _kind(source), _kind(target)
-    corr = load_dat(source) if source_kind == "dat" else load_correspondences(source)
+    if loaded is not None:
+        corr = loaded
+    else:
+        corr = load_dat(source) if source_kind == "dat" else load_correspondences(source)
     if target_kind == "dat":
         save_dat(corr, target)
         return

@@ -14,13 +14,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ursim_core.cli.common import finite_or_nan, refuse_overwriting_inputs
+from ursim_core.cli.common import check_map_options, finite_or_nan, refuse_overwriting_inputs
 from ursim_core.errors import ParameterError
 
 __all__ = [
     "add_parser",
     "cmd_goal",
     "prepare_navigation",
+    "navigation_inputs",
     "Navigation",
     "add_navigation_options",
     "parse_point",
@@ -187,8 +188,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return add_subcommand(subparsers, "goal", sys.modules[__name__])
 
 
-def prepare_navigation(args: argparse.Namespace) -> Navigation:
-    """Load both maps, segment them (or load the correspondence file's label images) and match."""
+def prepare_navigation(args: argparse.Namespace, *, correspondences=None) -> Navigation:
+    """Load both maps, segment them (or load the correspondence file's label images) and match.
+
+    ``correspondences``: the file of ``args.correspondences`` when the caller has loaded it
+    already (for its overwrite check, :func:`navigation_inputs`); else it is loaded here.
+    """
     from ursim_core.io.maps import load_map
     from ursim_core.navigation.goal import match_table
     from ursim_core.segmentation import segment
@@ -200,7 +205,7 @@ def prepare_navigation(args: argparse.Namespace) -> Navigation:
     if args.correspondences:
         from ursim_core.correspondences import assign_regions, load_correspondences
 
-        corr = load_correspondences(Path(args.correspondences))
+        corr = correspondences if correspondences is not None else load_correspondences(Path(args.correspondences))
         sketch_seg = _labels_or_segment(corr.sketch, sketch_map, args.sketch_preset)
         metric_seg = _labels_or_segment(corr.metric, metric_map, args.metric_preset)
         # Points are authoritative: region ids follow the segmentations used here.
@@ -220,6 +225,31 @@ def _labels_or_segment(ref, the_map, preset: str):
     if ref.labels_path is not None and Path(ref.labels_path).is_file():
         return load_label_image(ref.labels_path, shape=the_map.shape)
     return segment(the_map, preset=preset)
+
+
+def navigation_inputs(args: argparse.Namespace) -> tuple[list, Any]:
+    """The files ``ursim goal`` and ``ursim route`` read, for the overwrite check, and the loaded
+    correspondence file (None without ``--correspondences``).
+
+    Beside the arguments: the image of a ROS YAML map, and the maps and label images the
+    correspondence file names (:mod:`ursim_core.cli.inputs`).
+    """
+    from ursim_core.cli.inputs import correspondence_inputs, map_inputs
+
+    corr = None
+    if args.correspondences:
+        from ursim_core.correspondences import load_correspondences
+
+        corr = load_correspondences(Path(args.correspondences))
+    inputs = [
+        args.sketch,
+        args.metric,
+        args.correspondences,
+        *map_inputs(args.sketch),
+        *map_inputs(args.metric),
+        *correspondence_inputs(args.correspondences, corr),
+    ]
+    return inputs, corr
 
 
 def goal_document(goal, *, frame_id: str = "map") -> dict[str, Any]:
@@ -244,7 +274,7 @@ def write_json(document: Any, output: str | None) -> None:
         resolution overflow puts them in a pose), naming the file and the field; nothing is
         printed or written.
     """
-    from ursim_core.correspondences.exporters import finite_json
+    from ursim_core.correspondences.json_text import finite_json
 
     text = finite_json(document, output or "<standard output>", indent=2) + "\n"
     sys.stdout.write(text)
@@ -267,8 +297,10 @@ def cmd_goal(args: argparse.Namespace) -> int:
     for row, col in args.at:
         if not (math.isfinite(row) and math.isfinite(col)):
             raise ParameterError(f"--at must be two finite numbers, got {row},{col}")
-    refuse_overwriting_inputs([args.output], [args.sketch, args.metric, args.correspondences])
-    nav = prepare_navigation(args)
+    check_map_options(args)
+    inputs, corr = navigation_inputs(args)
+    refuse_overwriting_inputs([args.output], inputs)
+    nav = prepare_navigation(args, correspondences=corr)
     # A georeference too large overflows to NaN or infinity, which write_json refuses by name:
     # numpy's warnings would only add lines that do not say which file is at fault.
     with np.errstate(over="ignore", invalid="ignore"):

@@ -58,6 +58,35 @@ class RosMap:
     origin: tuple[float, float, float]
 
 
+def ros_image_path(yaml_path: str | os.PathLike) -> Path:
+    """The image file a map_server YAML file names, resolved as :func:`read_ros_yaml` resolves
+    it: relative to the YAML's folder unless absolute (nav2's rule).
+
+    Raises
+    ------
+    MapError
+        The YAML cannot be read or is not a valid map_server file (as the loader would say).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "map.yaml").write_text("image: map.pgm\\nresolution: 0.05\\norigin: [0, 0, 0]\\n")
+    >>> ros_image_path(folder / "map.yaml") == folder / "map.pgm"
+    True
+    """
+    yaml_path = Path(yaml_path)
+    document = _parse_yaml(yaml_path)
+    if not isinstance(document, dict):
+        raise MapError("not a ROS map_server YAML file: expected a mapping", path=yaml_path)
+    return _image_path(yaml_path, _ros_settings(document, yaml_path)["image"])
+
+
+def _image_path(yaml_path: Path, image: str) -> Path:
+    image_path = Path(image)
+    return image_path if image_path.is_absolute() else yaml_path.parent / image_path
+
+
 def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
     """Read a ROS map_server YAML file and its image (see :func:`ursim_core.io.load_map`).
 
@@ -74,10 +103,7 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
             path=yaml_path,
         )
     settings = _ros_settings(document, yaml_path)
-
-    image_path = Path(settings["image"])
-    if not image_path.is_absolute():
-        image_path = yaml_path.parent / image_path
+    image_path = _image_path(yaml_path, settings["image"])
     shown = _cut(str(image_path), 200)
     if not os.path.lexists(image_path):
         raise MapError(f"image file not found: {shown}", path=yaml_path, field="image")
