@@ -16,10 +16,12 @@ crashes cannot fill a disk.
 A destination that exists and is not a regular file is never replaced: renaming a file
 over ``/dev/null`` (as root) or over a named pipe would destroy the node and silently
 turn it into a plain file. A character device (``/dev/null``, ``/dev/full``, a terminal)
-is written through instead, in place, since writing to it is what the user asked for and
-it has no old content to keep; a folder, a named pipe (opening it would block until a
-reader comes), a socket (cannot be opened) or a block device (a disk: never what a JSON
-or an image is meant for) is refused with an error naming it.
+or a pipe (a named pipe, or ``/dev/stdout`` when standard output is one: ``-o /dev/stdout |
+jq``) is written through instead, in place, since writing to it is what the user asked for
+and it has no old content to keep. A pipe is opened without waiting: when no process has it
+open for reading, the save fails at once ("no process is reading the named pipe") rather
+than hang until one comes. A folder, a socket (cannot be opened) or a block device (a disk:
+never what a JSON or an image is meant for) is refused with an error naming it.
 
 Every :class:`OSError` raised names the caller's path (``error.filename``), not the
 hidden temporary file, whatever step failed (a missing folder, a read-only folder, a
@@ -55,8 +57,8 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
     path : str or path-like
         The file to create or replace. Its directory must exist. If it is a
         symbolic link, the file it points to is replaced (the link is kept).
-        If it is a character device (``/dev/null``), ``data`` is written to the
-        device in place (see the module's docstring).
+        If it is a character device (``/dev/null``) or a pipe with a reader, ``data`` is
+        written to it in place (see the module's docstring).
     data : bytes-like
         The complete new content.
 
@@ -67,7 +69,8 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
         synced or renamed, with ``filename`` set to ``path``. The temporary file
         is removed first and an existing file at ``path`` is left untouched.
         Also raised, before anything is written, when ``path`` is a folder
-        (:class:`IsADirectoryError`), a named pipe, a socket or a block device.
+        (:class:`IsADirectoryError`), a socket, a block device or a named pipe that no
+        process is reading (``errno.ENXIO``).
 
     Notes
     -----
@@ -101,8 +104,8 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes | bytearray | memory
 def _write(target: Path, payload: memoryview) -> None:
     mode = _existing_mode(target)
     if mode is not None and not stat.S_ISREG(mode):
-        if stat.S_ISCHR(mode):
-            _write_through(target, payload)
+        if stat.S_ISCHR(mode) or stat.S_ISFIFO(mode):
+            _write_through(target, payload, stat.S_IFMT(mode))
             return
         raise _refusal(mode)
     if target.is_symlink():
@@ -143,10 +146,10 @@ def _existing_mode(target: Path) -> int | None:
 def _refusal(mode: int) -> OSError:
     if stat.S_ISDIR(mode):
         return IsADirectoryError(errno.EISDIR, "is a folder, not a file: nothing was written")
-    if stat.S_ISFIFO(mode):
-        kind = "a named pipe (FIFO)"
-    elif stat.S_ISSOCK(mode):
+    if stat.S_ISSOCK(mode):
         kind = "a socket"
+    elif stat.S_ISFIFO(mode):  # only when one was swapped in for a device during the save
+        kind = "a named pipe (FIFO)"
     elif stat.S_ISBLK(mode):
         kind = "a block device (a disk)"
     else:
@@ -154,17 +157,26 @@ def _refusal(mode: int) -> OSError:
     return OSError(errno.EINVAL, f"is {kind}, not a regular file: refusing to write to it or replace it")
 
 
-def _write_through(target: Path, payload: memoryview) -> None:
-    """Write ``payload`` to the character device ``target`` in place (nothing to keep, nothing to sync)."""
-    # Non-blocking open, so that a named pipe swapped in since the stat cannot hang the save;
-    # no O_CREAT: if the device went away, nothing is created in its place.
+def _write_through(target: Path, payload: memoryview, kind: int) -> None:
+    """Write ``payload`` in place to ``target``, a character device or a pipe (``kind``, the
+    ``S_IFMT`` bits its stat gave): nothing to keep, nothing to sync."""
+    # Non-blocking open: a pipe with no reader fails at once (ENXIO) instead of waiting for one,
+    # and so does a pipe swapped in for a device since the stat. No O_CREAT: if the node went
+    # away, nothing is created in its place.
     flags = os.O_WRONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0)
-    descriptor = os.open(target, flags)
+    try:
+        descriptor = os.open(target, flags)
+    except OSError as error:
+        if error.errno == errno.ENXIO and kind == stat.S_IFIFO:
+            raise OSError(errno.ENXIO, "no process is reading the named pipe: nothing was written") from None
+        raise
     try:
         mode = os.fstat(descriptor).st_mode
-        if not stat.S_ISCHR(mode):
+        if stat.S_IFMT(mode) != kind:
             # Replaced between the stat and the open: refuse rather than write a file in place.
             raise _refusal(mode) if not stat.S_ISREG(mode) else OSError(errno.EAGAIN, "changed while being saved")
+        # Blocking again (fcntl F_SETFL): a reader slower than the save makes it wait, not fail
+        # with EAGAIN once the pipe's buffer is full.
         os.set_blocking(descriptor, True)
         view = payload
         while view:

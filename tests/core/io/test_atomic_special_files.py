@@ -1,5 +1,6 @@
-"""Atomic writes onto what is not a regular file (ursim_core.io.atomic): a device is written through,
-never replaced; a folder, a named pipe or a socket is refused; every error names the caller's path."""
+"""Atomic writes onto what is not a regular file (ursim_core.io.atomic): a device or a pipe with a
+reader is written through, never replaced; a pipe without one, a folder or a socket is refused at
+once; every error names the caller's path."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ import stat
 import subprocess
 import sys
 import textwrap
+import threading
+import time
 
 import pytest
 
@@ -72,13 +75,62 @@ def test_a_folder_is_refused_naming_it(tmp_path):
     assert _names(tmp_path) == ["out.json"] and folder.is_dir()
 
 
+def _drain(descriptor: int, expected: int, received: bytearray) -> None:
+    """Read the non-blocking ``descriptor`` until ``expected`` bytes came, for 60 s at most; then
+    close it, so that a writer blocked on a full pipe fails (EPIPE) instead of hanging the test."""
+    deadline = time.monotonic() + 60
+    try:
+        while len(received) < expected and time.monotonic() < deadline:
+            try:
+                chunk = os.read(descriptor, 1 << 16)
+            except BlockingIOError:
+                chunk = b""
+            if chunk:
+                received.extend(chunk)
+            else:
+                time.sleep(0.005)  # no writer yet, or nothing written yet
+    finally:
+        os.close(descriptor)
+
+
 @posix_only
-def test_a_named_pipe_is_refused_without_opening_it(tmp_path):
+def test_a_named_pipe_with_a_reader_receives_the_bytes_and_stays_a_pipe(tmp_path):
     pipe = tmp_path / "out.json"
     os.mkfifo(pipe)
-    with pytest.raises(OSError, match="named pipe") as caught:
-        atomic_write_text(pipe, "{}")
-    assert caught.value.filename == str(pipe)
+    # Larger than a pipe's buffer (64 KiB on Linux): the save must wait for the reader, not fail.
+    payload = bytes(range(256)) * 4096
+    received = bytearray()
+    reader = os.open(pipe, os.O_RDONLY | os.O_NONBLOCK)  # the reader is there before the save
+    thread = threading.Thread(target=_drain, args=(reader, len(payload), received), daemon=True)
+    thread.start()
+    atomic_write_bytes(pipe, payload)
+    thread.join(70)
+    assert bytes(received) == payload
+    assert stat.S_ISFIFO(os.stat(pipe).st_mode)
+    assert _names(tmp_path) == ["out.json"]
+
+
+@posix_only
+def test_a_named_pipe_without_a_reader_fails_at_once_naming_it(tmp_path):
+    # In a subprocess with a timeout: a save that waits for a reader must fail the test, not hang it.
+    pipe = tmp_path / "out.json"
+    os.mkfifo(pipe)
+    code = textwrap.dedent(
+        f"""
+        from ursim_core.io.atomic import atomic_write_text
+        try:
+            atomic_write_text({str(pipe)!r}, "{{}}")
+        except OSError as error:
+            print(error.errno, error.filename, "|", error.strerror)
+        """
+    )
+    started = time.monotonic()
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    numbers, _, problem = result.stdout.strip().partition(" | ")
+    assert numbers.split() == [str(errno.ENXIO), str(pipe)]
+    assert problem == "no process is reading the named pipe: nothing was written"
+    assert time.monotonic() - started < 30
     assert stat.S_ISFIFO(os.stat(pipe).st_mode)
     assert _names(tmp_path) == ["out.json"]
 
