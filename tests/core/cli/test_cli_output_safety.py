@@ -139,7 +139,7 @@ def test_match_stages_its_json_with_the_images(tmp_path, monkeypatch):
 
 def _options(argv):
     from ursim_core.cli.main import build_parser
-    from ursim_core.cli.match import options_of
+    from ursim_core.cli.match_options import options_of
 
     return options_of(build_parser("match").parse_args(argv))
 
