@@ -123,7 +123,7 @@ def tolerance_value(text: str) -> float:
 
 def add_navigation_options(parser: argparse.ArgumentParser) -> None:
     """Map, segmentation and correspondence options shared by ``ursim goal`` and ``ursim route``."""
-    from ursim_core.matching.pipeline import MATCH_PRESETS
+    from ursim_core.matching.config import MATCH_PRESETS
 
     parser.add_argument("sketch", metavar="SKETCH", help="the sketch image")
     parser.add_argument("metric", metavar="METRIC", help="the robot's map: map_server YAML (or an image: pixels only)")
@@ -196,7 +196,6 @@ def prepare_navigation(args: argparse.Namespace, *, correspondences=None) -> Nav
     """
     from ursim_core.io.maps import load_map
     from ursim_core.navigation.goal import match_table
-    from ursim_core.segmentation import segment
 
     def load(path):
         return load_map(path, threshold=args.threshold, nonzero_free=args.nonzero_free, max_pixels=args.max_pixels)
@@ -211,12 +210,12 @@ def prepare_navigation(args: argparse.Namespace, *, correspondences=None) -> Nav
         # Points are authoritative: region ids follow the segmentations used here.
         corr = assign_regions(corr, sketch_seg.labels, metric_seg.labels, tolerance=args.tolerance)
         return Navigation(sketch_map, metric_map, sketch_seg, metric_seg, match_table(corr), "correspondences")
-    from ursim_core.matching.pipeline import match
+    from ursim_core.matching import match_maps
 
-    sketch_seg = segment(sketch_map, preset=args.sketch_preset)
-    metric_seg = segment(metric_map, preset=args.metric_preset)
-    result = match(sketch_seg, metric_seg)
-    return Navigation(sketch_map, metric_map, sketch_seg, metric_seg, match_table(result), "match")
+    # As ursim match matches: the sketch in its canonical pose with its resamplings, two YAMLs'
+    # scale (a turned KTH sketch's goals went to the wrong room with plain segment + match).
+    found = match_maps(sketch_map, metric_map, sketch_preset=args.sketch_preset, metric_preset=args.metric_preset)
+    return Navigation(sketch_map, metric_map, found.sketch_seg, found.metric_seg, match_table(found.result), "match")
 
 
 def _labels_or_segment(ref, the_map, preset: str):

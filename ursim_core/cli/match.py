@@ -88,27 +88,10 @@ def reviewed_cliques(review, sketch_seg, metric_seg):
     return kept, constraints_from_cliques(kept, sizes=sizes) or None
 
 
-def reference_scores(pairs, reference, sketch_seg, metric_seg, metric_map, *, metric_preset: str, params: dict):
-    """Pair score and place score of ``pairs`` against a ground truth with points."""
-    from ursim_core.correspondences import assign_regions
-    from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, place_accuracy, score_matches
-
-    assigned = assign_regions(reference, sketch_seg.labels, metric_seg.labels, tolerance=10)
-    pair_score = score_matches(pairs, assigned)
-    if metric_preset == PLACE_REFERENCE_PRESET and not params:
-        place_labels = metric_seg.labels
-    else:
-        from ursim_core.cli.segment import segment_checked
-
-        place_labels = segment_checked(metric_map, preset=PLACE_REFERENCE_PRESET, params={}).labels
-    place = place_accuracy(
-        pairs, reference, sketch_seg.labels, metric_seg.labels, place_labels, metric_seg.graph, tolerance=10
-    )
-    return pair_score, place
-
-
-def load_and_segment(sketch, metric, args, *, params: dict[str, Any], canonical: bool, resampled: bool = False):
-    """Both maps loaded, then both segmented, each pair of steps on two threads.
+def load_and_segment(sketch, metric, args, config, *, params: dict[str, Any], constrained: bool = False):
+    """Both maps loaded on two threads, then segmented for matching
+    (:func:`ursim_core.matching.segment_pair`, two threads again); the configuration with two
+    georeferenced maps' scale.
 
     The decoders, OpenCV and the MAORIS kernels release the GIL, so two building-sized maps take
     about the time of the larger one (8000 px: about 13 s instead of 23 s, peak resident memory
@@ -119,25 +102,25 @@ def load_and_segment(sketch, metric, args, *, params: dict[str, Any], canonical:
     from concurrent.futures import ThreadPoolExecutor
 
     from ursim_core.cli.common import announce_kernel_compilation
-    from ursim_core.cli.segment import segment_checked
-    from ursim_core.segmentation import segment, segment_canonical  # noqa: F401 - imported once, not by two threads
+    from ursim_core.matching import segment_pair
 
     announce_kernel_compilation()
     with ThreadPoolExecutor(max_workers=2, thread_name_prefix="ursim-match") as pool:
         sketch_load, metric_load = pool.submit(load, sketch, args), pool.submit(load, metric, args)
         sketch_map, metric_map = sketch_load.result(), metric_load.result()
-        sketch_job = pool.submit(
-            segment_checked,
-            sketch_map,
-            preset=args.sketch_preset,
-            params=params,
-            canonical=canonical,
-            resampled=resampled,
-        )
-        metric_job = pool.submit(segment_checked, metric_map, preset=args.metric_preset, params=params)
-        sketch_seg, metric_seg = sketch_job.result(), metric_job.result()
+    # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
+    config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
+    sketch_seg, metric_seg = segment_pair(
+        sketch_map,
+        metric_map,
+        config=config,
+        sketch_preset=args.sketch_preset,
+        metric_preset=args.metric_preset,
+        params=params,
+        constrained=constrained,
+    )
     _return_freed_memory()
-    return sketch_map, metric_map, sketch_seg, metric_seg
+    return sketch_map, metric_map, sketch_seg, metric_seg, config
 
 
 def _return_freed_memory() -> None:
@@ -187,8 +170,8 @@ def match_pair(
     """
     from types import SimpleNamespace
 
-    from ursim_core.correspondences import Correspondences, MapRef, check_maps, from_pairs
-    from ursim_core.matching import CONSTRAINED_MATCHERS, match, pairs_beside_review
+    from ursim_core.correspondences import Correspondences, check_maps, from_pairs
+    from ursim_core.matching import CONSTRAINED_MATCHERS, map_ref, match, pairs_beside_review
     from ursim_core.matching.results import laid_by, match_record, next_reading_record
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
@@ -208,36 +191,20 @@ def match_pair(
     reference = None if reference_path is None else load_reference(reference_path)
     review = None if review_path is None else load_reference(review_path)
     params = segmentation_params(args)
-    # The sketch is segmented in its canonical pose unless the matcher is told it is upright, and
-    # in its other resamplings when it is turned onto its wall axes, for the planar matcher's vote.
-    canonical = config.orientation != "upright"
-    resampled = canonical and config.resampling_vote and config.resolved().matcher == "planar" and review is None
-    sketch_map, metric_map, sketch_seg, metric_seg = load_and_segment(
-        sketch, metric, args, params=params, canonical=canonical, resampled=resampled
+    # A review's pairs fix region ids of one segmentation: no resamplings to vote over then.
+    sketch_map, metric_map, sketch_seg, metric_seg, config = load_and_segment(
+        sketch, metric, args, config, params=params, constrained=review is not None
     )
     for loaded, loaded_path in ((reference, reference_path), (review, review_path)):
         if loaded is not None:
             # A file of another pair is named as such, not by its label image's size.
             check_maps(loaded, sketch_map, metric_map, loaded_path)
-    # Two georeferenced maps (ROS YAML): the scale is known, metric pixels per input pixel.
-    config = config.with_resolutions(sketch_map.resolution, metric_map.resolution)
     # The images and the JSON that names them are staged and moved in together, so a failure
     # leaves none of them; the JSON's paths are made relative to OUT, where it ends up.
     # The two label images are encoded on two threads while the maps are matched (OpenCV
     # releases the GIL, the matcher holds it most of the time; 8000 px labels take about half a
     # second each); errors are raised in the order of the steps (match, labels, figure).
     from concurrent.futures import ThreadPoolExecutor
-
-    def ref(the_map, seg, labels_name):
-        return MapRef(
-            path=Path(the_map.path).resolve() if the_map.path else None,
-            sha256=the_map.sha256,
-            size=tuple(the_map.shape),
-            segmentation_method=seg.method,
-            segmentation_params=dict(seg.params),
-            labels_path=(out / labels_name).resolve(),
-            extra={},
-        )
 
     with staged_folder(out) as staging, ThreadPoolExecutor(max_workers=2, thread_name_prefix="ursim-save") as pool:
         jobs = [
@@ -268,8 +235,8 @@ def match_pair(
             ),
         ]
         corr = Correspondences(
-            sketch=ref(sketch_map, sketch_seg, "sketch.labels.png"),
-            metric=ref(metric_map, metric_seg, "metric.labels.png"),
+            sketch=map_ref(sketch_map, sketch_seg, labels_path=out / "sketch.labels.png"),
+            metric=map_ref(metric_map, metric_seg, labels_path=out / "metric.labels.png"),
             cliques=cliques,
             extra={"matcher": match_record(config, result)},
         )
@@ -297,9 +264,10 @@ def match_pair(
         "out": out,
     }
     if reference is not None:
-        pair_score, place = reference_scores(
-            result.pairs, reference, sketch_seg, metric_seg, metric_map, metric_preset=args.metric_preset, params=params
-        )
+        from ursim_core.evaluation import score_against_reference
+
+        scores = score_against_reference(result.pairs, reference, sketch_seg, metric_seg, metric_map)
+        pair_score, place = scores.pairs, scores.place
         record.update(
             precision=pair_score.precision,
             recall=pair_score.recall,

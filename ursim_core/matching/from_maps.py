@@ -5,9 +5,9 @@ its business but matters as much as the matcher itself. The KTH evidence was gat
 MAORIS preset of :data:`~ursim_core.matching.config.MATCH_PRESETS` on both maps (``"default"``,
 not ``segment``'s own default ``"sketch"``), and a sketch whose orientation the matcher does not
 assume is segmented in its canonical pose, with its other resamplings for the planar matcher's
-vote. On KTH sketches 00 / 04 / 20 against the model, ``segment`` then ``match`` with the
-defaults scored F1 0.64 / 0.50 / 0.67 where ``ursim match`` scored 1.00 / 0.55 / 0.92 (round 60's
-audit of the library). :func:`match_maps` is that pipeline for callers of the library;
+vote. On KTH sketches 00 / 04 / 20 against the model (Malcolm's ground truth), ``segment`` then
+``match`` with their defaults scored F1 0.64 / 0.50 / 0.67 and place accuracy 0.93 / 0.75 / 0.75
+where this pipeline scores 1.00 / 0.55 / 0.92 and 0.93 / 0.75 / 0.83 (round 60). :func:`match_maps` is that pipeline for callers of the library;
 ``ursim match`` and ``ursim goal`` run it too.
 """
 
@@ -92,12 +92,12 @@ def map_ref(the_map: Any, segmentation: Any, *, labels_path=None):
     )
 
 
-def sketch_segmentation_rule(config: MatchConfig, *, constraints: Any = None) -> tuple[bool, bool]:
+def sketch_segmentation_rule(config: MatchConfig, *, constrained: bool = False) -> tuple[bool, bool]:
     """``(canonical, resampled)``: how the sketch is segmented for ``config``.
 
     In its canonical pose unless the matcher is told it is upright; in its other resamplings
-    too when, turned onto its wall axes, the planar matcher votes over them (not with pairs
-    fixed by ``constraints``, whose region ids belong to one segmentation).
+    too when, turned onto its wall axes, the planar matcher votes over them (not when the match
+    is ``constrained`` by fixed pairs, whose region ids belong to one segmentation).
 
     Examples
     --------
@@ -109,7 +109,7 @@ def sketch_segmentation_rule(config: MatchConfig, *, constraints: Any = None) ->
     (True, False)
     """
     canonical = config.orientation != "upright"
-    resampled = canonical and config.resampling_vote and config.resolved().matcher == "planar" and constraints is None
+    resampled = canonical and config.resampling_vote and config.resolved().matcher == "planar" and not constrained
     return canonical, resampled
 
 
@@ -120,7 +120,7 @@ def segment_for_matching(
     config: MatchConfig = MatchConfig(),
     preset: str | None = None,
     params: dict[str, Any] | None = None,
-    constraints: Any = None,
+    constrained: bool = False,
 ) -> Any:
     """Segment ``the_map`` (a :class:`~ursim_core.io.Map`) as the matcher expects its ``side``.
 
@@ -137,8 +137,8 @@ def segment_for_matching(
         MAORIS preset; default ``MATCH_PRESETS[side]``.
     params : dict, optional
         MAORIS parameters over the preset's.
-    constraints : MatchConstraints, optional
-        The pairs the match will be given, if any.
+    constrained : bool, optional
+        Whether the match will be given fixed pairs (``constraints``).
 
     Returns
     -------
@@ -166,7 +166,7 @@ def segment_for_matching(
         raise ParameterError(f"side must be 'sketch' or 'metric', got {side!r}", field="side")
     preset = MATCH_PRESETS[side] if preset is None else preset
     canonical, resampled = (
-        sketch_segmentation_rule(config, constraints=constraints) if side == "sketch" else (False, False)
+        sketch_segmentation_rule(config, constrained=constrained) if side == "sketch" else (False, False)
     )
     if canonical:
         segmentation = segment_canonical(the_map, preset=preset, params=params, resampled=resampled)
@@ -185,7 +185,7 @@ def segment_pair(
     sketch_preset: str | None = None,
     metric_preset: str | None = None,
     params: dict[str, Any] | None = None,
-    constraints: Any = None,
+    constrained: bool = False,
 ) -> tuple[Any, Any]:
     """Both maps segmented for matching (:func:`segment_for_matching`), on two threads.
 
@@ -197,7 +197,7 @@ def segment_pair(
 
     def one(the_map, side, preset):
         return segment_for_matching(
-            the_map, side=side, config=config, preset=preset, params=params, constraints=constraints
+            the_map, side=side, config=config, preset=preset, params=params, constrained=constrained
         )
 
     with ThreadPoolExecutor(max_workers=2, thread_name_prefix="ursim-segment") as pool:
@@ -264,7 +264,7 @@ def match_maps(
         sketch_preset=sketch_preset,
         metric_preset=metric_preset,
         params=params,
-        constraints=constraints,
+        constrained=constraints is not None,
     )
     result = match(sketch_seg, metric_seg, config=config, progress=progress, constraints=constraints)
     return MapsMatch(sketch_map, metric_map, sketch_seg, metric_seg, result, config)

@@ -66,3 +66,30 @@ def test_bad_point_is_a_usage_error(maps, capsys):
         ursim(["goal", str(sketch), str(metric_yaml), "--at", "12"])
     assert exit_info.value.code == 2
     assert "ROW,COL" in capsys.readouterr().err
+
+
+def test_goal_without_correspondences_matches_as_ursim_match_does(maps):
+    # It segmented the sketch with plain segment() (not in its canonical pose, no resamplings)
+    # and ignored two YAMLs' scale: another pipeline than ursim match's, and worse on turned
+    # sketches (a KTH sketch turned by 45 degrees: place accuracy 0.80 against 1.00).
+    import argparse
+
+    from ursim_core.cli.goal import prepare_navigation
+    from ursim_core.matching import match_maps
+
+    sketch, _, metric_yaml = maps
+    args = argparse.Namespace(
+        sketch=str(sketch),
+        metric=str(metric_yaml),
+        correspondences=None,
+        sketch_preset="default",
+        metric_preset="default",
+        threshold=250,
+        nonzero_free=False,
+        max_pixels=64_000_000,
+        tolerance=10,
+    )
+    navigation = prepare_navigation(args)
+    assert navigation.sketch_seg.params.get("canonical") is True
+    found = match_maps(load_map(sketch), load_map(metric_yaml))
+    assert navigation.table.pairs == tuple(found.result.pairs)

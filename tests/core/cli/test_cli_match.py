@@ -223,13 +223,14 @@ def test_threads_give_the_outputs_of_one_step_after_the_other(tmp_path):
     from ursim_core.cli.common import load
     from ursim_core.cli.match import load_and_segment
     from ursim_core.cli.segment import segment_checked
+    from ursim_core.matching import MatchConfig
 
     sketch, metric = two_rooms(tmp_path / "a.png"), two_rooms(tmp_path / "b.png")
     args = SimpleNamespace(
         threshold=250, nonzero_free=False, max_pixels=64_000_000, sketch_preset="sketch", metric_preset="default"
     )
-    *_, sketch_seg, metric_seg = load_and_segment(sketch, metric, args, params={}, canonical=True)
-    alone = segment_checked(load(sketch, args), preset="sketch", params={}, canonical=True)
+    _, _, sketch_seg, metric_seg, _ = load_and_segment(sketch, metric, args, MatchConfig(), params={})
+    alone = segment_checked(load(sketch, args), preset="sketch", params={}, canonical=True, resampled=True)
     assert np.array_equal(sketch_seg.labels, alone.labels)
     assert np.array_equal(metric_seg.labels, segment_checked(load(metric, args), preset="default", params={}).labels)
 

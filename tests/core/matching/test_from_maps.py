@@ -41,7 +41,7 @@ def test_the_resamplings_are_made_only_for_the_planar_matchers_vote():
     assert sketch_segmentation_rule(MatchConfig()) == (True, True)
     assert sketch_segmentation_rule(MatchConfig(resampling_vote=False)) == (True, False)
     assert sketch_segmentation_rule(MatchConfig(matcher="hungarian")) == (True, False)
-    assert sketch_segmentation_rule(MatchConfig(), constraints=object()) == (True, False)
+    assert sketch_segmentation_rule(MatchConfig(), constrained=True) == (True, False)
 
 
 def test_two_georeferenced_maps_give_the_matcher_their_scale(tmp_path):

@@ -23,7 +23,7 @@ from ursim_core.cli import goal as goal_cli
 from ursim_core.correspondences import load_dat, regions_at_points
 from ursim_core.evaluation.datasets import MISSING_REASON, dataset_root
 from ursim_core.io.maps import load_map
-from ursim_core.matching.pipeline import match
+from ursim_core.matching import match_maps
 from ursim_core.navigation.goal import locate, match_table
 from ursim_core.segmentation import segment
 
@@ -82,7 +82,6 @@ def test_ursim_goal_lands_in_the_place_as_often_as_place_accuracy_says(
 ):
     model_path = kth_folder() / "model" / "model_simple.png"
     metric_map = load_map(model_path)
-    metric_seg = segment(metric_map, preset="default")
     accuracies = []
     for sketch_path in sorted((kth_folder() / "sketches").glob("*.png")):
         image = np.asarray(Image.open(sketch_path))
@@ -91,10 +90,14 @@ def test_ursim_goal_lands_in_the_place_as_often_as_place_accuracy_says(
         cliques = cliques_with_both_sides(sketch_path.stem)
         points = [turned_point(p, image.shape[:2], quarter_turns) for _, c in cliques for p in c.sketch_points]
 
-        # Place accuracy's side: locate() on the matcher's own segmentations, in process.
-        sketch_seg = segment(load_map(turned_path), preset="default")
-        table = match_table(match(sketch_seg, metric_seg))
-        located = [locate(table, sketch_seg, metric_seg, None, r, c, suggest_nearest=False).pixel for r, c in points]
+        # Place accuracy's side: locate() on the matcher's own segmentations, in process (the
+        # pipeline of ursim match, which ursim goal runs too).
+        found = match_maps(load_map(turned_path), metric_map)
+        table = match_table(found.result)
+        located = [
+            locate(table, found.sketch_seg, found.metric_seg, None, r, c, suggest_nearest=False).pixel
+            for r, c in points
+        ]
 
         # The robot's side: the `ursim goal` command at every point.
         argv = ["goal", str(turned_path), str(model_path)] + [f"--at={r},{c}" for r, c in points]
