@@ -11,7 +11,8 @@ region centroids and kept inside the matched metric regions.
 :func:`locate` is pure and cheap (one region look-up and a dictionary access; no image-sized
 work unless the tap is unmatched and a nearest matched region is asked for), so evaluation code
 can call it for every ground-truth point. Build the :class:`MatchTable` once with
-:func:`match_table` and pass it instead of the match when calling it many times.
+:func:`match_table` (given the segmentations, for a correspondence file: its points decide the
+regions) and pass it instead of the match when calling it many times.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ __all__ = [
     "NearestMatch",
     "MatchTable",
     "match_table",
+    "clique_regions",
     "locate",
     "LABEL_KEY",
     "TARGETS",
@@ -65,7 +67,7 @@ class MatchTable:
     pairs: tuple = ()
 
 
-def match_table(match: Any) -> MatchTable:
+def match_table(match: Any, sketch_seg: Any = None, metric_seg: Any = None, *, tolerance: float = 10) -> MatchTable:
     """Normalise any form of match into a :class:`MatchTable`.
 
     Parameters
@@ -75,6 +77,23 @@ def match_table(match: Any) -> MatchTable:
         region of a clique is matched to every metric region of it; rejected cliques are left
         out; a clique's ``label`` is kept); ``{sketch_region: metric_region(s)}``; or
         ``(sketch_region, metric_region)`` pairs.
+    sketch_seg, metric_seg : Segmentation or label array, optional
+        The segmentations the table is for. With both, the region ids of cliques come from
+        their points (points are authoritative: ids stored in a file may be those of another
+        segmentation), as ``ursim goal --correspondences`` does; see :func:`clique_regions`.
+        Without them, a clique's stored ids are used as they are.
+    tolerance : float, keyword-only
+        Pixels from a region within which a clique's point still counts (10, as the annotators).
+
+    Raises
+    ------
+    SegmentationError
+        A label image's shape differs from the map size the correspondence file recorded.
+
+    Warns
+    -----
+    RegionsRecomputedWarning
+        Stored region ids of cliques disagreed with their points in these segmentations.
 
     Examples
     --------
@@ -84,6 +103,8 @@ def match_table(match: Any) -> MatchTable:
     """
     if isinstance(match, MatchTable):
         return match
+    if hasattr(match, "cliques") and sketch_seg is not None and metric_seg is not None:
+        match = clique_regions(match, sketch_seg, metric_seg, tolerance=tolerance)
     metric_of: dict[int, list[int]] = {}
     clique_of: dict[int, int] = {}
     label_of: dict[int, str] = {}
@@ -123,6 +144,41 @@ def match_table(match: Any) -> MatchTable:
         label_of=label_of,
         pairs=tuple(pairs),
     )
+
+
+def clique_regions(corr: Any, sketch_seg: Any, metric_seg: Any, *, tolerance: float = 10) -> Any:
+    """``corr`` with the region ids of its cliques taken from their points in these segmentations.
+
+    :func:`~ursim_core.correspondences.assign_regions` on the cliques that have points; a clique
+    with no point at all (made in code from region ids) keeps its ids, since nothing says
+    otherwise.
+
+    Parameters
+    ----------
+    corr : Correspondences
+    sketch_seg, metric_seg : Segmentation or (rows, cols) integer array
+        The segmentations (their ``labels``) or the label images themselves.
+    tolerance : float, keyword-only
+        As in :func:`~ursim_core.correspondences.regions_at_points`.
+
+    Examples
+    --------
+    >>> from ursim_core.correspondences import Clique, Correspondences
+    >>> labels = np.array([[1, 1, 0, 2, 2]], dtype=np.int32)
+    >>> stale = Correspondences(cliques=(Clique(id=1, sketch_points=[(0, 4)], metric_points=[(0, 0)]),))
+    >>> clique_regions(stale, labels, labels).cliques[0].metric_regions
+    (1,)
+    """
+    from ursim_core.correspondences import assign_regions
+
+    sketch_labels = getattr(sketch_seg, "labels", sketch_seg)
+    metric_labels = getattr(metric_seg, "labels", metric_seg)
+    with_points = [clique for clique in corr.cliques if clique.sketch_points or clique.metric_points]
+    if not with_points:
+        return corr
+    assigned = assign_regions(corr.with_cliques(with_points), sketch_labels, metric_labels, tolerance=tolerance)
+    by_id = {clique.id: clique for clique in assigned.cliques}
+    return corr.with_cliques(by_id.get(clique.id, clique) for clique in corr.cliques)
 
 
 @dataclass(frozen=True)
@@ -248,13 +304,17 @@ def locate(
     Parameters
     ----------
     match : MatchResult, Correspondences, MatchTable, mapping or pairs
-        See :func:`match_table` (pass a table when calling many times).
+        See :func:`match_table`. The region ids of a Correspondences' cliques are taken from
+        their points in ``sketch_seg`` and ``metric_seg`` (:func:`clique_regions`), whatever ids
+        the file stored. When calling many times, pass the table of
+        ``match_table(corr, sketch_seg, metric_seg)`` instead: the assignment is then done once.
     sketch_seg, metric_seg : Segmentation
         The segmentations the match refers to (``labels`` and the region ``graph``).
     metric_map : Map or None
-        With a ``resolution`` the goal also gets a world ``pose``.
+        With a ``resolution`` the goal also gets a world ``pose``. When given, its shape must
+        be that of ``metric_seg.labels``.
     row, col : float
-        The sketch point, in sketch pixels.
+        The sketch point, in sketch pixels (finite numbers).
     target : {"interior", "mirror"}, keyword-only
         ``interior``: the interior point of the largest matched metric region (the place
         accuracy rule). ``mirror``: the point of the matched metric regions that best mirrors
@@ -273,6 +333,15 @@ def locate(
         ``goal.ok`` False with a ``reason`` when the tap is off every region or its region is
         unmatched.
 
+    Raises
+    ------
+    ParameterError
+        ``target`` unknown; ``row``, ``col``, ``tolerance`` or ``yaw`` not a finite number
+        (``tolerance`` >= 0); a segmentation without a 2-D label image; ``metric_map`` of
+        another shape than ``metric_seg`` (the arguments swapped?).
+    SegmentationError, RegionsRecomputedWarning
+        As :func:`match_table`, for a Correspondences.
+
     Examples
     --------
     >>> from ursim_core.segmentation.interface import Segmentation
@@ -287,7 +356,9 @@ def locate(
     """
     if target not in TARGETS:
         raise ParameterError(f"target must be one of {', '.join(TARGETS)}, got {target!r}", field="target")
-    table = match_table(match)
+    _check_inputs(sketch_seg, metric_seg, metric_map, row, col, tolerance, yaw)
+    # A correspondence file's stored ids may be another segmentation's: its points decide.
+    table = match_table(match, sketch_seg, metric_seg, tolerance=tolerance)
     point = (int(round(float(row))), int(round(float(col))))
     sketch_region = regions_at_points(sketch_seg.labels, [point], tolerance=tolerance)[0]
     if sketch_region == 0:
@@ -330,6 +401,41 @@ def locate(
         clique_id=clique_id,
         label=label,
     )
+
+
+def _check_inputs(sketch_seg, metric_seg, metric_map, row, col, tolerance, yaw) -> None:
+    """Refuse what would give a wrong goal without a word (swapped maps) or a numpy error."""
+    for name, value in (("row", row), ("col", col), ("yaw", yaw)):
+        if not _is_finite(value):
+            raise ParameterError(f"must be a finite number, got {value!r}", field=name)
+    if not (_is_finite(tolerance) and tolerance >= 0):
+        raise ParameterError(f"must be a finite number of pixels >= 0, got {tolerance!r}", field="tolerance")
+    for name, seg in (("sketch_seg", sketch_seg), ("metric_seg", metric_seg)):
+        if np.ndim(getattr(seg, "labels", None)) != 2:
+            raise ParameterError(
+                f"must be a Segmentation (a 2-D label image and its region graph), got {type(seg).__name__}",
+                field=name,
+            )
+    if metric_map is not None:
+        map_shape = tuple(np.shape(getattr(metric_map, "free", None)))
+        seg_shape = tuple(np.shape(metric_seg.labels))
+        if map_shape != seg_shape:
+            raise ParameterError(
+                f"metric_map is {_size(map_shape)} but metric_seg is {_size(seg_shape)}: "
+                "not the segmentation of this map (sketch and metric arguments swapped?)",
+                field="metric_map",
+            )
+
+
+def _is_finite(value: Any) -> bool:
+    try:
+        return math.isfinite(float(value))
+    except (TypeError, ValueError):
+        return False
+
+
+def _size(shape: tuple) -> str:
+    return "x".join(str(n) for n in shape) if shape else "not a map"
 
 
 def _nearest_matched(table: MatchTable, labels: np.ndarray, point: tuple[int, int]) -> NearestMatch | None:
