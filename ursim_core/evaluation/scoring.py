@@ -124,6 +124,13 @@ def score_matches(pairs: Iterable[tuple[int, int]], reference: Iterable, *, lega
     -------
     MatchScore
 
+    Raises
+    ------
+    ParameterError
+        The reference cliques have points but not one region id (e.g. from
+        :func:`~ursim_core.correspondences.load_dat`): call
+        :func:`~ursim_core.correspondences.assign_regions` first, else every clique is unusable.
+
     Notes
     -----
     Correct mode: precision is 0 when there are no pairs and recall is 0 when
@@ -145,7 +152,9 @@ def score_matches(pairs: Iterable[tuple[int, int]], reference: Iterable, *, lega
     """
     mode = _mode(legacy)
     pairs = tuple((operator.index(sketch), operator.index(metric)) for sketch, metric in pairs)
-    cliques = [_region_sets(item) for item in _cliques_of(reference)]
+    items = list(_cliques_of(reference))
+    _refuse_unassigned(items, "reference")
+    cliques = [_region_sets(item) for item in items]
 
     pair_cliques = tuple(
         tuple(index for index, (sketch_set, metric_set) in enumerate(cliques) if s in sketch_set and m in metric_set)
@@ -222,6 +231,11 @@ def score_cliques(predicted: Iterable, reference: Iterable, *, legacy: bool | st
     MatchScore
         ``pairs`` holds the generated pairs.
 
+    Raises
+    ------
+    ParameterError
+        Either side's cliques have points but no region id (see :func:`score_matches`).
+
     Examples
     --------
     >>> score = score_cliques([({1, 2}, {10})], [({1}, {10}), ({2}, {11})])
@@ -229,7 +243,9 @@ def score_cliques(predicted: Iterable, reference: Iterable, *, legacy: bool | st
     (((1, 10), (2, 10)), ('tp', 'fp'), 1)
     """
     pairs: dict[tuple[int, int], None] = {}
-    for item in _cliques_of(predicted):
+    predicted = list(_cliques_of(predicted))
+    _refuse_unassigned(predicted, "predicted")
+    for item in predicted:
         sketch_regions, metric_regions = _region_lists(item)
         for pair in product(sketch_regions, metric_regions):
             pairs.setdefault(pair, None)
@@ -251,6 +267,18 @@ def _mode(legacy: Any) -> str:
 def _cliques_of(items: Any) -> Sequence:
     # A Correspondences is scored through its cliques.
     return getattr(items, "cliques", items)
+
+
+def _refuse_unassigned(items: Sequence, name: str) -> None:
+    # Points and not one region id: never assigned. One id is enough (points off every region get none).
+    if any(getattr(item, "sketch_points", ()) or getattr(item, "metric_points", ()) for item in items) and all(
+        _region_lists(item) == ([], []) for item in items
+    ):
+        raise ParameterError(
+            f"the {name} cliques have points but no region ids: call ursim_core.correspondences.assign_regions"
+            f"({name}, sketch_labels, metric_labels) with the labels the pairs refer to first",
+            field=name,
+        )
 
 
 def _region_lists(item: Any) -> tuple[list[int], list[int]]:
