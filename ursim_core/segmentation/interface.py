@@ -8,6 +8,7 @@ and their adjacency graph (:func:`ursim_core.segmentation.graph.region_graph`) w
 
 from __future__ import annotations
 
+import os
 import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -315,6 +316,27 @@ def _resolve_method_params(method, preset, params, ParameterError) -> dict[str, 
     return PRESETS[preset].with_overrides(**(params or {})).to_dict()
 
 
+def _free_mask(map_or_free: Any) -> np.ndarray:
+    # A grey image's free pixels depend on a threshold (the loader's grey > 250, not "non-zero").
+    from ursim_core.errors import ParameterError
+
+    if hasattr(map_or_free, "free"):
+        return np.asarray(map_or_free.free, dtype=bool)
+    if isinstance(map_or_free, (str, bytes, os.PathLike)):
+        raise ParameterError(
+            f"got the path {os.fsdecode(map_or_free)!r}: pass a Map (ursim_core.io.load_map(path)) or a bool array",
+            field="map_or_free",
+        )
+    free = np.asarray(map_or_free)
+    if free.dtype != bool:
+        raise ParameterError(
+            f"expected a Map or a bool free-space mask, got an array of {free.dtype}: make a Map of an image "
+            "with ursim_core.io.map_from_array(array) (free: grey > 250, as load_map)",
+            field="map_or_free",
+        )
+    return free
+
+
 def segment(
     map_or_free: Any,
     *,
@@ -327,7 +349,8 @@ def segment(
     Parameters
     ----------
     map_or_free : Map or ndarray of bool
-        The map (its ``free`` mask is used) or a free-space mask.
+        The map (its ``free`` mask is used) or a free-space mask. Make a grey image a Map with
+        :func:`ursim_core.io.map_from_array` (free: grey > 250, as ``load_map``).
     method : str
         A key of :data:`SEGMENTERS`.
     preset : str, optional
@@ -336,6 +359,11 @@ def segment(
         'default' = 'sketch').
     params : dict, optional
         Overrides of single parameters.
+
+    Raises
+    ------
+    ParameterError
+        ``map_or_free`` is a path, or an array not of bool (a uint8 grey image, say).
 
     Examples
     --------
@@ -347,7 +375,7 @@ def segment(
     """
     from ursim_core.segmentation.regions import region_table
 
-    free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
+    free = _free_mask(map_or_free)
     resolved = resolve_params(method, preset, params)
     settings = {name: value for name, value in resolved.items() if name not in ("canonical", "canonical_turn_offset")}
     if resolved.get("canonical"):
@@ -430,7 +458,7 @@ def with_resamplings(
         return segmentation
     from ursim_core.segmentation.canonical import RESAMPLING_OFFSETS, turned_back
 
-    free = np.asarray(getattr(map_or_free, "free", map_or_free), dtype=bool)
+    free = _free_mask(map_or_free)
     if not turned_back(free):
         return segmentation
 
