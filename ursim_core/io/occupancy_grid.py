@@ -203,8 +203,9 @@ def map_from_occupancy_grid(
 
     Parameters
     ----------
-    data : sequence of int
-        ``width * height`` cells, row-major, row 0 at the origin (bottom).
+    data : sequence of int or 2-D array
+        ``width * height`` cells, row-major, row 0 at the origin (bottom); or an array of shape
+        ``(height, width)``, e.g. ``np.reshape(message.data, (height, width))``.
     width, height : int
     resolution : float
         Metres per cell.
@@ -224,7 +225,8 @@ def map_from_occupancy_grid(
     Raises
     ------
     MapError
-        Wrong number of cells, values outside int8, a bad origin, or no free cell.
+        Wrong number of cells, a 2-D ``data`` not of shape ``(height, width)``, values outside
+        int8, a bad origin, or no free cell.
 
     Examples
     --------
@@ -235,8 +237,20 @@ def map_from_occupancy_grid(
     >>> the_map.free.sum(), the_map.origin
     (np.int64(2), (1.0, 2.0, 0.0))
     """
+    cells = np.asarray(data, dtype=np.int64)
+    if cells.ndim > 1:
+        # ravel() would take a (width, height) array, or any other shape of as many cells, and
+        # read its rows as the grid's: a garbled map.
+        expected = (_positive_int(height, "height"), _positive_int(width, "width"))
+        if cells.shape != expected:
+            raise MapError(
+                f"data is a {cells.ndim}-D array of shape {cells.shape}, but (height, width) is {expected}: "
+                "a 2-D data array must be (height, width), row 0 at the origin (width and height swapped?)",
+                path=path,
+                field="data",
+            )
     grid = OccupancyGrid(
-        data=np.asarray(data, dtype=np.int64).ravel(),
+        data=cells.ravel(),
         width=width,
         height=height,
         resolution=resolution,

@@ -80,3 +80,23 @@ def test_a_grid_whose_corners_overflow_is_refused():
     with pytest.raises(MapError, match="from the world origin") as raised:
         OccupancyGrid(data=[0] * 4, width=2, height=2, resolution=1e306, origin=(1.7e308, 0.0, 0.0))
     assert raised.value.field == "origin"
+
+
+def test_a_2d_data_array_of_shape_height_width_is_the_grid():
+    cells = np.array([[0, 0, 100], [-1, 0, 0]])  # (height 2, width 3), row 0 at the origin
+    the_map = map_from_occupancy_grid(cells, 3, 2, 0.05)
+    assert np.array_equal(the_map.occupancy, cells[::-1])
+    assert np.array_equal(the_map.occupancy, map_from_occupancy_grid(cells.ravel(), 3, 2, 0.05).occupancy)
+
+
+@pytest.mark.parametrize(
+    "shape",
+    [(3, 2), (1, 6), (6, 1), (1, 2, 3)],
+    ids=["width-height-swapped", "one-row", "one-column", "3-d"],
+)
+def test_a_multi_dimensional_data_array_of_another_shape_is_refused(shape):
+    # The same six cells: ravel() used to read them as a 2 x 3 grid, garbled.
+    cells = np.zeros(shape, dtype=np.int64)
+    with pytest.raises(MapError, match=r"field 'data'.*\(height, width\) is \(2, 3\).*swapped") as raised:
+        map_from_occupancy_grid(cells, 3, 2, 0.05, path="scan.yaml")
+    assert str(raised.value).startswith("scan.yaml: ") and "\n" not in str(raised.value)
