@@ -147,8 +147,21 @@ class MatchResult:
         With ``laid``: how the sketch was laid on the metric map before it was bent
         (:class:`~ursim_core.matching.layings.Laying`: box onto box, or fitted to the planar
         answer's pairs; ``MatchConfig.elastic_laying``), to draw it again; None otherwise.
+
+    Examples
+    --------
+    The repr shows the answer; ``signatures``, ``c_matrix``, ``config``, ``m_scan`` and
+    ``orientation_scan`` are left out of it (read them as attributes):
+
+    >>> result = MatchResult([(1, 2)], [], [], [], 0.1, 3.0, 0.2, None, np.zeros((40, 40)), 1, 1, "", MatchConfig())
+    >>> repr(result)[:60]
+    'MatchResult(pairs=[(1, 2)], anchors=[], unique_sketch=[], un'
+    >>> "c_matrix" in repr(result), result.c_matrix.shape
+    (False, (40, 40))
     """
 
+    # repr=False: the signatures, c, the scans and the configuration made a repr of ~7,500
+    # characters that buried the answer (pairs, m, cost, reason); they stay attributes.
     pairs: list
     anchors: list
     unique_sketch: list
@@ -156,15 +169,15 @@ class MatchResult:
     m: float
     cost: float
     normalised_cost: float
-    signatures: tuple | None
-    c_matrix: np.ndarray
+    signatures: tuple | None = field(repr=False)
+    c_matrix: np.ndarray = field(repr=False)
     seeds_count: int
     hypotheses: int
     reason: str
-    config: MatchConfig
-    m_scan: dict = field(default_factory=dict)
+    config: MatchConfig = field(repr=False)
+    m_scan: dict = field(default_factory=dict, repr=False)
     orientation: tuple = (0.0, False)
-    orientation_scan: dict = field(default_factory=dict)
+    orientation_scan: dict = field(default_factory=dict, repr=False)
     resampling_votes: int = 0
     laid: bool = False
     laying: Any = None
