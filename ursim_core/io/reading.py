@@ -24,7 +24,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ursim_core.errors import UrsimError
+from ursim_core.errors import UrsimError, file_not_found
 
 __all__ = [
     "check_regular_file",
@@ -94,9 +94,12 @@ def check_regular_file(path: Path, *, error: type[UrsimError], what: str) -> os.
     try:
         info = os.stat(path)
     except FileNotFoundError:
+        # Also a FileNotFoundError (file_not_found): ``except FileNotFoundError`` catches it too.
         if os.path.islink(path):
-            raise error(f"dangling symbolic link to {os.readlink(path)} (no such file)", path=path) from None
-        raise error("file not found", path=path) from None
+            raise file_not_found(
+                error, f"dangling symbolic link to {os.readlink(path)} (no such file)", path=path
+            ) from None
+        raise file_not_found(error, "file not found", path=path) from None
     except ValueError:
         # os.stat refuses embedded NUL characters before asking the system.
         raise error("the file name contains a NUL character", path=path) from None

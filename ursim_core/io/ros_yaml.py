@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ursim_core.errors import MapError
+from ursim_core.errors import MapError, MapFileNotFoundError
 from ursim_core.io.images import Pixels, decode_image, display_grey, read_file_bytes, row_blocks, transparent_mask
 from ursim_core.io.reading import read_regular_file
 
@@ -106,13 +106,15 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
     image_path = _image_path(yaml_path, settings["image"])
     shown = _cut(str(image_path), 200)
     if not os.path.lexists(image_path):
-        raise MapError(f"image file not found: {shown}", path=yaml_path, field="image")
+        raise MapFileNotFoundError(f"image file not found: {shown}", path=yaml_path, field="image", filename=image_path)
     try:
         data = read_file_bytes(image_path, empty_problem="empty file (0 bytes): zero-size image", max_pixels=max_pixels)
         # nav2 loads through GraphicsMagick without auto-orientation, so EXIF is ignored here.
         pixels = decode_image(data, image_path, max_pixels=max_pixels, apply_exif_orientation=False)
     except MapError as error:
-        raise MapError(f"cannot load the image {shown}: {error.problem}", path=yaml_path, field="image") from error
+        problem = f"cannot load the image {shown}: {error.problem}"
+        kind = MapFileNotFoundError if isinstance(error, FileNotFoundError) else MapError
+        raise kind(problem, path=yaml_path, field="image") from error
     extent_problem = world_extent_problem(settings["resolution"], settings["origin"], pixels.colour.shape[:2])
     if extent_problem is not None:
         raise MapError(extent_problem[1], path=yaml_path, field=extent_problem[0])

@@ -43,7 +43,7 @@ def read_unchanged(path: str | Path, *, max_pixels: int | None = None, error=Non
     """
     import cv2
 
-    from ursim_core.errors import MapError
+    from ursim_core.errors import MapError, file_not_found
     from ursim_core.io.images import read_file_bytes
     from ursim_core.io.maps import DEFAULT_MAX_PIXELS
     from ursim_core.io.png import plain_png_size
@@ -53,6 +53,8 @@ def read_unchanged(path: str | Path, *, max_pixels: int | None = None, error=Non
     try:
         data = read_file_bytes(path, empty_problem="empty file, not an image", max_pixels=max_pixels)
     except MapError as problem:
+        if isinstance(problem, FileNotFoundError):
+            raise file_not_found(error, problem.problem, path=path) from None
         raise error(problem.problem, path=path) from None
     if plain_png_size(data, max_pixels=max_pixels) is None:
         # The header check lets through a file whose head Pillow cannot read alone (a small file,
@@ -104,11 +106,11 @@ def read_label_array(path: str | Path, *, max_pixels: int | None = None) -> np.n
     (checked before decoding, :func:`ursim_core.io.unchanged.read_unchanged`; default
     :data:`~ursim_core.io.maps.DEFAULT_MAX_PIXELS`, the map loader's).
     """
-    from ursim_core.errors import SegmentationError
+    from ursim_core.errors import LabelFileNotFoundError, SegmentationError
 
     path = Path(path)
     if not path.exists():
-        raise SegmentationError("label image not found", path=path)
+        raise LabelFileNotFoundError("label image not found", path=path)
     labels = read_unchanged(path, max_pixels=max_pixels, error=SegmentationError)
     if labels is None:
         raise SegmentationError("not a readable image", path=path)

@@ -6,6 +6,7 @@ import os
 import sys
 import threading
 import tracemalloc
+from pathlib import Path
 
 import pytest
 from io_helpers import VALID_YAML, _png, _refused, _yaml
@@ -115,3 +116,26 @@ def test_symlink_loop_in_yaml_image_says_so(tmp_path):
 def test_dangling_symlink_says_so(tmp_path):
     (tmp_path / "gone.png").symlink_to(tmp_path / "nowhere.png")
     assert "nowhere.png" in _refused(tmp_path / "gone.png")
+
+
+def test_a_missing_file_is_also_a_file_not_found_error_for_every_loader(tmp_path):
+    # ``except FileNotFoundError`` (what a Python caller writes) missed the loaders' errors; each
+    # stays its own kind too (MapError, FormatError, SegmentationError), naming the file.
+    from ursim_core.correspondences import load_correspondences, load_dat
+    from ursim_core.errors import FormatError, MapError, SegmentationError
+    from ursim_core.io import load_map
+    from ursim_core.segmentation import load_label_image
+
+    (tmp_path / "map.yaml").write_text("image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    cases = [
+        (load_map, tmp_path / "gone.png", MapError, tmp_path / "gone.png"),
+        (load_map, tmp_path / "map.yaml", MapError, tmp_path / "gone.pgm"),
+        (load_correspondences, tmp_path / "gone.json", FormatError, tmp_path / "gone.json"),
+        (load_dat, tmp_path / "gone.dat", FormatError, tmp_path / "gone.dat"),
+        (load_label_image, tmp_path / "gone.labels.png", SegmentationError, tmp_path / "gone.labels.png"),
+    ]
+    for loader, path, kind, missing in cases:
+        with pytest.raises(FileNotFoundError) as raised:
+            loader(path)
+        assert isinstance(raised.value, kind) and raised.value.path == path
+        assert Path(raised.value.filename) == missing and "\n" not in str(raised.value)
