@@ -84,6 +84,10 @@ def save_waypoints_yaml(poses: Iterable[Sequence[float]], path: str | Path) -> N
     atomic_write_text(Path(path), waypoints_yaml(poses))
 
 
+#: Far above any waypoint file (about 200 bytes a waypoint), far below what would hurt to read.
+MAX_WAYPOINT_BYTES = 16 * 1024**2
+
+
 def load_waypoints_yaml(path: str | Path) -> list[tuple[float, float, float]]:
     """Read a nav2 RViz-panel waypoint file back as (x, y, yaw) poses, in file order.
 
@@ -92,12 +96,16 @@ def load_waypoints_yaml(path: str | Path) -> list[tuple[float, float, float]]:
     import yaml
 
     from ursim_core.io.occupancy_grid import yaw_from_quaternion
+    from ursim_core.io.reading import decode_text, read_regular_file
 
     path = Path(path)
+    # Bounded, and never a named pipe (which would block the reader); a file not found is also a
+    # FileNotFoundError.
+    raw = read_regular_file(path, max_bytes=MAX_WAYPOINT_BYTES, error=FormatError, what="waypoint file")
     try:
-        document = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as error:
-        raise FormatError(f"cannot read the waypoint file: {error}", path=path) from None
+        document = yaml.safe_load(decode_text(raw, path, error=FormatError, what="waypoint file"))
+    except (yaml.YAMLError, ValueError, RecursionError) as error:
+        raise FormatError(f"cannot read the waypoint file: {' '.join(str(error).split())}", path=path) from None
     waypoints = document.get("waypoints") if isinstance(document, dict) else None
     if not isinstance(waypoints, dict):
         raise FormatError("not a nav2 waypoint file: no 'waypoints' map", path=path, field="waypoints")

@@ -285,11 +285,16 @@ def _writable(folder: Path) -> bool:
     return probe.is_dir() and os.access(probe, os.W_OK | os.X_OK)
 
 
+#: Far above any campaign's manifest (a path per sketch), far below what would hurt to read.
+MAX_MANIFEST_BYTES = 16 * 1024**2
+
+
 def _read_manifest(path: Path) -> dict:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as error:
-        raise FormatError(f"cannot read the campaign manifest: {error}", path=path) from error
+    from ursim_core.io.reading import read_json_file
+
+    # The project's guarded reader: a named pipe does not hang the app, deep nesting or a
+    # repeated key is a FormatError naming the file.
+    data = read_json_file(path, max_bytes=MAX_MANIFEST_BYTES, error=FormatError, what="campaign manifest")
     if (
         not isinstance(data, dict)
         or not isinstance(data.get("metric"), str)

@@ -40,3 +40,16 @@ def test_empty_and_bad_waypoint_files(tmp_path):
     (tmp_path / "other.yaml").write_text("goals: []\n")
     with pytest.raises(FormatError, match="no 'waypoints'"):
         load_waypoints_yaml(tmp_path / "other.yaml")
+
+
+def test_a_waypoint_file_that_is_a_pipe_or_missing_is_refused_naming_it(tmp_path):
+    # It was read with read_text: a named pipe blocked the reader forever.
+    import os
+
+    pipe = tmp_path / "wps.yaml"
+    os.mkfifo(pipe)
+    with pytest.raises(FormatError, match="named pipe") as raised:
+        load_waypoints_yaml(pipe)
+    assert raised.value.path == pipe
+    with pytest.raises(FileNotFoundError):
+        load_waypoints_yaml(tmp_path / "gone.yaml")

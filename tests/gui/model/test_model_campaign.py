@@ -60,3 +60,17 @@ def test_a_pairs_file_says_its_reading(tmp_path):
     save_correspondences(Correspondences(extra={"matcher": _record(0.001)}), path)
     assert pair_summary(path).close_call and pair_summary(path).reading.startswith("turned 90°, mirrored")
     assert pair_summary(tmp_path / "none.json").reading == ""
+
+
+def test_a_manifest_nested_deep_or_repeating_a_key_is_refused_naming_it(tmp_path):
+    # It was read with read_text + json.loads: deep nesting raised RecursionError (a traceback),
+    # and a repeated key silently kept the last value.
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 5000 + "]" * 5000)
+    with pytest.raises(FormatError, match="nested deeper") as raised:
+        open_campaign(deep)
+    assert raised.value.path == deep
+    twice = tmp_path / "twice.json"
+    twice.write_text('{"metric": "a.png", "metric": "b.png", "sketches": []}')
+    with pytest.raises(FormatError, match="'metric' appears twice"):
+        open_campaign(twice)
