@@ -20,7 +20,14 @@ from typing import Any
 from ursim_core.errors import ParameterError, SegmentationError
 from ursim_core.matching.config import MATCH_PRESETS, MatchConfig
 
-__all__ = ["MapsMatch", "map_ref", "sketch_segmentation_rule", "segment_for_matching", "segment_pair", "match_maps"]
+__all__ = [
+    "MapsMatch",
+    "map_ref",
+    "sketch_segmentation_rule",
+    "segment_for_matching",
+    "segment_pair",
+    "match_maps",
+]
 
 _SIDES = ("sketch", "metric")
 

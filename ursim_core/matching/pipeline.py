@@ -59,7 +59,7 @@ from ursim_core.matching.overlay_answer import prepare_overlay
 from ursim_core.matching.partial import PARTIAL_NOTE, looks_partial, reading_windows, window_starts_of
 from ursim_core.matching.refit import refit_by_transform, refit_from, refit_positions, signature_start
 from ursim_core.matching.resampling import voted_answer, with_resampled
-from ursim_core.matching.results import MatchResult, Prepared, replaced
+from ursim_core.matching.results import MatchResult, Prepared, replaced, require_segmentations
 from ursim_core.matching.single import match_at, pair_cost_matrix, seed_cap, seed_pairs
 
 __all__ = [
@@ -134,6 +134,7 @@ def prepare(
     >>> prepare(g, g.copy()).c_matrix.shape
     (3, 3)
     """
+    require_segmentations(sketch_seg, metric_seg)
     prepared = _prepare_one(sketch_seg, metric_seg, config, progress=progress, constraints=constraints)
     labels = elastic_labels(prepared, sketch_seg, metric_seg, largest=_SCREEN_BY_ASSIGNMENT)
     answers: dict = {}

@@ -10,6 +10,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from ursim_core.errors import ParameterError
 from ursim_core.matching.config import MatchConfig
 from ursim_core.matching.constraints import IndexConstraints, MatchConstraints, index_constraints
 from ursim_core.matching.descriptors import PairDescriptors
@@ -319,3 +320,24 @@ def readings_record(result: MatchResult) -> dict[str, Any]:
             for (degrees, mirrored), gap in ranked
         ]
     }
+
+
+def require_segmentations(sketch_seg: Any, metric_seg: Any) -> None:
+    """Refuse what :func:`~ursim_core.matching.pipeline.match` cannot take, naming the argument:
+    a map (``match(Map, Map)`` gave ``AttributeError: 'Map' object has no attribute 'graph'``),
+    an array, a path.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ursim_core.io import map_from_array
+    >>> require_segmentations(map_from_array(np.full((4, 4), 255, np.uint8)), None)
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: field 'sketch_seg': must be a Segmentation or a region graph, got Map: segment it first (ursim_core.matching.match_maps matches two maps)
+    """
+    for name, value in (("sketch_seg", sketch_seg), ("metric_seg", metric_seg)):
+        if hasattr(value, "graph") or (hasattr(value, "nodes") and hasattr(value, "edges")):
+            continue
+        hint = ": segment it first (ursim_core.matching.match_maps matches two maps)" if hasattr(value, "free") else ""
+        raise ParameterError(f"must be a Segmentation or a region graph, got {type(value).__name__}{hint}", field=name)

@@ -127,3 +127,14 @@ def test_a_configuration_is_built_without_importing_the_matcher():
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.split() == ["False", "False"]
+
+
+def test_match_refuses_maps_naming_the_argument_and_what_to_call():
+    # match(Map, Map) gave "AttributeError: 'Map' object has no attribute 'graph'".
+    the_map = map_from_array(_rooms())
+    with pytest.raises(ParameterError, match="match_maps") as raised:
+        match(the_map, the_map)
+    assert raised.value.field == "sketch_seg"
+    with pytest.raises(ParameterError) as raised:
+        match(segment(the_map), "metric.png")
+    assert raised.value.field == "metric_seg" and "got str" in str(raised.value)
