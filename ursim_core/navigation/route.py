@@ -125,7 +125,8 @@ def plan_route(
     Parameters
     ----------
     match : MatchResult, Correspondences, MatchTable, mapping or pairs
-        See :func:`~ursim_core.navigation.goal.match_table`.
+        See :func:`~ursim_core.navigation.goal.match_table`; a Correspondences' region ids are
+        taken from its points in ``sketch_seg`` and ``metric_seg``, as :func:`locate` does.
     sketch_seg, metric_seg : Segmentation
     metric_map : Map or None
         With a ``resolution``, waypoints get world poses.
@@ -159,7 +160,7 @@ def plan_route(
     samples = sample_polyline(points)
     if len(samples) == 0:
         raise ParameterError("a route needs at least one point")
-    table = match_table(match)
+    table = match_table(match, sketch_seg, metric_seg, tolerance=tolerance)
     regions = regions_at_points(sketch_seg.labels, samples, tolerance=tolerance)
     sketch_sequence = _without_repeats(r for r in regions if r != 0)
     metric_graph = metric_seg.graph

@@ -43,7 +43,10 @@ class NavigationSession:
     ----------
     match : MatchResult, Correspondences, MatchTable, mapping or pairs
         See :func:`~ursim_core.navigation.goal.match_table`; call :meth:`set_match` when the
-        user edits the cliques.
+        user edits the cliques. A Correspondences' stored region ids are used as they are (the
+        app keeps them those of ``sketch_seg`` and ``metric_seg``, and a table built on every
+        edit stays cheap): pass ``match_table(corr, sketch_seg, metric_seg)`` for a file saved
+        with other segmentations.
     sketch_seg, metric_seg : Segmentation
     metric_map : Map or None
         With a resolution, goals and waypoints get world poses.

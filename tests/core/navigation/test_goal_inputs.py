@@ -172,3 +172,25 @@ def test_kth_goals_of_a_file_made_with_other_segmentations_follow_the_points(tmp
         got = [locate(loaded, sketch_seg, metric_seg, metric_map, r, c).pixel for r, c in points]
     assert got == [locate(table, sketch_seg, metric_seg, metric_map, r, c).pixel for r, c in points]
     assert sum(pixel is not None for pixel in got) >= len(points) - 1
+
+
+def test_a_route_over_a_loaded_file_follows_its_points_too(tmp_path):
+    # plan_route used a file's stored region ids whatever segmentations it was given.
+    from ursim_core.correspondences import Clique, Correspondences
+    from ursim_core.navigation.route import plan_route
+    from ursim_core.segmentation.graph import region_graph
+    from ursim_core.segmentation.interface import Segmentation
+
+    labels = np.zeros((10, 30), np.int32)
+    labels[:, :10], labels[:, 10:20], labels[:, 20:] = 1, 2, 3
+    seg = Segmentation(labels=labels, graph=region_graph(labels))
+    # Points in regions 1 and 3 of these segmentations; the ids stored are another's (3 and 1).
+    corr = Correspondences(
+        cliques=(
+            Clique(id=1, sketch_points=[(5, 2)], metric_points=[(5, 2)], sketch_regions=(3,), metric_regions=(1,)),
+            Clique(id=2, sketch_points=[(5, 28)], metric_points=[(5, 28)], sketch_regions=(1,), metric_regions=(3,)),
+        )
+    )
+    with pytest.warns(RegionsRecomputedWarning):
+        route = plan_route(corr, seg, seg, None, [(5, 2), (5, 28)])
+    assert route.metric_regions == (1, 2, 3)
