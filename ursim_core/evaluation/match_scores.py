@@ -76,7 +76,9 @@ def score_against_reference(
 
     pairs = list(pairs)
     assigned = assign_regions(reference, sketch_seg.labels, metric_seg.labels, tolerance=tolerance)
-    pair_score = score_matches(pairs, assigned)
+    # As region sets: assigned here, so cliques whose points all fell off every region (and have
+    # no ids) are unusable, not a sign that assign_regions was forgotten.
+    pair_score = score_matches(pairs, [(c.sketch_regions, c.metric_regions) for c in assigned.cliques])
     reference_params = resolve_params("maoris", PLACE_REFERENCE_PRESET, {})
     # A segmentation records its resolved parameters: the matcher's is reused when it is the
     # reference one (a metric map's is never canonical).

@@ -58,3 +58,10 @@ def test_a_metric_segmentation_of_another_preset_is_scored_on_the_place_referenc
     scores = score_against_reference(pairs, _truth((60, 40), (60, 100), (60, 150)), sketch, coarse, the_map)
     assert scores.pairs.f1 == 1.0
     assert scores.place.successes == 1 and scores.place.n_points == 3  # one place holds the goal
+
+
+def test_a_reference_whose_points_fall_off_every_region_scores_zero_without_an_error():
+    found = match_maps(map_from_array(_rooms()), map_from_array(_rooms()))
+    far = _truth((0, 199), (119, 0))  # in the walls, farther than 10 px from any room
+    scores = score_against_reference(found.result.pairs, far, found.sketch_seg, found.metric_seg, found.metric_map)
+    assert scores.pairs.tp == 0 and scores.pairs.fp == len(found.result.pairs)
