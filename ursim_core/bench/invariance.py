@@ -168,7 +168,8 @@ def run_case(
     ``segmentations``: a dict that keeps the transformed sketch's segmentation for a later call
     on the same case (it does not depend on what the matcher is told)."""
     from ursim_core.correspondences import regions_at_points
-    from ursim_core.evaluation.scoring import place_problem, score_matches, score_places
+    from ursim_core.evaluation.place import place_problem, score_places
+    from ursim_core.evaluation.scoring import score_matches
     from ursim_core.matching import MatchConfig, match
     from ursim_core.matching.orientation import same_reading
     from ursim_core.segmentation import segment_canonical

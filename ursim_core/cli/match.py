@@ -2,7 +2,7 @@
 
 With ``--reference FILE`` (a ground-truth .dat or correspondence JSON of the same pair) the result
 is also scored: precision, recall, F1 (:func:`ursim_core.evaluation.scoring.score_matches`) and
-place accuracy (:func:`ursim_core.evaluation.scoring.place_accuracy`, places in the MAORIS
+place accuracy (:func:`ursim_core.evaluation.place.place_accuracy`, places in the MAORIS
 ``default`` segmentation of the metric map).
 """
 

@@ -1,6 +1,8 @@
 """Scoring matches against ground truth and running the paper's experiments.
 
-Owns: pair scores and place accuracy (:mod:`~ursim_core.evaluation.scoring`), the dataset
+Owns: pair scores (:mod:`~ursim_core.evaluation.scoring`), place accuracy
+(:mod:`~ursim_core.evaluation.place`), both for one match against a file
+(:mod:`~ursim_core.evaluation.match_scores`), the dataset
 layouts and where the datasets are (:mod:`~ursim_core.evaluation.layouts`,
 :mod:`~ursim_core.evaluation.datasets`), the experiment runner behind ``ursim evaluate``
 (:mod:`~ursim_core.evaluation.runner`, with its segmentation cache :mod:`~ursim_core.evaluation.cache`,
@@ -30,6 +32,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
         "kth_protocol",
         "layouts",
         "match_scores",
+        "place",
         "plots",
         "pool",
         "published",
@@ -47,10 +50,8 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "score_matches",
             "score_cliques",
             "SCORING_MODES",
-            "PlaceScore",
-            "place_accuracy",
-            "PLACE_REFERENCE_PRESET",
         ],
+        "place": ["PLACE_REFERENCE_PRESET", "PlaceScore", "place_accuracy"],
         "ceiling": ["Ceiling", "best_one_to_one"],
         "match_scores": ["MatchScores", "score_against_reference"],
         "augment": ["Orientation", "DIHEDRAL", "parse_augment", "transform_image", "transform_points"],

@@ -4,7 +4,7 @@
 A reference file's region ids belong to the segmentation it was saved with (or, for a ``.dat``
 file, to none): its cliques are assigned regions from their points in the matcher's
 segmentations first. Place accuracy needs a fixed reference segmentation of the metric map
-(:data:`~ursim_core.evaluation.scoring.PLACE_REFERENCE_PRESET`); the matcher's own is used when
+(:data:`~ursim_core.evaluation.place.PLACE_REFERENCE_PRESET`); the matcher's own is used when
 it is that one, else the metric map is segmented with it.
 """
 
@@ -13,7 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ursim_core.evaluation.scoring import MatchScore, PlaceScore
+from ursim_core.evaluation.place import PlaceScore
+from ursim_core.evaluation.scoring import MatchScore
 
 __all__ = ["MatchScores", "score_against_reference"]
 
@@ -71,7 +72,8 @@ def score_against_reference(
     (1, 1.0)
     """
     from ursim_core.correspondences import assign_regions
-    from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, place_accuracy, score_matches
+    from ursim_core.evaluation.place import PLACE_REFERENCE_PRESET, place_accuracy
+    from ursim_core.evaluation.scoring import score_matches
     from ursim_core.segmentation import resolve_params, segment
 
     pairs = list(pairs)

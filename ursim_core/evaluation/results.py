@@ -86,7 +86,7 @@ class RunRow:
     Human-vs-human rows have ``matcher='human'``, ``variant`` = the annotator whose cliques were
     scored, ``annotator`` = the reference annotator, ``m_label='-'`` and ``m_value`` NaN.
 
-    ``place_accuracy`` is :func:`ursim_core.evaluation.scoring.place_accuracy` of the same pairs
+    ``place_accuracy`` is :func:`ursim_core.evaluation.place.place_accuracy` of the same pairs
     (NaN when no clique could be scored); ``augment`` the orientation of the sketch
     (:attr:`ursim_core.evaluation.augment.Orientation.name`, '' when the run was not augmented).
     """

@@ -45,6 +45,7 @@ from ursim_core.errors import ParameterError
 from ursim_core.evaluation.augment import UPRIGHT, Orientation, parse_augment
 from ursim_core.evaluation.cache import SegmentationJob, segment_all
 from ursim_core.evaluation.layouts import Experiment, discover
+from ursim_core.evaluation.place import PLACE_REFERENCE_PRESET
 from ursim_core.evaluation.pool import Progress, ProgressCallback
 from ursim_core.evaluation.results import (
     AUTO,
@@ -61,7 +62,7 @@ from ursim_core.evaluation.results import (
     summarise,
     summarise_human,
 )
-from ursim_core.evaluation.scoring import PLACE_REFERENCE_PRESET, score_matches
+from ursim_core.evaluation.scoring import score_matches
 from ursim_core.evaluation.tasks import (
     Instance,
     MatchTask,
@@ -170,7 +171,7 @@ def run_evaluation(
         needs the ``distributed`` extra). The rows are the same as a local run's.
 
     Every run is scored by pair F1 and by place accuracy
-    (:func:`ursim_core.evaluation.scoring.place_accuracy`), against a reference segmentation of
+    (:func:`ursim_core.evaluation.place.place_accuracy`), against a reference segmentation of
     each metric map with the MAORIS ``default`` preset and default loading.
 
     Returns

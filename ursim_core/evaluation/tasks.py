@@ -12,7 +12,7 @@ evaluation is augmented); the ground-truth sketch points of a turned sketch are 
    (:func:`ursim_core.matching.match_prepared`) and scored against every annotator. These tasks
    run on the process pool, the segmentations handed to each worker once.
    Each run is also scored by place accuracy
-   (:func:`ursim_core.evaluation.scoring.place_accuracy`) against a fixed reference segmentation
+   (:func:`ursim_core.evaluation.place.place_accuracy`) against a fixed reference segmentation
    of the metric map (MAORIS ``default``, the one the annotators clicked on).
 3. Human vs human: on a map pair that several annotators annotated, each annotator's cliques are
    scored against each other's (:func:`ursim_core.evaluation.scoring.score_cliques`).
@@ -29,9 +29,10 @@ from typing import Any
 
 from ursim_core.evaluation.cache import SegmentationJob
 from ursim_core.evaluation.layouts import Experiment
+from ursim_core.evaluation.place import place_problem, score_places
 from ursim_core.evaluation.pool import Progress, completed
 from ursim_core.evaluation.results import AUTO, CEILING, HUMAN, RunRow, m_label
-from ursim_core.evaluation.scoring import place_problem, score_cliques, score_matches, score_places
+from ursim_core.evaluation.scoring import score_cliques, score_matches
 
 __all__ = [
     "Instance",

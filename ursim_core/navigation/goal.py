@@ -271,7 +271,7 @@ def interior_target(metric_graph: Any, metric_regions: Any) -> tuple[int, tuple[
     """Where the robot is sent for a sketch region matched to ``metric_regions``.
 
     The largest of them (pixel count; the smallest id on ties) and its interior point, the pixel
-    farthest from its border. Place accuracy (:func:`ursim_core.evaluation.scoring.place_accuracy`)
+    farthest from its border. Place accuracy (:func:`ursim_core.evaluation.place.place_accuracy`)
     and :func:`locate` both call this, so a goal and the score of goals are one rule.
 
     Examples

@@ -12,8 +12,8 @@ tolerance, as the evaluation), so the three are compared on the same regions:
 - F1 of the *ceiling* against A and against B: the one-to-one answer with the best mean F1
   against both at once (:func:`ursim_core.evaluation.ceiling.best_one_to_one`), what any
   one-to-one matcher can reach where A and B disagree;
-- place accuracy of the same, when the core has ``scoring.place_accuracy``
-  (its reference metric segmentation is the pair's metric segmentation here).
+- place accuracy of the same (:func:`ursim_core.evaluation.place.place_accuracy`;
+  its reference metric segmentation is the pair's metric segmentation here).
 
 The whole set pools TP / FP / FN over the pairs (a micro F1) and averages place accuracy
 over the pairs that have one.
@@ -99,14 +99,14 @@ def region_sets(corr: Correspondences, sketch_labels, metric_labels, *, which: s
 
 
 def _compare(claimed, reference, *, place_inputs=None) -> Agreement:
-    from ursim_core.evaluation import scoring
+    from ursim_core.evaluation.place import place_accuracy
+    from ursim_core.evaluation.scoring import score_matches
 
     pairs = sorted({pair for _id, sketch, metric in claimed for pair in product(sketch, metric)})
-    score = scoring.score_matches(pairs, [(sketch, metric) for _id, sketch, metric in reference])
+    score = score_matches(pairs, [(sketch, metric) for _id, sketch, metric in reference])
     defined = (score.tp + score.fp) > 0 and (score.tp + score.fn) > 0
     place = None
-    place_accuracy = getattr(scoring, "place_accuracy", None)
-    if place_accuracy is not None and place_inputs is not None:
+    if place_inputs is not None:
         reference_corr, sketch_labels, metric_labels = place_inputs
         value = place_accuracy(pairs, reference_corr, sketch_labels, metric_labels, metric_labels).accuracy
         place = None if math.isnan(value) else float(value)

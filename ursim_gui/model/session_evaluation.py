@@ -85,7 +85,8 @@ class EvaluationOperations:
             self._evaluation = None
             self._clique_marks = {}
             return
-        from ursim_core.evaluation.scoring import place_accuracy, score_matches
+        from ursim_core.evaluation.place import place_accuracy
+        from ursim_core.evaluation.scoring import score_matches
 
         pairs, owners = [], []
         for clique in self._corr.cliques:
@@ -112,5 +113,5 @@ class EvaluationOperations:
 
     @property
     def place(self):
-        """``ursim_core.evaluation.scoring.PlaceScore`` of the non-rejected cliques, or None."""
+        """``ursim_core.evaluation.place.PlaceScore`` of the non-rejected cliques, or None."""
         return getattr(self, "_place", None)

@@ -103,7 +103,7 @@ class AgreementPanel(QWidget):
                 self.table.setItem(index, 1 + 2 * column, QTableWidgetItem(_text(value and value.f1)))
                 self.table.setItem(index, 2 + 2 * column, QTableWidgetItem(_text(value and value.place)))
         self.export_button.setEnabled(bool(rows))
-        # Place accuracy needs the core's scoring.place_accuracy: no empty columns without it.
+        # No place accuracy without the segmentations it is read on: no empty columns then.
         has_place = any(value.place is not None for _name, comparisons in lines for value in comparisons.values())
         for column in range(len(COMPARISONS)):
             self.table.setColumnHidden(2 + 2 * column, not has_place)

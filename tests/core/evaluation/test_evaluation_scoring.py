@@ -9,14 +9,8 @@ import pytest
 
 from ursim_core.correspondences import Clique, Correspondences
 from ursim_core.errors import ParameterError
-from ursim_core.evaluation.scoring import (
-    MatchScore,
-    place_accuracy,
-    place_problem,
-    score_cliques,
-    score_matches,
-    score_places,
-)
+from ursim_core.evaluation.place import place_accuracy, place_problem, score_places
+from ursim_core.evaluation.scoring import MatchScore, score_cliques, score_matches
 from ursim_core.segmentation.graph import region_graph
 
 # Three one-to-one cliques.
