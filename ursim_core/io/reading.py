@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import stat
 from collections.abc import Callable
 from pathlib import Path
@@ -208,7 +209,6 @@ MAX_JSON_DEPTH = 64
 # The most digits an integer may have and still convert to a float (10**308 < 1.8e308):
 # every number the project reads ends up as one.
 _MAX_INT_DIGITS = 308
-_LARGEST_FLOAT_INT = int(1.7976931348623157e308)
 
 
 def decode_text(raw: bytes, path: Path, *, error: type[UrsimError], what: str) -> str:
@@ -285,13 +285,13 @@ def parse_json(
     what : str
         What the file should be, for the messages ("points file").
     max_depth : int or None, optional
-        Most levels of arrays and objects inside each other; None leaves the depth and the
-        integers' size to the caller, which walks the document anyway (the correspondence
-        codec, to name the field).
+        Most levels of arrays and objects inside each other; None leaves the depth to the
+        caller, which walks the document anyway (the correspondence codec, to name the field).
     out_of_range : callable, optional
-        Given the text of a number that is not a finite float (``1e999``) or an integer too
-        long for ``int()``, returns the value to keep in its place: a placeholder the caller
-        refuses later with the field's path. By default such numbers are refused here.
+        Given the text of a number that is not a finite float (``1e999``) or an integer of
+        more than 308 digits (too large for the float every number becomes), returns the value
+        to keep in its place: a placeholder the caller refuses later with the field's path. By
+        default such numbers are refused here.
 
     Examples
     --------
@@ -320,18 +320,13 @@ def parse_json(
 
     hooks = {"object_pairs_hook": _refuse_duplicate_keys, "parse_constant": _refuse_constant}
     try:
-        try:
+        if _LONG_DIGITS.search(text) is None:
             document = json.loads(text, parse_float=parse_float, **hooks)
-        except ValueError as problem:
-            if isinstance(problem, (json.JSONDecodeError, _JsonRefused)) or "digits" not in str(problem):
-                raise
-
-            # An integer too long for int() (rare): parse again, each integer through Python.
+        else:
+            # A run of more digits than a float's integers have (rare; C-speed to find): every
+            # integer through Python, those too large for a float kept by the caller's rule.
             def parse_int(number: str):
-                try:
-                    return int(number)
-                except ValueError:
-                    return keep(number)
+                return keep(number) if len(number.lstrip("-")) > _MAX_INT_DIGITS else int(number)
 
             document = json.loads(text, parse_float=parse_float, parse_int=parse_int, **hooks)
     except json.JSONDecodeError as problem:
@@ -343,14 +338,15 @@ def parse_json(
     except (ValueError, OverflowError) as problem:
         raise error(f"not JSON for a {what}: {problem}", path=path) from None
     if max_depth is not None:
-        _check_depth_and_integers(document, path, error=error, what=what, max_depth=max_depth)
+        _check_depth(document, path, error=error, what=what, max_depth=max_depth)
     return document
 
 
 _INF = float("inf")
+_LONG_DIGITS = re.compile(rf"\d{{{_MAX_INT_DIGITS + 1}}}")
 
 
-def _check_depth_and_integers(document, path: Path, *, error, what: str, max_depth: int) -> None:
+def _check_depth(document, path: Path, *, error, what: str, max_depth: int) -> None:
     # An explicit stack: a check of depth must not itself recurse.
     stack = [(document, 1)]
     while stack:
@@ -359,12 +355,6 @@ def _check_depth_and_integers(document, path: Path, *, error, what: str, max_dep
             if depth > max_depth:
                 raise error(f"not JSON for a {what}: nested deeper than {max_depth} levels", path=path)
             stack.extend((item, depth + 1) for item in (value.values() if isinstance(value, dict) else value))
-        elif type(value) is int and not -_LARGEST_FLOAT_INT <= value <= _LARGEST_FLOAT_INT:
-            digits = len(str(abs(value)))
-            raise error(
-                f"not JSON for a {what}: an integer of {digits} digits is too large (at most {_MAX_INT_DIGITS})",
-                path=path,
-            )
 
 
 def read_json_file(path: Path, *, max_bytes: int, error: type[UrsimError], what: str, max_depth: int = MAX_JSON_DEPTH):

@@ -608,6 +608,10 @@ def test_deep_nesting_is_a_format_error(tmp_path, depth):
         ({"sketch_regions": [2.0]}, "cliques[0].sketch_regions[0]"),
         ({"score": "1e400"}, "cliques[0].score"),
         ({"id": "9" * 5000}, "cliques[0].id"),
+        # Too large for a float but not for int(): loaded, then an OverflowError in the first
+        # float() (ursim goal, match --reference, locate).
+        ({"sketch_points": "[[" + "9" * 400 + ", 2]]"}, "cliques[0].sketch_points[0][0]"),
+        ({"metric_regions": "[" + "9" * 309 + "]"}, "cliques[0].metric_regions[0]"),
     ],
 )
 def test_numbers_that_crashed_are_format_errors(tmp_path, change, field):
