@@ -276,11 +276,25 @@ def write_json(document: Any, output: str | None) -> None:
     from ursim_core.correspondences.json_text import finite_json
 
     text = finite_json(document, output or "<standard output>", indent=2) + "\n"
-    sys.stdout.write(text)
+    if not (output and _is_standard_output(output)):
+        sys.stdout.write(text)  # not twice for `-o /dev/stdout | jq .`
     if output:
         from ursim_core.io.atomic import atomic_write_text
 
+        sys.stdout.flush()
         atomic_write_text(Path(output), text)
+
+
+def _is_standard_output(output: str) -> bool:
+    """Whether the file ``output`` is this process's standard output (``/dev/stdout``, or the
+    file or pipe it was redirected to)."""
+    import os
+
+    try:
+        mine, theirs = os.fstat(sys.stdout.fileno()), os.stat(output)
+    except (OSError, ValueError, AttributeError):
+        return False  # no file behind sys.stdout (captured), or no such output yet
+    return (mine.st_dev, mine.st_ino) == (theirs.st_dev, theirs.st_ino)
 
 
 def cmd_goal(args: argparse.Namespace) -> int:
