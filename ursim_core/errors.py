@@ -27,8 +27,8 @@ __all__ = [
     "FileChangedError",
     "UrsimFileNotFoundError",
     "MapFileNotFoundError",
-    "CorrespondenceFileNotFoundError",
-    "LabelFileNotFoundError",
+    "FormatFileNotFoundError",
+    "SegmentationFileNotFoundError",
     "file_not_found",
     "UrsimWarning",
     "MapChangedWarning",
@@ -167,12 +167,13 @@ class MapFileNotFoundError(UrsimFileNotFoundError, MapError):
     """A map file (image, ROS YAML or the image it names) does not exist."""
 
 
-class CorrespondenceFileNotFoundError(UrsimFileNotFoundError, FormatError):
-    """A correspondence file (JSON or .dat), or another file read as a :class:`FormatError`, does not exist."""
+class FormatFileNotFoundError(UrsimFileNotFoundError, FormatError):
+    """A file read as a :class:`FormatError` (a correspondence file, points, waypoints, a
+    manifest) does not exist."""
 
 
-class LabelFileNotFoundError(UrsimFileNotFoundError, SegmentationError):
-    """A label image does not exist."""
+class SegmentationFileNotFoundError(UrsimFileNotFoundError, SegmentationError):
+    """A file read as a :class:`SegmentationError` (a label image, a learned merge model) does not exist."""
 
 
 def _rebuild_not_found(cls, problem, path, field, filename):
@@ -183,8 +184,8 @@ def _rebuild_not_found(cls, problem, path, field, filename):
 _NOT_FOUND = {
     UrsimError: UrsimFileNotFoundError,
     MapError: MapFileNotFoundError,
-    FormatError: CorrespondenceFileNotFoundError,
-    SegmentationError: LabelFileNotFoundError,
+    FormatError: FormatFileNotFoundError,
+    SegmentationError: SegmentationFileNotFoundError,
 }
 
 
@@ -214,7 +215,7 @@ def file_not_found(
     --------
     >>> found = file_not_found(FormatError, "file not found", path="corr.json")
     >>> type(found).__name__, isinstance(found, FileNotFoundError)
-    ('CorrespondenceFileNotFoundError', True)
+    ('FormatFileNotFoundError', True)
     >>> type(file_not_found(ParameterError, "file not found", path="p.json")).__name__
     'ParameterError'
     """

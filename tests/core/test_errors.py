@@ -9,9 +9,9 @@ import pytest
 
 from ursim_core import errors
 from ursim_core.errors import (
-    CorrespondenceFileNotFoundError,
+    FormatFileNotFoundError,
     FormatError,
-    LabelFileNotFoundError,
+    SegmentationFileNotFoundError,
     MapError,
     MapFileNotFoundError,
     ParameterError,
@@ -24,8 +24,8 @@ from ursim_core.errors import (
 KINDS = [
     (UrsimError, UrsimFileNotFoundError),
     (MapError, MapFileNotFoundError),
-    (FormatError, CorrespondenceFileNotFoundError),
-    (SegmentationError, LabelFileNotFoundError),
+    (FormatError, FormatFileNotFoundError),
+    (SegmentationError, SegmentationFileNotFoundError),
 ]
 
 
@@ -76,6 +76,6 @@ def test_other_error_types_are_given_as_they_are():
 
 
 def test_the_not_found_classes_are_exported():
-    for name in ("UrsimFileNotFoundError", "MapFileNotFoundError", "CorrespondenceFileNotFoundError"):
+    for name in ("UrsimFileNotFoundError", "MapFileNotFoundError", "FormatFileNotFoundError"):
         assert name in errors.__all__
-    assert "LabelFileNotFoundError" in errors.__all__ and "file_not_found" in errors.__all__
+    assert "SegmentationFileNotFoundError" in errors.__all__ and "file_not_found" in errors.__all__

@@ -113,8 +113,9 @@ def read_ros_yaml(yaml_path: Path, *, max_pixels: int) -> RosMap:
         pixels = decode_image(data, image_path, max_pixels=max_pixels, apply_exif_orientation=False)
     except MapError as error:
         problem = f"cannot load the image {shown}: {error.problem}"
-        kind = MapFileNotFoundError if isinstance(error, FileNotFoundError) else MapError
-        raise kind(problem, path=yaml_path, field="image") from error
+        if isinstance(error, FileNotFoundError):  # a dangling link: the image it names is missing
+            raise MapFileNotFoundError(problem, path=yaml_path, field="image", filename=error.filename) from error
+        raise MapError(problem, path=yaml_path, field="image") from error
     extent_problem = world_extent_problem(settings["resolution"], settings["origin"], pixels.colour.shape[:2])
     if extent_problem is not None:
         raise MapError(extent_problem[1], path=yaml_path, field=extent_problem[0])

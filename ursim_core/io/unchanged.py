@@ -106,11 +106,11 @@ def read_label_array(path: str | Path, *, max_pixels: int | None = None) -> np.n
     (checked before decoding, :func:`ursim_core.io.unchanged.read_unchanged`; default
     :data:`~ursim_core.io.maps.DEFAULT_MAX_PIXELS`, the map loader's).
     """
-    from ursim_core.errors import LabelFileNotFoundError, SegmentationError
+    from ursim_core.errors import SegmentationFileNotFoundError, SegmentationError
 
     path = Path(path)
     if not path.exists():
-        raise LabelFileNotFoundError("label image not found", path=path)
+        raise SegmentationFileNotFoundError("label image not found", path=path)
     labels = read_unchanged(path, max_pixels=max_pixels, error=SegmentationError)
     if labels is None:
         raise SegmentationError("not a readable image", path=path)

@@ -41,7 +41,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from ursim_core.correspondences import Correspondences, load_correspondences
-from ursim_core.errors import FormatError, UrsimError
+from ursim_core.errors import FormatError, UrsimError, file_not_found
 from ursim_core.io.atomic import atomic_write_bytes
 
 __all__ = [
@@ -226,9 +226,15 @@ def open_campaign(
         folder = source
         pairs_in = _folder_pairs(source)
         name = source.name
+    elif not os.path.lexists(source):
+        raise file_not_found(
+            FormatError,
+            "campaign not found: give a dataset folder, a folder of sketches or a manifest .json",
+            path=source,
+        )
     else:
         raise FormatError(
-            "campaign not found: give a dataset folder, a folder of sketches or a manifest .json", path=source
+            "not a campaign: give a dataset folder, a folder of sketches or a manifest .json", path=source
         )
     if output_dir is None and manifest.get("output"):
         output_dir = (folder / str(manifest["output"])).absolute()

@@ -139,3 +139,13 @@ def test_a_missing_file_is_also_a_file_not_found_error_for_every_loader(tmp_path
             loader(path)
         assert isinstance(raised.value, kind) and raised.value.path == path
         assert Path(raised.value.filename) == missing and "\n" not in str(raised.value)
+
+
+def test_a_yaml_whose_image_is_a_dangling_link_names_the_image_as_missing(tmp_path):
+    from ursim_core.io import load_map
+
+    (tmp_path / "map.pgm").symlink_to(tmp_path / "gone.pgm")
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    with pytest.raises(FileNotFoundError, match="dangling symbolic link") as raised:
+        load_map(tmp_path / "map.yaml")
+    assert raised.value.path == tmp_path / "map.yaml" and Path(raised.value.filename) == tmp_path / "map.pgm"

@@ -74,3 +74,9 @@ def test_a_manifest_nested_deep_or_repeating_a_key_is_refused_naming_it(tmp_path
     twice.write_text('{"metric": "a.png", "metric": "b.png", "sketches": []}')
     with pytest.raises(FormatError, match="'metric' appears twice"):
         open_campaign(twice)
+
+
+def test_a_campaign_that_is_not_there_is_also_a_file_not_found_error(tmp_path):
+    with pytest.raises(FileNotFoundError, match="campaign not found") as raised:
+        open_campaign(tmp_path / "gone")
+    assert isinstance(raised.value, FormatError) and raised.value.path == tmp_path / "gone"
