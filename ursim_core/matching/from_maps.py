@@ -13,6 +13,7 @@ where this pipeline scores 1.00 / 0.55 / 0.92 and 0.93 / 0.75 / 0.83 (round 60).
 
 from __future__ import annotations
 
+import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
@@ -171,6 +172,12 @@ def segment_for_matching(
 
     if side not in _SIDES:
         raise ParameterError(f"side must be 'sketch' or 'metric', got {side!r}", field="side")
+    if not hasattr(the_map, "free"):
+        hint = " (load it first: ursim_core.io.load_map(path))" if isinstance(the_map, (str, os.PathLike)) else ""
+        raise ParameterError(
+            f"must be a Map (ursim_core.io.load_map or map_from_array), got {type(the_map).__name__}{hint}",
+            field=f"{side}_map",
+        )
     preset = MATCH_PRESETS[side] if preset is None else preset
     canonical, resampled = (
         sketch_segmentation_rule(config, constrained=constrained) if side == "sketch" else (False, False)

@@ -138,3 +138,12 @@ def test_match_refuses_maps_naming_the_argument_and_what_to_call():
     with pytest.raises(ParameterError) as raised:
         match(segment(the_map), "metric.png")
     assert raised.value.field == "metric_seg" and "got str" in str(raised.value)
+
+
+def test_a_path_given_for_a_map_is_refused_naming_the_argument():
+    with pytest.raises(ParameterError, match="load_map") as raised:
+        match_maps("sketch.png", map_from_array(_rooms()))
+    assert raised.value.field == "sketch_map"
+    with pytest.raises(ParameterError) as raised:
+        match_maps(map_from_array(_rooms()), _rooms())
+    assert raised.value.field == "metric_map" and "ndarray" in str(raised.value)
