@@ -123,7 +123,7 @@ def tolerance_value(text: str) -> float:
 
 def add_navigation_options(parser: argparse.ArgumentParser) -> None:
     """Map, segmentation and correspondence options shared by ``ursim goal`` and ``ursim route``."""
-    from ursim_core.matching.config import MATCH_PRESETS
+    from ursim_core.cli.match_options import add_preset_options
 
     parser.add_argument("sketch", metavar="SKETCH", help="the sketch image")
     parser.add_argument("metric", metavar="METRIC", help="the robot's map: map_server YAML (or an image: pixels only)")
@@ -132,16 +132,7 @@ def add_navigation_options(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="use these cliques (JSON) instead of matching; their label images are used when present",
     )
-    parser.add_argument(
-        "--sketch-preset",
-        default=MATCH_PRESETS["sketch"],
-        help=f"sketch segmentation (default {MATCH_PRESETS['sketch']})",
-    )
-    parser.add_argument(
-        "--metric-preset",
-        default=MATCH_PRESETS["metric"],
-        help=f"metric segmentation (default {MATCH_PRESETS['metric']})",
-    )
+    add_preset_options(parser)
     parser.add_argument(
         "--tolerance", type=tolerance_value, default=10, help="px from a region a point still counts (default 10)"
     )

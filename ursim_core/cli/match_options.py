@@ -20,7 +20,6 @@ __all__ = ["add_pair_options", "orientation_value", "match_config", "OPTION_NAME
 def add_pair_options(parser: argparse.ArgumentParser) -> None:
     """The matching, segmentation and map-loading options of a pair (``match`` and ``match-batch``)."""
     # The presets' defaults come from the matcher's options (which import no networkx).
-    from ursim_core.matching.config import MATCH_PRESETS
 
     parser.add_argument("--m", default="auto", help="threshold m on the signature difference, or 'auto' (default)")
     parser.add_argument(
@@ -73,16 +72,7 @@ def add_pair_options(parser: argparse.ArgumentParser) -> None:
         help="any other matching option (a MatchConfig field, e.g. vote_orientations=first); repeatable, "
         "and it wins over the options above",
     )
-    parser.add_argument(
-        "--sketch-preset",
-        default=MATCH_PRESETS["sketch"],
-        help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)",
-    )
-    parser.add_argument(
-        "--metric-preset",
-        default=MATCH_PRESETS["metric"],
-        help=f"segmentation preset for the metric map (default {MATCH_PRESETS['metric']})",
-    )
+    add_preset_options(parser)
     parser.add_argument(
         "--param", action="append", metavar="NAME=VALUE", help="segmentation parameter override (both maps)"
     )
@@ -166,3 +156,20 @@ OPTION_NAMES = (
 def options_of(args: argparse.Namespace) -> dict[str, Any]:
     """The pair options of parsed arguments as a plain (picklable) dict."""
     return {name: getattr(args, name) for name in OPTION_NAMES}
+
+
+def add_preset_options(parser: argparse.ArgumentParser) -> None:
+    """``--sketch-preset`` and ``--metric-preset``, the segmentations the matcher expects by
+    default (:data:`~ursim_core.matching.config.MATCH_PRESETS`); for match and for goal / route."""
+    from ursim_core.matching.config import MATCH_PRESETS
+
+    parser.add_argument(
+        "--sketch-preset",
+        default=MATCH_PRESETS["sketch"],
+        help=f"segmentation preset for the sketch (default {MATCH_PRESETS['sketch']}, measured best for matching)",
+    )
+    parser.add_argument(
+        "--metric-preset",
+        default=MATCH_PRESETS["metric"],
+        help=f"segmentation preset for the metric map (default {MATCH_PRESETS['metric']})",
+    )
