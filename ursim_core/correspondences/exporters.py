@@ -343,7 +343,17 @@ def _number(value: float) -> str:
 
 def export_format_of(path: str | Path, format: str | None = None) -> str:
     """The export format named by ``format`` or by the file name (``.geojson``, ``.points``,
-    ``.labelme.json``); :class:`~ursim_core.errors.ParameterError` when neither says."""
+    ``.labelme.json``); :class:`~ursim_core.errors.ParameterError` when neither says.
+
+    Examples
+    --------
+    >>> export_format_of("rooms.geojson"), export_format_of("pair.points"), export_format_of("a.txt", "labelme")
+    ('geojson', 'qgis-points', 'labelme')
+    >>> export_format_of("rooms.json")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: rooms.json: cannot tell the export format from the name (use ...)
+    """
     if format is not None:
         if format not in EXPORT_FORMATS:
             raise ParameterError(f"unknown export format '{format}' (known: {', '.join(EXPORT_FORMATS)})")
@@ -376,6 +386,17 @@ def export_correspondences(
     side per file); ``metric_map`` georeferences the QGIS points (which hold both sides). A
     coordinate that is not a finite number is a :class:`~ursim_core.errors.FormatError` naming
     ``path`` and the field, and nothing is written.
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> from ursim_core.correspondences import Clique, Correspondences
+    >>> corr = Correspondences(cliques=(Clique(id=1, sketch_points=[(10, 20)], metric_points=[(5, 7)]),))
+    >>> target = Path(tempfile.mkdtemp()) / "pair.geojson"
+    >>> export_correspondences(corr, target)  # the format from the name; the metric side
+    'geojson'
+    >>> json.loads(target.read_text())["features"][0]["geometry"]  # [x, y] = [col + 0.5, row + 0.5]
+    {'type': 'Point', 'coordinates': [7.5, 5.5]}
     """
     kind = export_format_of(path, format)
     if kind == "geojson":
@@ -409,6 +430,18 @@ def export_file(
     ParameterError
         Unknown format or side. FormatError / MapError / SegmentationError for unreadable
         inputs, naming the file.
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> from ursim_core.correspondences import Clique, Correspondences, save_correspondences
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> hall = Clique(id=1, sketch_points=[(10, 20)], extra={"label": "hall"})
+    >>> _ = save_correspondences(Correspondences(cliques=(hall,)), folder / "pair.json")
+    >>> export_file(folder / "pair.json", folder / "pair.labelme.json", side="sketch")
+    'labelme'
+    >>> json.loads((folder / "pair.labelme.json").read_text())["shapes"][0]["points"]  # [x, y]
+    [[20.5, 10.5]]
     """
     from ursim_core.correspondences import load_correspondences, load_dat
 

@@ -131,6 +131,18 @@ def check_maps(corr: Correspondences, sketch_map, metric_map, path: str | os.Pat
     -----
     MapChangedWarning
         Same size, other SHA-256 (as :func:`load_correspondences` with the maps).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ursim_core.io import map_from_array
+    >>> sketch, plan = map_from_array(np.ones((4, 6), bool)), map_from_array(np.ones((5, 5), bool))
+    >>> corr = Correspondences(MapRef(size=(4, 6)), MapRef(size=(5, 5)))
+    >>> check_maps(corr, sketch, plan, "pair.json")  # the pair the file was made on: silent
+    >>> check_maps(corr, plan, plan, "pair.json")
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: pair.json: made on a sketch map of 4x6 px, not this one of 5x5 px: ...
     """
     for side, ref, loaded in (("sketch", corr.sketch, sketch_map), ("metric", corr.metric, metric_map)):
         shape = tuple(getattr(loaded, "shape", ())[:2])

@@ -43,6 +43,14 @@ class Ceiling:
     exact : bool
         False when the search stopped at :data:`NODE_BUDGET` nodes: ``mean_f1`` is then what the
         best answer found reaches, a lower bound of the ceiling.
+
+    Examples
+    --------
+    >>> ana = ben = [({1}, {10}), ({2}, {20})]
+    >>> cy = [({1}, {10}), ({2}, {21})]  # the third annotator put sketch region 2 elsewhere
+    >>> ceiling = best_one_to_one([ana, ben, cy])
+    >>> ceiling.pairs, ceiling.f1, round(ceiling.mean_f1, 3), ceiling.exact
+    (((1, 10), (2, 20)), (1.0, 1.0, 0.5), 0.833, True)
     """
 
     pairs: tuple[tuple[int, int], ...]

@@ -70,6 +70,19 @@ class Experiment:
     input_kind : {'sketch', 'metric'}
         What the input map is: 'metric' for the Halmstad robot maps (the layout holds robot maps
         only), so that the automatic matcher overlays them (``MatchConfig.input_kind``).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp()).resolve()  # a Halmstad layout: robot maps against a model
+    >>> (root / "GT" / "Malcolm").mkdir(parents=True)
+    >>> for name in ("E5_01.png", "GT/Malcolm/model_simple.png", "GT/Malcolm/gt_E5_01_model_simple.dat"):
+    ...     _ = (root / name).write_bytes(b"")
+    >>> (experiment,) = discover(root)
+    >>> experiment.name, experiment.layout, experiment.input_kind, experiment.annotators
+    ('E5_01', 'halmstad', 'metric', ('malcolm',))
+    >>> experiment.metric.relative_to(root).as_posix(), experiment.ground_truth["malcolm"].name
+    ('GT/Malcolm/model_simple.png', 'gt_E5_01_model_simple.dat')
     """
 
     name: str

@@ -21,7 +21,20 @@ __all__ = ["MatchScores", "score_against_reference"]
 
 @dataclass(frozen=True)
 class MatchScores:
-    """Both scores of one match: ``pairs`` (precision, recall, F1) and ``place`` (accuracy)."""
+    """Both scores of one match: ``pairs`` (precision, recall, F1) and ``place`` (accuracy).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ursim_core.correspondences import Clique, Correspondences
+    >>> from ursim_core.segmentation import segment
+    >>> free = np.zeros((60, 130), bool); free[5:55, 5:60] = free[5:55, 70:125] = free[27:33, 60:70] = True
+    >>> seg = segment(free, preset="default")  # two rooms: 1 on the left, 2 on the right
+    >>> left = Clique(id=1, sketch_points=[(30, 30)], metric_points=[(30, 30)])
+    >>> scores = score_against_reference([(1, 2)], Correspondences(cliques=(left,)), seg, seg, free)
+    >>> scores.pairs.f1, scores.pairs.pair_labels, scores.place.accuracy  # the robot goes to room 2
+    (0.0, ('fp',), 0.0)
+    """
 
     pairs: MatchScore
     place: PlaceScore

@@ -43,6 +43,16 @@ class PlaceScore:
         Sketch points sent to the right place, and sketch points scored.
     n_cliques : int
         Cliques scored: with points on both sides and a non-empty place.
+
+    Examples
+    --------
+    Three rooms in a row, the same in both maps; the second clique has no metric point:
+
+    >>> labels = np.array([[1, 1, 1, 2, 2, 2, 3, 3, 3]])
+    >>> reference = [([(0, 1)], [(0, 1)]), ([(0, 4)], []), ([(0, 7), (0, 8)], [(0, 7)])]
+    >>> score = place_accuracy([(1, 1), (3, 2)], reference, labels, labels, labels)
+    >>> score.accuracy, score.per_clique, score.clique_indices, (score.successes, score.n_points)
+    (0.5, (1.0, 0.0), (0, 2), (1, 3))
     """
 
     accuracy: float

@@ -101,6 +101,17 @@ class Map:
         For ROS maps: 0 free, 100 occupied, -1 unknown (trinary view); else None.
     image : ndarray of uint8 or None
         The grey image as loaded (for display), shape (rows, cols).
+
+    Examples
+    --------
+    Usually made by :func:`load_map` or :func:`map_from_array`; by hand, a georeferenced map:
+
+    >>> free = np.zeros((10, 20), bool); free[2:8, 2:18] = True
+    >>> room = Map(free=free, resolution=0.05, origin=(-1.0, 2.0, 0.0))
+    >>> room
+    Map(shape=(10, 20), free=96 px, resolution=0.05, origin=(-1.0, 2.0, 0.0))
+    >>> room.name, pixel_to_world(room, 9, 0)  # no file; the lower-left pixel's centre in metres
+    ('map', (-0.975, 2.025))
     """
 
     free: np.ndarray

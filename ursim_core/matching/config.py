@@ -295,6 +295,18 @@ class MatchConfig:
         metric map ('neighbours', default: a drawn room bent over two rooms with a wall between
         belongs to one of them), or all of them ('all', before round 53;
         :func:`~ursim_core.matching.laid.joined_partners`). Evidence: docs/options.md.
+
+    Examples
+    --------
+    >>> upright = MatchConfig(orientation="upright")  # a sketch drawn in the metric map's orientation
+    >>> upright.orientation, upright.m, upright.resolved().matcher
+    ('upright', 'auto', 'planar')
+    >>> MatchConfig.paper().m, MatchConfig.paper().replace(m=0.1).m  # the paper's method at another m
+    (0.15, 0.1)
+    >>> MatchConfig(m=-0.1)
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.ParameterError: field 'm': must be 'auto' or a non-negative number, not -0.1
     """
 
     variant: str = "T4"

@@ -325,6 +325,17 @@ class PairDescriptors:
         position distance when ``position_weight > 0``).
     notes : list of str
         Degenerate conditions met on the way (empty when none).
+
+    Examples
+    --------
+    >>> g = nx.path_graph(4)  # four rooms in a row, the first much larger
+    >>> nx.set_node_attributes(g, {0: 100, 1: 10, 2: 12, 3: 11}, "size")
+    >>> nx.set_node_attributes(g, 0.5, "pca_shape")
+    >>> d = pair_descriptors(g, g.copy())
+    >>> d.unique_sketch, d.anchors, d.sketch_signatures.shape, d.c_matrix.argmin(axis=1).tolist()
+    ([0], [(0, 0)], (4, 15), [0, 1, 2, 3])
+    >>> d.notes[0]
+    "sketch attribute 'pca_shape' has zero variance"
     """
 
     sketch_nodes: list

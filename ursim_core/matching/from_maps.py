@@ -36,7 +36,18 @@ _SIDES = ("sketch", "metric")
 @dataclass(frozen=True)
 class MapsMatch:
     """What :func:`match_maps` made: both maps and segmentations, the answer, and the
-    configuration the matcher ran with (``scale`` filled in from two georeferenced maps)."""
+    configuration the matcher ran with (``scale`` filled in from two georeferenced maps).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ursim_core.io import map_from_array
+    >>> image = np.zeros((100, 170), np.uint8)  # a large and a small room joined by a corridor
+    >>> image[10:90, 10:70] = image[30:70, 100:150] = image[45:55, 70:100] = 255
+    >>> found = match_maps(map_from_array(image), map_from_array(image), config=MatchConfig(orientation="upright"))
+    >>> found.sketch_seg.n_regions, sorted(found.result.pairs), found.config.orientation
+    (3, [(1, 1), (2, 2), (3, 3)], 'upright')
+    """
 
     sketch_map: Any = field(repr=False)
     metric_map: Any = field(repr=False)
@@ -83,7 +94,18 @@ class MapsMatch:
 
 def map_ref(the_map: Any, segmentation: Any, *, labels_path=None):
     """The :class:`~ursim_core.correspondences.MapRef` of a map and its segmentation: the map's
-    file (absolute), digest and size, the segmenter and its parameters, the label image's path."""
+    file (absolute), digest and size, the segmenter and its parameters, the label image's path.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ursim_core.io import map_from_array
+    >>> from ursim_core.segmentation import segment
+    >>> room = map_from_array(np.ones((40, 60), bool), path="room.png")
+    >>> ref = map_ref(room, segment(room, preset="default"), labels_path="room.labels.png")
+    >>> ref.path.is_absolute(), ref.size, ref.segmentation_method, ref.labels_path.name
+    (True, (40, 60), 'maoris', 'room.labels.png')
+    """
     from pathlib import Path
 
     from ursim_core.correspondences import MapRef
@@ -206,6 +228,16 @@ def segment_pair(
     The MAORIS kernels and OpenCV release the GIL, so two building-sized maps take about the
     time of the larger one (8000 px: about 13 s instead of 23 s). The segmentations are those of
     one after the other; when both fail, the sketch's error is the one raised.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ursim_core.io import map_from_array
+    >>> image = np.zeros((100, 170), np.uint8)  # a large and a small room joined by a corridor
+    >>> image[10:90, 10:70] = image[30:70, 100:150] = image[45:55, 70:100] = 255
+    >>> sketch_seg, metric_seg = segment_pair(map_from_array(image), map_from_array(image))
+    >>> sketch_seg.n_regions, sketch_seg.params["canonical"], "canonical" in metric_seg.params
+    (3, True, False)
     """
     from ursim_core.segmentation import segment  # noqa: F401 - imported once here, not by two threads
 

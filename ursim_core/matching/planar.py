@@ -79,6 +79,16 @@ class PlanarGraph:
         Cyclic neighbour order of each vertex (indices).
     edges : list of (int, int)
         Undirected edges as index pairs, each once.
+
+    Examples
+    --------
+    >>> g = nx.star_graph([10, 20, 30, 40])  # hall 10 opens onto rooms 20 (left), 30 (below), 40 (right)
+    >>> nx.set_node_attributes(g, {10: (5, 5), 20: (5, 0), 30: (10, 5), 40: (5, 10)}, "centroid")
+    >>> p = planar_graph(g)
+    >>> p.nodes, p.neighbours[0], p.edges  # indices: 0 is region 10; its neighbours in angular order
+    ([10, 20, 30, 40], [1, 3, 2], [(0, 1), (0, 2), (0, 3)])
+    >>> p.n_vertices, p.branching
+    (4, [True, False, False, False])
     """
 
     nodes: list

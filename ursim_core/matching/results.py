@@ -30,7 +30,21 @@ __all__ = [
 
 @dataclass(frozen=True, eq=False)
 class Prepared:
-    """Everything of a map pair that does not depend on m (see :func:`prepare`)."""
+    """Everything of a map pair that does not depend on m (see :func:`prepare`).
+
+    Examples
+    --------
+    >>> from ursim_core.matching.pipeline import match_prepared, prepare
+    >>> g = nx.cycle_graph(4)  # four rooms around a courtyard
+    >>> nx.set_node_attributes(g, {0: 90, 1: 10, 2: 20, 3: 30}, "size")
+    >>> nx.set_node_attributes(g, {0: 0.1, 1: 0.5, 2: 0.3, 3: 0.2}, "pca_shape")
+    >>> nx.set_node_attributes(g, {0: (0, 0), 1: (0, 10), 2: (10, 10), 3: (10, 0)}, "centroid")
+    >>> prepared = prepare(g, g.copy())  # orientation unknown: the candidate orientations are tried
+    >>> prepared.orientation, len(prepared.orientation_scan), prepared.c_matrix.shape
+    ((0.0, False), 4, (4, 4))
+    >>> sorted(match_prepared(prepared, 0.1).pairs)  # matched at any m without preparing again
+    [(0, 0), (1, 1), (2, 2), (3, 3)]
+    """
 
     config: MatchConfig
     sketch_graph: nx.Graph

@@ -59,6 +59,17 @@ class MatchTable:
         sketch region -> semantic label of its clique, when it has one.
     pairs : tuple of (int, int)
         Every (sketch, metric) pair, for the mirror target's alignment.
+
+    Examples
+    --------
+    Made by :func:`match_table`; from a correspondence file, its points decide the regions:
+
+    >>> from ursim_core.correspondences import Clique, Correspondences
+    >>> labels = np.zeros((10, 20), np.int32); labels[:, :9] = 1; labels[:, 11:] = 2
+    >>> kitchen = Clique(id=5, sketch_points=[(4, 3)], metric_points=[(4, 15)], extra={"label": "kitchen"})
+    >>> table = match_table(Correspondences(cliques=(kitchen,)), labels, labels)
+    >>> table.metric_of, table.clique_of, table.label_of, table.pairs
+    ({1: (2,)}, {1: 5}, {1: 'kitchen'}, ((1, 2),))
     """
 
     metric_of: dict = field(default_factory=dict)
@@ -183,7 +194,20 @@ def clique_regions(corr: Any, sketch_seg: Any, metric_seg: Any, *, tolerance: fl
 
 @dataclass(frozen=True)
 class NearestMatch:
-    """The matched sketch region nearest to an unmatched tap (offered instead)."""
+    """The matched sketch region nearest to an unmatched tap (offered instead).
+
+    Examples
+    --------
+    >>> from ursim_core.segmentation import Segmentation, region_table
+    >>> labels = np.zeros((10, 20), np.int32); labels[:, :9] = 1; labels[:, 11:] = 2  # two rooms
+    >>> seg = Segmentation(labels, regions=region_table(labels))
+    >>> goal = locate([(1, 2)], seg, seg, None, 4, 15)  # a tap in sketch region 2, which is unmatched
+    >>> goal.nearest
+    NearestMatch(sketch_region=1, point=(4, 8), distance=7.0)
+    >>> print(goal.failure_message())
+    sketch point (4, 15): sketch region 2 is not matched to any metric region;
+    the nearest matched region is 1, at (4, 8), 7.0 px away
+    """
 
     sketch_region: int
     point: tuple[int, int]
@@ -216,6 +240,16 @@ class Goal:
         Empty on success, else why there is no goal.
     nearest : NearestMatch or None
         For an unmatched tap: the nearest matched sketch region, if any was asked for.
+
+    Examples
+    --------
+    >>> from ursim_core.io import Map
+    >>> from ursim_core.segmentation import Segmentation, region_table
+    >>> labels = np.zeros((10, 20), np.int32); labels[:, :9] = 1; labels[:, 11:] = 2  # two rooms
+    >>> seg = Segmentation(labels, regions=region_table(labels))
+    >>> goal = locate([(1, 2)], seg, seg, Map(free=labels > 0, resolution=0.5), 4, 3)
+    >>> goal.ok, goal.sketch_region, goal.metric_region, goal.pixel, goal.pose  # pose: x, y (m), yaw
+    (True, 1, 2, (4, 15), (7.75, 2.75, 0.0))
     """
 
     sketch_point: tuple[int, int]

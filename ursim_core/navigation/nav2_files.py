@@ -80,7 +80,19 @@ def waypoints_yaml(poses: Iterable[Sequence[float]]) -> str:
 
 
 def save_waypoints_yaml(poses: Iterable[Sequence[float]], path: str | Path) -> None:
-    """Write :func:`waypoints_yaml` to ``path`` atomically."""
+    """Write :func:`waypoints_yaml` to ``path`` atomically.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "route.yaml"
+    >>> save_waypoints_yaml([(1.0, 2.0, 0.0)], path)  # (x, y, yaw) in the map frame
+    >>> print(path.read_text(), end="")  # the orientation quaternion is [w, x, y, z]
+    waypoints:
+      waypoint0:
+        pose: [1.0, 2.0, 0.0]
+        orientation: [1.0, 0.0, 0.0, 0.0]
+    """
     atomic_write_text(Path(path), waypoints_yaml(poses))
 
 
@@ -92,6 +104,19 @@ def load_waypoints_yaml(path: str | Path) -> list[tuple[float, float, float]]:
     """Read a nav2 RViz-panel waypoint file back as (x, y, yaw) poses, in file order.
 
     Raises :class:`~ursim_core.errors.FormatError` naming the file and the field on bad input.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "route.yaml"
+    >>> save_waypoints_yaml([(1.0, 2.0, math.pi / 2), (3.0, 2.0, 0.0)], path)
+    >>> [tuple(round(v, 4) for v in pose) for pose in load_waypoints_yaml(path)]  # (x, y, yaw)
+    [(1.0, 2.0, 1.5708), (3.0, 2.0, 0.0)]
+    >>> _ = path.write_text("goals: []\\n")
+    >>> load_waypoints_yaml(path)
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.FormatError: ...route.yaml: field 'waypoints': not a nav2 waypoint file: no 'waypoints' map
     """
     import yaml
 

@@ -29,7 +29,20 @@ __all__ = ["Route", "Waypoint", "plan_route", "sample_polyline"]
 
 @dataclass(frozen=True)
 class Waypoint:
-    """One stop of a route: a metric region, its interior pixel and, when georeferenced, a pose."""
+    """One stop of a route: a metric region, its interior pixel and, when georeferenced, a pose.
+
+    Examples
+    --------
+    >>> from ursim_core.io import Map
+    >>> from ursim_core.segmentation import Segmentation, region_table
+    >>> labels = np.zeros((10, 20), np.int32); labels[:, :10], labels[:, 10:] = 1, 2  # two rooms
+    >>> seg = Segmentation(labels, regions=region_table(labels))
+    >>> route = plan_route({1: 1, 2: 2}, seg, seg, Map(free=labels > 0, resolution=0.1), [(5, 2), (5, 18)])
+    >>> route.waypoints[0]  # heading 0: towards +x, where the next waypoint is
+    Waypoint(metric_region=1, pixel=(4, 4), pose=(0.45, 0.55, 0.0), sketch_region=1, label=None, filled=False)
+    >>> route.waypoints[1].to_dict()["pose"]  # JSON: rounded to 6 decimals
+    [1.45, 0.55, 0.0]
+    """
 
     metric_region: int
     pixel: tuple[int, int]
@@ -64,6 +77,16 @@ class Route:
     gaps : tuple of (int, int)
         Consecutive metric regions that no path of the region graph connects (the route is
         broken there; the robot's planner may still find a way).
+
+    Examples
+    --------
+    >>> from ursim_core.segmentation import Segmentation, region_table
+    >>> labels = np.zeros((10, 30), np.int32)
+    >>> labels[:, :10], labels[:, 10:20], labels[:, 20:] = 1, 2, 3  # three rooms in a row
+    >>> seg = Segmentation(labels, regions=region_table(labels))
+    >>> route = plan_route([(1, 1), (3, 3)], seg, seg, None, [(5, 2), (5, 28)])  # room 2 unmatched
+    >>> route.sketch_regions, route.skipped, route.metric_regions, route.path, route.gaps
+    ((1, 2, 3), (2,), (1, 2, 3), [(4, 4), (4, 14), (4, 24)], ())
     """
 
     waypoints: tuple[Waypoint, ...] = ()

@@ -66,6 +66,15 @@ def label_colors(labels: np.ndarray, colors: dict[int, Sequence[int]] | None = N
         Label image.
     colors : dict, optional
         Fixed colours for some labels; the others get :func:`distinct_colors`.
+
+    Examples
+    --------
+    >>> labels = np.array([[0, 1, 1], [3, 3, 0]])
+    >>> table = label_colors(labels, {3: (255, 0, 0)})  # region 3 red, the others distinct colours
+    >>> table.tolist()
+    [[0, 0, 0], [242, 85, 85], [85, 131, 242], [255, 0, 0]]
+    >>> table[labels].shape  # the label image in colour
+    (2, 3, 3)
     """
     n = int(labels.max()) + 1 if labels.size else 1
     table = np.zeros((n, 3), np.uint8)
@@ -209,6 +218,17 @@ def side_by_side_matches(
     exceeds ``max_side`` pixels is drawn scaled down to it (None: never): a building-sized
     map would otherwise give a figure of hundreds of megabytes that takes longer to draw
     than to match.
+
+    Examples
+    --------
+    >>> from ursim_core.segmentation.graph import region_graph
+    >>> labels = np.zeros((40, 60), np.int32); labels[2:38, 2:30] = 1; labels[2:38, 30:58] = 2
+    >>> rooms = (labels, region_graph(labels), None)  # labels, region graph, grey image or None
+    >>> figure = side_by_side_matches(rooms, rooms, [(1, 2)], gap=10)  # sketch region 1 is metric 2
+    >>> figure.shape  # 60 px, the gap, 60 px
+    (40, 130, 3)
+    >>> figure[4, 4].tolist(), figure[4, 70 + 34].tolist(), figure[4, 34].tolist()  # unmatched: grey
+    ([245, 136, 136], [245, 136, 136], [220, 220, 220])
     """
     pair_colors = distinct_colors(max(len(pairs), 1))
     grey = np.array((205, 205, 205), np.uint8)
@@ -274,7 +294,19 @@ def _shrunk(labels: np.ndarray, graph: nx.Graph, image: np.ndarray | None, max_s
 
 
 def save_png(path: str | Path, rgb: np.ndarray) -> None:
-    """Write an RGB (or grey) uint8 image as PNG, atomically."""
+    """Write an RGB (or grey) uint8 image as PNG, atomically.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from PIL import Image
+    >>> rgb = np.zeros((2, 3, 3), np.uint8); rgb[0, 0] = (255, 0, 0)
+    >>> path = Path(tempfile.mkdtemp()) / "figure.png"
+    >>> save_png(path, rgb)
+    >>> with Image.open(path) as png:
+    ...     png.size, png.mode, png.getpixel((0, 0))  # Pillow's size is (width, height)
+    ((3, 2), 'RGB', (255, 0, 0))
+    """
     array = np.asarray(rgb)
     if array.ndim == 3:
         array = cv2.cvtColor(array, cv2.COLOR_RGB2BGR)

@@ -36,6 +36,21 @@ def load_label_image(
     max_pixels : int, optional
         Largest image read (:func:`read_label_array`); by default the map loader's default, or
         the pixels of ``shape`` when more (the map was loaded with a higher limit).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from ursim_core.segmentation import region_table
+    >>> labels = np.array([[0, 7, 7], [3, 3, 0]], np.int32)
+    >>> path = Path(tempfile.mkdtemp()) / "rooms.png"
+    >>> save_label_image(Segmentation(labels, regions=region_table(labels)), path)
+    >>> seg = load_label_image(path, shape=(2, 3))
+    >>> seg.labels.tolist(), seg.method, sorted(seg.regions.nodes)  # ids kept as stored
+    ([[0, 7, 7], [3, 3, 0]], 'label-image', [3, 7])
+    >>> load_label_image(path, shape=(3, 3))
+    Traceback (most recent call last):
+    ...
+    ursim_core.errors.SegmentationError: ...rooms.png: label image is 2x3 (rows x cols) but the map is 3x3
     """
 
     from ursim_core.errors import SegmentationError
@@ -56,7 +71,18 @@ def load_label_image(
 
 
 def save_label_image(segmentation: Segmentation, path: str | Path) -> None:
-    """Write the label image as a 16-bit PNG (0 = no region), atomically."""
+    """Write the label image as a 16-bit PNG (0 = no region), atomically.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from ursim_core.segmentation import region_table
+    >>> labels = np.array([[0, 1], [2, 300]], np.int32)
+    >>> path = Path(tempfile.mkdtemp()) / "labels.png"
+    >>> save_label_image(Segmentation(labels, regions=region_table(labels)), path)
+    >>> read_label_array(path).tolist()  # ids above 255 survive: 16 bits
+    [[0, 1], [2, 300]]
+    """
     import cv2
 
     from ursim_core.errors import SegmentationError

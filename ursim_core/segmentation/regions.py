@@ -44,6 +44,17 @@ class RegionTable:
     contacts : dict
         ``(a, b)`` as in ``edges`` -> ``contact``, the mean (row, col) of the midpoints of those
         pixel pairs: where the two regions touch (a door, for two rooms split at it).
+
+    Examples
+    --------
+    >>> labels = np.array([[1, 1, 2, 2], [1, 1, 2, 2], [3, 3, 3, 3]])
+    >>> table = region_table(labels)
+    >>> len(table), 3 in table, table.nodes[1]["centroid"], table.edges[1, 3]
+    (3, True, (0.5, 0.5), 2)
+    >>> table.neighbours()[3], table.contacts[1, 2]  # regions 1 and 2 touch between columns 1 and 2
+    ([1, 2], (0.5, 1.5))
+    >>> RegionTable.from_graph(table.to_graph()) == table
+    True
     """
 
     nodes: dict[int, dict]

@@ -203,6 +203,16 @@ def watershed_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     -------
     ndarray of int32
         0 = obstacle; regions 1..N in the raster order of their first pixel.
+
+    Examples
+    --------
+    >>> free = np.zeros((60, 130), bool)
+    >>> free[5:55, 5:60] = free[5:55, 70:125] = free[27:33, 60:70] = True  # two rooms, a door
+    >>> labels = watershed_labels(free)
+    >>> labels.dtype, int(labels[0, 0]), int(labels[30, 30]), int(labels[30, 100])  # wall, rooms
+    (dtype('int32'), 0, 1, 2)
+    >>> int(watershed_labels(free, door_ratio=0.0).max())  # every pass counts as wide: one region
+    1
     """
     import cv2
     from scipy import ndimage

@@ -36,6 +36,18 @@ class Sketch:
         Places drawn that do not exist in the plan.
     notes : tuple of str
         What was changed, in words (drops, additions, scale, rotation).
+
+    Examples
+    --------
+    >>> from ursim_core.synth import generate_floor_plan
+    >>> plan = generate_floor_plan(shape=(200, 300), seed=1)
+    >>> sketch = sketchify(plan, seed=1)
+    >>> sketch.free.shape, sketch.dropped, sketch.extra, int(sketch.rooms.max())
+    ((308, 456), (5,), (12,), 12)
+    >>> print(*sketch.notes, sep="\\n")
+    place 5 (dead-end corridor) is not drawn
+    place 12 (corridor stub, 25 x 52 px) added right of place 3
+    drawn at scale 1.3 (local +-0.3), rotated +2.7 degrees
     """
 
     free: np.ndarray

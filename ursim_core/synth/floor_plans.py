@@ -35,6 +35,17 @@ class Place:
         two corridors cross, or a corridor that leads nowhere else.
     interior : (int, int)
         A (row, col) point well inside the place (see :func:`interior_points`).
+
+    Examples
+    --------
+    >>> plan = generate_floor_plan(shape=(200, 300), seed=1)
+    >>> corridor = plan.places[0]
+    >>> corridor
+    Place(id=1, kind='corridor', role='segment', interior=(99, 149))
+    >>> int(plan.rooms[corridor.interior]) == corridor.id  # the interior point lies in the place
+    True
+    >>> sorted({place.role for place in plan.places})
+    ['crossing', 'dead end', 'room', 'segment']
     """
 
     id: int
@@ -62,6 +73,14 @@ class FloorPlan:
     params : dict
         The sizes the plan was drawn with (``corridor_width``, ``wall_thickness``,
         ``door_width``, ``seed``).
+
+    Examples
+    --------
+    >>> plan = generate_floor_plan(shape=(200, 300), seed=1)
+    >>> plan.free.shape, len(plan.places), plan.params["corridor_width"]
+    ((200, 300), 11, 30)
+    >>> plan.kinds[8], plan.graph.edges[1, 8]["via"]  # room 8 opens onto corridor 1 through a door
+    ('room', 'door')
     """
 
     free: np.ndarray

@@ -145,6 +145,16 @@ def learned_labels(free: np.ndarray, **params: Any) -> np.ndarray:
     -------
     ndarray of int32
         0 = obstacle; regions 1..N in the raster order of their first pixel.
+
+    Examples
+    --------
+    >>> free = np.zeros((60, 130), bool)
+    >>> free[5:55, 5:60] = free[5:55, 70:125] = free[27:33, 60:70] = True  # two rooms, a door
+    >>> labels = learned_labels(free)
+    >>> int(labels[30, 30]), int(labels[30, 100]), int(labels[30, 65])  # left room, right room, door
+    (1, 2, 3)
+    >>> int(learned_labels(free, threshold=0.0).max())  # every touching pair merges
+    1
     """
     from ursim_core.segmentation.learned.features import PieceGraph
     from ursim_core.segmentation.learned.model import default_merge_model, load_merge_model
