@@ -162,12 +162,17 @@ def _warn_if_changed(side: str, ref: MapRef, loaded, path: Path) -> None:
         return
     warnings.warn(
         MapChangedWarning(
-            f"{path}: the {side} map {getattr(loaded, 'path', None) or ref.path} is not the one these "
+            f"{path}: the {side} map{_named(getattr(loaded, 'path', None) or ref.path)} is not the one these "
             f"correspondences were made on (SHA-256 {actual[:12]}... instead of {ref.sha256[:12]}...): "
             "points may no longer fall on the same places"
         ),
         stacklevel=3,
     )
+
+
+def _named(map_path) -> str:
+    # A map made in code has no file: "the sketch map is not...", never "the sketch map None".
+    return f" {map_path}" if map_path else ""
 
 
 def save_correspondences(

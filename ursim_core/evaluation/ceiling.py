@@ -86,8 +86,11 @@ def best_one_to_one(references: Sequence, *, node_budget: int = NODE_BUDGET) -> 
     Returns
     -------
     Ceiling
-        Ties between answers go to the first found: sketch regions in increasing order, each
-        paired before it is left unpaired, partners in increasing order.
+        Ties between answers go to the first one the depth-first search reaches (sketch regions
+        in increasing order, each paired before it is left unpaired, partners in increasing
+        order). Every node counts as an answer, so the first may be the shorter one: with
+        annotators A = {1-10, 2-20} and B = A + {3-30}, pairing 3 with 30 too scores the same
+        mean F1 (B's recall gained, A's precision lost) and is not returned.
 
     Examples
     --------

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import networkx as nx
@@ -93,7 +93,6 @@ class Route:
     sketch_regions: tuple[int, ...] = ()
     skipped: tuple[int, ...] = ()
     gaps: tuple[tuple[int, int], ...] = ()
-    notes: tuple[str, ...] = field(default=())
 
     @property
     def metric_regions(self) -> tuple[int, ...]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import colorsys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
@@ -268,7 +268,7 @@ def side_by_side_matches(
     return canvas
 
 
-def _shrunk(labels: np.ndarray, graph: nx.Graph, image: np.ndarray | None, max_side: int | None):
+def _shrunk(labels: np.ndarray, graph: Any, image: np.ndarray | None, max_side: int | None):
     """``(labels, graph, image)`` scaled so that the longer side is at most ``max_side``.
 
     Labels are resized by nearest neighbour, the grey image by area averaging, and the graph
@@ -288,7 +288,9 @@ def _shrunk(labels: np.ndarray, graph: nx.Graph, image: np.ndarray | None, max_s
     import networkx as nx
 
     small_graph = nx.Graph()
-    for region, (row, col) in graph.nodes(data="interior"):
+    # Indexed, not nodes(data=...): a RegionTable's nodes are a dict, as overlay_segmentation allows.
+    for region in graph.nodes:
+        row, col = graph.nodes[region]["interior"]
         small_graph.add_node(region, interior=(row * factor, col * factor))
     return small_labels, small_graph, small_image
 

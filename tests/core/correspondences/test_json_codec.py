@@ -656,6 +656,17 @@ def test_sha256_mismatch_warns_when_the_map_is_given(tmp_path):
         load_correspondences(path, sketch_map=same)
 
 
+def test_the_warning_of_a_map_without_a_file_names_no_none(tmp_path):
+    from ursim_core.correspondences import check_maps
+
+    grey = np.full((4, 4), 255, np.uint8)
+    drawn = type(map_from_array(grey))(free=grey > 0, sha256="b" * 64)  # made in code: no path
+    corr = Correspondences(sketch=MapRef(sha256="a" * 64))
+    with pytest.warns(MapChangedWarning) as caught:
+        check_maps(corr, drawn, None, tmp_path / "pair.json")
+    assert "None" not in str(caught[0].message) and "the sketch map is not the one" in str(caught[0].message)
+
+
 # --------------------------------------------------------------------------- documentation
 
 

@@ -34,6 +34,17 @@ def test_a_map_above_the_limit_is_drawn_scaled_down():
     assert (figure[:, :75].std(axis=2) > 20).any() and (figure[:, 99:].std(axis=2) > 20).any()
 
 
+def test_a_region_table_serves_as_the_graph_when_the_map_is_scaled_down_too():
+    # overlay_segmentation takes a RegionTable for a graph; scaled down, the figure called
+    # graph.nodes(data=...), which a table's dict of nodes is not.
+    from ursim_core.segmentation.regions import region_table
+
+    labels, graph, image = _map(400, 300)
+    with_table = side_by_side_matches((labels, region_table(labels), image), _map(120, 80), [(1, 1)], max_side=100)
+    with_graph = side_by_side_matches((labels, graph, image), _map(120, 80), [(1, 1)], max_side=100)
+    assert np.array_equal(with_table, with_graph)
+
+
 @pytest.mark.parametrize("shape", [(40, 50), (1200, 700)])  # one band of rows; several (and a partial one)
 def test_the_table_blend_gives_the_pixels_of_the_float_blend(shape):
     from ursim_core.render.figures import _base_image, _blended, label_colors
