@@ -9,13 +9,13 @@ import pytest
 
 from ursim_core import errors
 from ursim_core.errors import (
-    FormatFileNotFoundError,
     FormatError,
-    SegmentationFileNotFoundError,
+    FormatFileNotFoundError,
     MapError,
     MapFileNotFoundError,
     ParameterError,
     SegmentationError,
+    SegmentationFileNotFoundError,
     UrsimError,
     UrsimFileNotFoundError,
     file_not_found,

@@ -106,7 +106,7 @@ def read_label_array(path: str | Path, *, max_pixels: int | None = None) -> np.n
     (checked before decoding, :func:`ursim_core.io.unchanged.read_unchanged`; default
     :data:`~ursim_core.io.maps.DEFAULT_MAX_PIXELS`, the map loader's).
     """
-    from ursim_core.errors import SegmentationFileNotFoundError, SegmentationError
+    from ursim_core.errors import SegmentationError, SegmentationFileNotFoundError
 
     path = Path(path)
     if not path.exists():
