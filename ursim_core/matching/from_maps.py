@@ -7,8 +7,9 @@ not ``segment``'s own default ``"sketch"``), and a sketch whose orientation the 
 assume is segmented in its canonical pose, with its other resamplings for the planar matcher's
 vote. On KTH sketches 00 / 04 / 20 against the model (Malcolm's ground truth), ``segment`` then
 ``match`` with their defaults scored F1 0.64 / 0.50 / 0.67 and place accuracy 0.93 / 0.75 / 0.75
-where this pipeline scores 1.00 / 0.55 / 0.92 and 0.93 / 0.75 / 0.83 (round 60). :func:`match_maps` is that pipeline for callers of the library;
-``ursim match`` and ``ursim goal`` run it too.
+where this pipeline scores 1.00 / 0.55 / 0.92 and 0.93 / 0.75 / 0.83 (round 60).
+:func:`match_maps` is that pipeline for callers of the library; ``ursim match`` and ``ursim goal``
+run it too.
 """
 
 from __future__ import annotations

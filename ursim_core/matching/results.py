@@ -348,7 +348,7 @@ def require_segmentations(sketch_seg: Any, metric_seg: Any) -> None:
     >>> require_segmentations(map_from_array(np.full((4, 4), 255, np.uint8)), None)
     Traceback (most recent call last):
     ...
-    ursim_core.errors.ParameterError: field 'sketch_seg': must be a Segmentation or a region graph, got Map: segment it first (ursim_core.matching.match_maps matches two maps)
+    ursim_core.errors.ParameterError: field 'sketch_seg': must be a Segmentation or a region graph, got Map: ...
     """
     for name, value in (("sketch_seg", sketch_seg), ("metric_seg", metric_seg)):
         if hasattr(value, "graph") or (hasattr(value, "nodes") and hasattr(value, "edges")):
