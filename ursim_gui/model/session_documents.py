@@ -121,13 +121,29 @@ class DocumentOperations:
         corr = load_correspondences(path)
         self._install_document(corr, path=path, saved=corr)
 
-    def restore(self, corr: Correspondences, *, origin: str | os.PathLike | None = None) -> None:
+    def restore(
+        self,
+        corr: Correspondences,
+        *,
+        origin: str | os.PathLike | None = None,
+        autosave: str | os.PathLike | None = None,
+    ) -> list[Path]:
         """Replace the document by a recovered value (from :func:`ursim_gui.model.autosave.recover`).
 
         The maps it names are loaded as in :meth:`open`. The document it belongs to is
         ``origin``, or the path the autosave file recorded under ``"autosave_of"`` (that key
         is removed so it never reaches the real file). The result is dirty: it has not been
         saved, unless it equals what the original file holds.
+
+        ``autosave``: the copy ``corr`` was read from. A sketch drawn in the app and never saved
+        was recovered from the copy's PNG beside it: it is a drawing again (no file), so a save
+        writes it beside the document instead of naming a file in the autosave folder.
+
+        Returns
+        -------
+        list of Path
+            The copy's drawn-map files the session no longer needs (the caller deletes them
+            with the copy).
 
         Raises
         ------
@@ -147,6 +163,24 @@ class DocumentOperations:
             except UrsimError:
                 saved = None  # the original is unreadable: everything recovered is unsaved
         self._install_document(corr, path=path, saved=saved)
+        return [] if autosave is None else self._drawings_again(_absolute(autosave))
+
+    def _drawings_again(self, autosave: Path) -> list[Path]:
+        released = []
+        for side in SIDES:
+            map_, copy = self._maps[side], drawn_map_path_for(autosave, side)
+            if map_ is None or map_.path is None or _absolute(map_.path) != copy:
+                continue
+            ref = getattr(self._corr, side)
+            # No map_changed: the pixels are the same (as _adopt_drawn_file); titles follow path_changed.
+            self._maps[side] = dataclasses.replace(map_, path=None, sha256=None)
+            self._corr = dataclasses.replace(self._corr, **{side: dataclasses.replace(ref, path=None, sha256=None)})
+            released.append(copy)
+        if released:
+            was_dirty = self.dirty
+            self.path_changed.emit(self._path)
+            self._announce_value_change(was_dirty)
+        return released
 
     def save(self, path: str | os.PathLike | None = None, *, overwrite_changed: bool = False) -> None:
         """Write the correspondences to ``path`` (default: the current file), atomically.

@@ -228,11 +228,13 @@ class DocumentController(QObject):
         if chosen is None:
             return False
         try:
-            self.session.restore(recover(chosen))
+            released = self.session.restore(recover(chosen), autosave=chosen)
         except _FAILURES as error:
             dialogs.show_error(self.window, "Recovery failed", str(error))
             return False
-        chosen.unlink(missing_ok=True)
+        # The drawings recovered are in memory again, and in this session's next autosave copy.
+        for path in (chosen, *released):
+            path.unlink(missing_ok=True)
         return True
 
     def _try(self, title: str, operation, *args) -> bool:

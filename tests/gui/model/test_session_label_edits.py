@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 
+from ursim_core.correspondences import load_correspondences
 from ursim_gui.model.session import AnnotationSession
 
 
@@ -110,8 +111,18 @@ def test_a_drawn_sketch_survives_a_crash_through_the_autosave_copy(session, tmp_
     assert session.map("sketch").path is None  # the session is untouched: the copy only references it
 
     recovered = AnnotationSession()
-    recovered.restore(recover(copy))
+    released = recovered.restore(recover(copy), autosave=copy)
     assert np.array_equal(recovered.map("sketch").free, session.map("sketch").free)
+    # A drawing again: saved beside the document, never named in the autosave folder (the
+    # recovered sketch's file was the copy's PNG, referenced by every later save).
+    assert released == [drawing] and recovered.map("sketch").path is None and recovered.dirty
     discard(copy)
     assert not copy.exists() and not drawing.exists()
+    document = tmp_path / "recovered.json"
+    recovered.save(document)
+    beside = tmp_path / "recovered.sketch.png"
+    assert load_correspondences(document).sketch.path == beside and beside.is_file()
+    reopened = AnnotationSession()
+    reopened.open(document)
+    assert np.array_equal(reopened.map("sketch").free, session.map("sketch").free)
     saver.close()

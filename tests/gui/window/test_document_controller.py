@@ -334,6 +334,33 @@ def test_autosave_and_recovery(window, qtbot, tmp_path, monkeypatch):
     assert fresh.table.model.rowCount() == 1
 
 
+def test_a_drawn_sketch_recovered_is_a_drawing_again(window, qtbot, tmp_path, monkeypatch):
+    # It was recovered from the copy's PNG and kept that file's path: every later save named a
+    # file in the autosave folder, which nothing ever removed nor copied beside the document.
+    from ursim_core.io import map_from_array
+
+    drawn = np.full((50, 70), 255, np.uint8)
+    drawn[0, :] = drawn[-1, :] = drawn[:, 0] = drawn[:, -1] = 0
+    window.session.new_document(keep=["metric"])
+    window.session.set_map("sketch", map_from_array(drawn))
+    window.documents.autosaver.flush_if_due(time.monotonic() + 60)
+    folder = window.documents.autosave_dir
+    (copy,) = folder.glob("*.autosave.json")
+    (drawing,) = folder.glob("*.sketch.png")
+    window.documents.autosave_timer.stop()
+    simulate_crash(window.documents.autosaver)
+
+    monkeypatch.setattr(dialogs, "ask_recover", lambda parent, paths: paths[0])
+    fresh = MainWindow(data_dir=tmp_path / "userdata")
+    qtbot.addWidget(fresh)
+    assert fresh.documents.offer_recovery()
+    assert fresh.session.map("sketch").path is None and fresh.session.dirty
+    assert "drawn, not saved yet" in fresh.view_titles["sketch"].text()
+    assert not copy.exists() and not drawing.exists()
+    fresh.session.save(tmp_path / "pair.json")
+    assert load_correspondences(tmp_path / "pair.json").sketch.path == tmp_path / "pair.sketch.png"
+
+
 def autosave_boxes(window):
     return [box for box in error_boxes(window) if box.windowTitle() == "Autosave failed"]
 
