@@ -170,9 +170,9 @@ def match_pair(
     """
     from types import SimpleNamespace
 
-    from ursim_core.correspondences import Correspondences, check_maps, from_pairs
-    from ursim_core.matching import CONSTRAINED_MATCHERS, map_ref, match, pairs_beside_review
-    from ursim_core.matching.results import laid_by, match_record, next_reading_record
+    from ursim_core.correspondences import check_maps
+    from ursim_core.matching import CONSTRAINED_MATCHERS, MapsMatch, match
+    from ursim_core.matching.results import laid_by, next_reading_record
     from ursim_core.render.figures import save_png, side_by_side_matches
     from ursim_core.segmentation import save_label_image
 
@@ -224,21 +224,8 @@ def match_pair(
         elapsed = time.perf_counter() - started
         for job in jobs:
             job.result()
-        cliques = [
-            *kept,
-            *from_pairs(
-                pairs_beside_review(result.pairs, kept),
-                sketch_points_of=lambda r: sketch_seg.graph.nodes[r]["interior"],
-                metric_points_of=lambda r: metric_seg.graph.nodes[r]["interior"],
-                source="auto",
-                first_id=max((c.id for c in kept), default=0) + 1,
-            ),
-        ]
-        corr = Correspondences(
-            sketch=map_ref(sketch_map, sketch_seg, labels_path=out / "sketch.labels.png"),
-            metric=map_ref(metric_map, metric_seg, labels_path=out / "metric.labels.png"),
-            cliques=cliques,
-            extra={"matcher": match_record(config, result)},
+        corr = MapsMatch(sketch_map, metric_map, sketch_seg, metric_seg, result, config).correspondences(
+            sketch_labels_path=out / "sketch.labels.png", metric_labels_path=out / "metric.labels.png", reviewed=kept
         )
         figure = side_by_side_matches(
             (sketch_seg.labels, sketch_seg.graph, sketch_map.image),

@@ -57,14 +57,16 @@ class MapsMatch:
     result: Any
     config: MatchConfig = field(repr=False)
 
-    def correspondences(self, *, sketch_labels_path=None, metric_labels_path=None):
+    def correspondences(self, *, sketch_labels_path=None, metric_labels_path=None, reviewed=()):
         """The answer as a :class:`~ursim_core.correspondences.Correspondences`, as ``ursim
         match`` writes it: one automatic clique per pair at each region's interior point, each
         map named with its digest and segmentation, and the matcher's record under ``matcher``.
 
         ``sketch_labels_path`` / ``metric_labels_path``: where the segmentations' label images
         are (or will be) saved (:func:`~ursim_core.segmentation.save_label_image`), for the file
-        to name them.
+        to name them. ``reviewed``: cliques a person linked, accepted or rejected (on these
+        segmentations' regions), kept first; the answer adds its pairs beside them
+        (:func:`~ursim_core.matching.constraints.pairs_beside_review`), numbered after them.
 
         Examples
         --------
@@ -77,18 +79,22 @@ class MapsMatch:
         (3, 'auto', ['matcher'])
         """
         from ursim_core.correspondences import Correspondences, from_pairs
+        from ursim_core.matching.constraints import pairs_beside_review
         from ursim_core.matching.results import match_record
 
         sketch_graph, metric_graph = self.sketch_seg.graph, self.metric_seg.graph
+        reviewed = tuple(reviewed)
+        answer = from_pairs(
+            pairs_beside_review(self.result.pairs, reviewed),
+            sketch_points_of=lambda region: sketch_graph.nodes[region]["interior"],
+            metric_points_of=lambda region: metric_graph.nodes[region]["interior"],
+            source="auto",
+            first_id=max((clique.id for clique in reviewed), default=0) + 1,
+        )
         return Correspondences(
             sketch=map_ref(self.sketch_map, self.sketch_seg, labels_path=sketch_labels_path),
             metric=map_ref(self.metric_map, self.metric_seg, labels_path=metric_labels_path),
-            cliques=from_pairs(
-                self.result.pairs,
-                sketch_points_of=lambda region: sketch_graph.nodes[region]["interior"],
-                metric_points_of=lambda region: metric_graph.nodes[region]["interior"],
-                source="auto",
-            ),
+            cliques=(*reviewed, *answer),
             extra={"matcher": match_record(self.config, self.result)},
         )
 
