@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 from pathlib import Path
 
 from ursim_core.cli.common import UsageError, refuse_overwriting_inputs
@@ -64,6 +65,11 @@ def run(args: argparse.Namespace) -> int:
 
         kind = export_file(source, target, format=args.format, side=args.side)
         print(f"wrote {args.output} ({kind})")
+        labels = getattr(corr, args.side).labels_path
+        if kind != "qgis-points" and (labels is None or not Path(labels).is_file()):
+            # Not an error (points are the file's substance), but a user expecting rooms should know.
+            shown = "names no label image" if labels is None else f"names the label image {labels}, which is missing"
+            print(f"note: {source} {shown} of the {args.side} map: points only, no region polygons", file=sys.stderr)
         return 0
     convert_correspondences(source, target, sketch=args.sketch, metric=args.metric, loaded=corr)
     print(f"wrote {args.output}")

@@ -52,3 +52,20 @@ def test_convert_bad_input(tmp_path, capsys):
     assert main(["convert", str(tmp_path / "bad.json"), str(tmp_path / "x.dat")]) == 1
     assert "bad.json" in capsys.readouterr().err
     assert main(["convert", str(tmp_path / "bad.json"), str(tmp_path / "x.txt")]) == 1
+
+
+def test_an_export_without_the_label_image_says_it_has_points_only(tmp_path, pair, capsys):
+    # The GeoJSON held points and no region, silently: a user expecting the rooms was not told why.
+    sketch, metric = pair
+    assert main(["match", str(sketch), str(metric), "-o", str(tmp_path / "out")]) == 0
+    source = tmp_path / "out" / "correspondences.json"
+    capsys.readouterr()
+    assert main(["convert", str(source), str(tmp_path / "with.geojson")]) == 0
+    assert "note:" not in capsys.readouterr().err
+    with_kinds = {f["geometry"]["type"] for f in json.loads((tmp_path / "with.geojson").read_text())["features"]}
+    (tmp_path / "out" / "metric.labels.png").unlink()
+    assert main(["convert", str(source), str(tmp_path / "without.geojson")]) == 0
+    err = capsys.readouterr().err
+    assert "which is missing" in err and "points only, no region polygons" in err and str(source) in err
+    kinds = {f["geometry"]["type"] for f in json.loads((tmp_path / "without.geojson").read_text())["features"]}
+    assert kinds < with_kinds and not kinds & {"Polygon", "MultiPolygon"}
