@@ -44,8 +44,8 @@ class SketchNavigator:
         target: str = "interior",
     ):
         from ursim_core.io.maps import load_map
-        from ursim_core.matching.pipeline import MATCH_PRESETS
-        from ursim_core.segmentation import segment
+        from ursim_core.matching.config import MATCH_PRESETS
+        from ursim_core.matching.from_maps import segment_for_matching
 
         if not str(sketch_path):
             raise ParameterError("the parameter sketch_path is empty: give the sketch image", field="sketch_path")
@@ -53,7 +53,9 @@ class SketchNavigator:
         self.metric_preset = metric_preset or MATCH_PRESETS["metric"]
         self.target = target
         self.sketch_map = load_map(sketch_path)
-        self.sketch_seg = segment(self.sketch_map, preset=self.sketch_preset)
+        # Segmented as ursim match segments a sketch (its canonical pose, its resamplings for the
+        # vote), once: each map received is matched against it.
+        self.sketch_seg = segment_for_matching(self.sketch_map, side="sketch", preset=self.sketch_preset)
         self.correspondences = None
         if correspondences:
             from ursim_core.correspondences import load_correspondences
@@ -71,11 +73,11 @@ class SketchNavigator:
     def set_map(self, grid) -> None:
         """Take the robot's map (an OccupancyGrid, e.g. ``OccupancyGrid.from_message(msg)``) and match."""
         from ursim_core.io.occupancy_grid import map_from_occupancy_grid
+        from ursim_core.matching.from_maps import segment_for_matching
         from ursim_core.navigation.goal import match_table
-        from ursim_core.segmentation import segment
 
         metric_map = map_from_occupancy_grid(grid.data, grid.width, grid.height, grid.resolution, grid.origin)
-        metric_seg = segment(metric_map, preset=self.metric_preset)
+        metric_seg = segment_for_matching(metric_map, side="metric", preset=self.metric_preset)
         if self.correspondences is not None:
             from ursim_core.correspondences import assign_regions
 

@@ -89,3 +89,19 @@ def test_without_rclpy_the_node_says_how_to_install_it():
     assert result.stderr.startswith("error: the URSIM ROS 2 node needs rclpy") and "Jazzy" in result.stderr
     with pytest.raises(ImportError, match="needs rclpy"):
         import ursim_ros.node  # noqa: F401
+
+
+def test_the_sketch_is_segmented_and_matched_as_ursim_match_does(tmp_path):
+    # The navigator segmented the sketch with plain segment(): not in its canonical pose, no
+    # resamplings for the vote, another pipeline than ursim match and ursim goal run.
+    from ursim_core.io import load_map
+    from ursim_core.matching import segment_for_matching
+
+    Image.fromarray(np.rot90(rooms())).save(tmp_path / "sketch.png")  # drawn turned
+    navigator = SketchNavigator(tmp_path / "sketch.png")
+    expected = segment_for_matching(load_map(tmp_path / "sketch.png"), side="sketch")
+    assert navigator.sketch_seg.params.get("canonical") is True
+    assert np.array_equal(navigator.sketch_seg.labels, expected.labels)
+    navigator.set_map(robot_grid())
+    goal = navigator.goal_for_tap(x=25, y=160)  # the turned sketch's first room (column 25, row 160)
+    assert goal.ok and goal.metric_region is not None
