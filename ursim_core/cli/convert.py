@@ -9,7 +9,8 @@ import sys
 from pathlib import Path
 
 from ursim_core.cli.common import UsageError, refuse_overwriting_inputs
-from ursim_core.cli.inputs import correspondence_inputs, load_correspondence_file, map_inputs
+from ursim_core.cli.inputs import correspondence_inputs, map_inputs
+from ursim_core.correspondences import load_correspondence_file
 from ursim_core.errors import ParameterError
 
 __all__ = ["convert_correspondences"]

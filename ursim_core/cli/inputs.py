@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["map_inputs", "yaml_image", "correspondence_inputs", "load_correspondence_file"]
+__all__ = ["map_inputs", "yaml_image", "correspondence_inputs"]
 
 #: A file read, and why (for the message).
 DescribedInput = tuple[Path, str]
@@ -55,14 +55,6 @@ def yaml_image(path: str | os.PathLike) -> Path | None:
         return ros_image_path(path)
     except MapError:
         return None
-
-
-def load_correspondence_file(path: str | os.PathLike):
-    """A correspondence file of either format, by its suffix (``.dat``, else JSON)."""
-    from ursim_core.correspondences import load_correspondences, load_dat
-
-    path = Path(path)
-    return load_dat(path) if path.suffix.lower() == ".dat" else load_correspondences(path)
 
 
 def correspondence_inputs(path: str | os.PathLike | None, corr) -> list[DescribedInput]:

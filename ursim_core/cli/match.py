@@ -56,15 +56,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def load_reference(path: str | Path):
     """A ground-truth file of either format, by its suffix."""
-    from ursim_core.correspondences import load_correspondences, load_dat
+    from ursim_core.correspondences import load_correspondence_file
 
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix == ".dat":
-        return load_dat(path)
-    if suffix == ".json":
-        return load_correspondences(path)
-    raise ParameterError("unknown ground-truth file type (expected .dat or .json)", path=path)
+    if path.suffix.lower() not in (".dat", ".json"):
+        raise ParameterError("unknown ground-truth file type (expected .dat or .json)", path=path)
+    return load_correspondence_file(path)
 
 
 def reviewed_cliques(review, sketch_seg, metric_seg):

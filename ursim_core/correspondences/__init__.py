@@ -39,6 +39,7 @@ __getattr__, __dir__, __all__ = _lazy.attach(
             "SUPPORTED_VERSIONS",
             "check_maps",
             "load_correspondences",
+            "load_correspondence_file",
             "save_correspondences",
             "correspondences_to_json",
         ],

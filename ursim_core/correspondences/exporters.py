@@ -443,12 +443,12 @@ def export_file(
     >>> json.loads((folder / "pair.labelme.json").read_text())["shapes"][0]["points"]  # [x, y]
     [[20.5, 10.5]]
     """
-    from ursim_core.correspondences import load_correspondences, load_dat
+    from ursim_core.correspondences import load_correspondence_file
 
     _check_side(side)
     kind = export_format_of(target, format)
     source = Path(source)
-    corr = load_dat(source) if source.suffix.lower() == ".dat" else load_correspondences(source)
+    corr = load_correspondence_file(source)
     _check_not_an_input(corr, source, Path(target))
     ref = getattr(corr, side)
     labels = _read_labels(ref.labels_path, ref.size) if ref.labels_path is not None else None

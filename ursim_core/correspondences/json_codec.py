@@ -48,6 +48,7 @@ __all__ = [
     "SUPPORTED_VERSIONS",
     "check_maps",
     "load_correspondences",
+    "load_correspondence_file",
     "save_correspondences",
     "correspondences_to_json",
     "MAX_DEPTH",
@@ -108,6 +109,25 @@ def load_correspondences(path: str | os.PathLike, *, sketch_map=None, metric_map
     for side, ref, loaded in (("sketch", corr.sketch, sketch_map), ("metric", corr.metric, metric_map)):
         _warn_if_changed(side, ref, loaded, path)
     return corr
+
+
+def load_correspondence_file(path: str | os.PathLike) -> Correspondences:
+    """A correspondence file of either format, by its suffix: ``.dat``
+    (:func:`~ursim_core.correspondences.dat_codec.load_dat`), else JSON (:func:`load_correspondences`).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from ursim_core.correspondences import save_dat
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "pair.dat"
+    >>> _ = save_dat(Correspondences(cliques=(Clique(id=1, sketch_points=[(1, 2)], metric_points=[(3, 4)]),)), target)
+    >>> load_correspondence_file(target).cliques[0].metric_points
+    ((3, 4),)
+    """
+    from ursim_core.correspondences.dat_codec import load_dat
+
+    path = Path(path)
+    return load_dat(path) if path.suffix.lower() == ".dat" else load_correspondences(path)
 
 
 def check_maps(corr: Correspondences, sketch_map, metric_map, path: str | os.PathLike) -> None:

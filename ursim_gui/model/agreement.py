@@ -28,7 +28,12 @@ from dataclasses import dataclass
 from itertools import product
 from pathlib import Path
 
-from ursim_core.correspondences import Correspondences, load_correspondences, load_dat, regions_at_points
+from ursim_core.correspondences import (
+    Correspondences,
+    load_correspondence_file,
+    load_correspondences,
+    regions_at_points,
+)
 from ursim_core.io.atomic import atomic_write_bytes
 
 __all__ = [
@@ -76,7 +81,7 @@ class PairAgreement:
 
 def load_annotation(path: Path) -> Correspondences:
     """A correspondence JSON or a legacy ``.dat`` file."""
-    return load_dat(path) if Path(path).suffix.lower() == ".dat" else load_correspondences(path)
+    return load_correspondence_file(path)
 
 
 def region_sets(corr: Correspondences, sketch_labels, metric_labels, *, which: str = "claims"):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from itertools import product
 
-from ursim_core.correspondences import load_correspondences, load_dat, regions_at_points
+from ursim_core.correspondences import load_correspondence_file, regions_at_points
 from ursim_gui.model.session_values import REFERENCE_TOLERANCE, SIDES, _absolute
 
 __all__ = ["EvaluationOperations"]
@@ -26,7 +26,7 @@ class EvaluationOperations:
         side that is not segmented.
         """
         path = _absolute(path)
-        reference = load_dat(path) if path.suffix.lower() == ".dat" else load_correspondences(path)
+        reference = load_correspondence_file(path)
         self._reference_corr = reference
         self._reference_path = path
         self._recompute_reference()
