@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     if export:
         from ursim_core.correspondences.exporters import export_file
 
-        kind = export_file(source, target, format=args.format, side=args.side)
+        kind = export_file(source, target, format=args.format, side=args.side, loaded=corr)
         print(f"wrote {args.output} ({kind})")
         labels = getattr(corr, args.side).labels_path
         if kind != "qgis-points" and (labels is None or not Path(labels).is_file()):

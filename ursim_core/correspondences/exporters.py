@@ -418,12 +418,14 @@ def export_file(
     *,
     format: str | None = None,
     side: str = "metric",
+    loaded=None,
 ) -> str:
     """Export a correspondence file (.json or .dat) to ``target``; what ``ursim convert`` calls.
 
     The maps and label images the file references are used when they exist: the label image
     of ``side`` gives the region polygons (GeoJSON, labelme), a map_server YAML map gives world
     coordinates (GeoJSON of that side; the metric side of QGIS points). Returns the format.
+    ``loaded``: ``source`` as the caller has loaded it already (else it is loaded here).
 
     Raises
     ------
@@ -448,7 +450,7 @@ def export_file(
     _check_side(side)
     kind = export_format_of(target, format)
     source = Path(source)
-    corr = load_correspondence_file(source)
+    corr = loaded if loaded is not None else load_correspondence_file(source)
     _check_not_an_input(corr, source, Path(target))
     ref = getattr(corr, side)
     labels = _read_labels(ref.labels_path, ref.size) if ref.labels_path is not None else None
